@@ -1,0 +1,28 @@
+// The list of algorithms. Adding one is a folder under algorithms/ and one line here.
+#include "algorithms/ShadowAlgorithm.h"
+#include "algorithms/psv/Psv.h"
+#include "algorithms/reference/Reference.h"
+#include "algorithms/shadow_map/ShadowMap.h"
+
+#include <algorithm>
+
+namespace shadowlab {
+
+const std::vector<AlgorithmInfo>& algorithmRegistry() {
+    static const std::vector<AlgorithmInfo> registry = {
+        shadowMapInfo(),
+        referenceInfo(),
+        psvInfo(),
+    };
+    return registry;
+}
+
+const AlgorithmInfo* findAlgorithm(const std::string& name) {
+    for (const auto& a : algorithmRegistry())
+        if (a.name == name) return &a;
+    return nullptr;
+}
+
+bool AlgorithmInfo::supports(LightType t) const { return std::find(lights.begin(), lights.end(), t) != lights.end(); }
+
+} // namespace shadowlab

@@ -1,0 +1,89 @@
+#pragma once
+// The interface every shadow algorithm implements, and its lifecycle:
+//
+//   1. create(params)      the registry's factory builds it from validated ParamValues.
+//   2. setScene(scene)     per-scene work (acceleration structures, caches); timed as `preprocess`.
+//   3. resize(resolution)  (re)allocates what depends on the image size; called after setScene()
+//                          and whenever the resolution changes.
+//   4. paramsChanged(p, c) new values; c = Rebuild means setScene() and resize() follow, c = Update
+//                          means only uniforms change.
+//   5. per frame:          computeVisibility(frame) writes visibility in [0, 1] per pixel into
+//                          frame.visibility, timing its stages through frame.timer;
+//                          then counters(), debugViews() and memoryBytes() describe that frame.
+//
+// The G-buffer and the shading pass are shared: an algorithm only produces visibility.
+#include "framework/core/Params.h"
+#include "framework/gl/StageTimer.h"
+#include "framework/render/GBuffer.h"
+#include "framework/render/SceneGpu.h"
+#include "framework/view/Camera.h"
+#include "framework/view/Light.h"
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace shadowlab {
+
+/// Everything an algorithm may read for one frame.
+struct FrameInputs {
+    const GBuffer& gbuffer;
+    /// The G-buffer on the CPU (CPU algorithms only; read back once per frame, shared).
+    const std::function<const CpuGBuffer&()> cpuGBuffer;
+    const Camera& camera;
+    const Light& light;
+    int frameIndex;
+    GLuint visibility; ///< R32F texture of gbuffer.resolution() to write (image unit or FBO attachment)
+    StageTimer& timer;
+};
+
+/// A named per-frame scalar gathered by the algorithm (e.g. nodes visited per pixel, mean and max).
+struct Counter {
+    std::string name;
+    double value = 0;
+};
+
+/// A per-pixel debug image (e.g. a cost heat map): R32F texture, shown with a colour map over [0, maxValue].
+struct DebugView {
+    std::string name;
+    GLuint texture = 0;
+    float maxValue = 0; ///< 0 = use the image's maximum
+    std::string unit;
+};
+
+class ShadowAlgorithm {
+public:
+    virtual ~ShadowAlgorithm() = default;
+
+    virtual void setScene(const SceneGpu& scene) = 0;
+    virtual void resize(glm::ivec2 resolution) { (void)resolution; }
+    virtual void paramsChanged(const ParamValues& params, ParamChange change) = 0;
+    virtual void computeVisibility(const FrameInputs& frame) = 0;
+
+    virtual std::vector<Counter> counters() const { return {}; }
+    virtual std::vector<DebugView> debugViews() const { return {}; }
+    /// Bytes of GPU (or CPU, for CPU algorithms) memory the algorithm holds for its structures.
+    virtual size_t memoryBytes() const { return 0; }
+    /// Fixed-size structures that overflowed in the last frame (0 = the image is trustworthy).
+    virtual uint64_t overflowCount() const { return 0; }
+};
+
+/// One registered algorithm: the registry key is also its folder, JSON "algorithm" value and label.
+struct AlgorithmInfo {
+    std::string name;
+    std::string summary;          ///< one line for `shadowlab list`
+    std::vector<LightType> lights; ///< light types it supports
+    bool exact = false;           ///< exact hard shadows: held to the reference's tiny mismatch
+    const ParamSchema& (*schema)();
+    std::unique_ptr<ShadowAlgorithm> (*create)(const ParamValues& params);
+
+    bool supports(LightType t) const;
+};
+
+/// Every registered algorithm, in registration order (algorithms/Registry.cpp).
+const std::vector<AlgorithmInfo>& algorithmRegistry();
+/// The entry called `name`, or nullptr.
+const AlgorithmInfo* findAlgorithm(const std::string& name);
+
+} // namespace shadowlab

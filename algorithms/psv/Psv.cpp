@@ -1,0 +1,226 @@
+#include "algorithms/psv/Psv.h"
+
+#include "algorithms/psv/PsvGpuLayout.h"
+#include "algorithms/psv/PsvPermutation.h"
+#include "framework/core/Error.h"
+#include "framework/render/LightUniforms.h"
+
+#include <algorithm>
+#include <array>
+#include <climits>
+
+namespace shadowlab {
+namespace {
+
+const ParamSchema& psvSchema() {
+    static const ParamSchema s = ParamSchema()
+        .boolean("wedge", true,
+                 "wedge optimisation (paper 3.5): an intersection child is visited only inside its wedge",
+                 ParamChange::Rebuild)
+        .boolean("random_order", true,
+                 "merge triangles in a seeded pseudo-random order (paper 3.3) instead of scene order",
+                 ParamChange::Rebuild)
+        .integer("seed", 1, 0, INT_MAX, "", "seed of the insertion order (with random_order)", ParamChange::Rebuild)
+        // Off by default: it is exact only for closed, consistently wound meshes (a ground plane
+        // facing the light is dropped, fine; an open mesh would leak light through its back).
+        .boolean("front_face_culling", false,
+                 "only triangles facing away from the light cast (paper 4.2); exact for closed meshes only",
+                 ParamChange::Rebuild)
+        .boolean("depth_skip", true,
+                 "skip a capping node's subtree when the point is nearer the light than all of it (Mora et al. 2016)",
+                 ParamChange::Rebuild)
+        .integer("stack_size", 32, 1, 256, "nodes",
+                 "query stack; a pixel that overflows it is written shadowed and counted", ParamChange::Rebuild)
+        .boolean("transparency", false,
+                 "x-ray shadows (paper 4.3): multiply (1 - opacity) of every frustum containing the point",
+                 ParamChange::Rebuild)
+        // Same key, default and unit as the reference's: the query point is the reference's ray origin.
+        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
+              "query point offset along the surface normal, against self-shadowing", ParamChange::Update);
+    return s;
+}
+
+constexpr GLuint kBuildGroup = 64;  ///< local_size_x of frusta.comp and build.comp
+constexpr GLuint kMaxGroups = 65535; ///< GL's minimum max work group count per dimension
+
+class Psv final : public ShadowAlgorithm {
+public:
+    explicit Psv(const ParamValues& p) : params_(p) { compile(); }
+
+    void setScene(const SceneGpu& scene) override {
+        scene_ = &scene;
+        const size_t n = scene.triangleCount();
+        if (psv::nodeCount(n) > size_t(UINT32_MAX))
+            throw RuntimeError("psv: " + std::to_string(n) + " triangles exceed 32-bit node indices");
+        nodes_ = GlBuffer(psv::nodeCount(n) * PSV_NODE_BYTES, nullptr, 0);
+        counters_ = GlBuffer(psv::kCounterBytes, nullptr, 0);
+        nodes_.clearUint(0);
+        counters_.clearUint(0);
+        permutation_ = psv::makePermutation(uint32_t(n), uint32_t(params_.getInt("seed")));
+    }
+
+    void resize(glm::ivec2 resolution) override {
+        resolution_ = resolution;
+        nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+        overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+    }
+
+    void paramsChanged(const ParamValues& p, ParamChange change) override {
+        params_ = p;
+        if (change != ParamChange::Rebuild) return;
+        compile();
+        if (scene_) setScene(*scene_);
+    }
+
+    void computeVisibility(const FrameInputs& f) override {
+        if (!scene_) throw RuntimeError("psv: computeVisibility() before setScene()");
+        if (f.light.type != LightType::Point && f.light.type != LightType::Directional)
+            throw RuntimeError(std::string("psv supports point and directional lights, not ") + toString(f.light.type));
+        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
+        setUniforms(f.light);
+
+        f.timer.begin("build");
+        counters_.clearUint(0);
+        // Node 0 is the sentinel whose `pos` is the root pointer: emptying it empties the tree.
+        // The other nodes need no clearing: frusta.comp rewrites every node that can be linked.
+        const GLuint zero = 0;
+        glClearNamedBufferSubData(nodes_.id(), GL_R32UI, 0, PSV_NODE_BYTES, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+        scene_->bindStorage();
+        nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, PSV_NODE_BINDING);
+        counters_.bindBase(GL_SHADER_STORAGE_BUFFER, PSV_COUNTER_BINDING);
+        if (scene_->triangleCount() > 0) {
+            dispatchPerTriangle(frusta_);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            dispatchPerTriangle(build_);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        f.timer.end();
+
+        // Light culling: a point light sees every direction and a directional light the whole
+        // scene, so a light-view frustum culls nothing for the lights psv supports (a spot light
+        // would cull the triangles outside its cone).
+        f.timer.begin("traverse");
+        glBindTextureUnit(0, f.gbuffer.position());
+        glBindTextureUnit(1, f.gbuffer.normal());
+        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(2, overflow_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        query_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        f.timer.end();
+        countersRead_ = false;
+    }
+
+    std::vector<Counter> counters() const override {
+        const auto& c = readCounters();
+        const double visited = double((uint64_t(c[PSV_C_VISITED_HI]) << 32) | c[PSV_C_VISITED_LO]);
+        const double traversed = c[PSV_C_TRAVERSED];
+        return {{"nodes_visited_mean", traversed > 0 ? visited / traversed : 0.0},
+                {"nodes_visited_max", double(c[PSV_C_VISITED_MAX])},
+                {"stack_overflow_pixels", double(c[PSV_C_STACK_OVERFLOW])},
+                {"traversed_pixels", traversed},
+                {"casters_inserted", double(c[PSV_C_INSERTED])},
+                {"culled_front_facing", double(c[PSV_C_CULLED_FACING])},
+                {"culled_edge_on", double(c[PSV_C_CULLED_EDGE_ON])},
+                {"culled_occluded", double(c[PSV_C_CULLED_OCCLUDED])},
+                {"insert_depth_max", double(c[PSV_C_INSERT_DEPTH_MAX])},
+                {"build_errors", double(c[PSV_C_BUILD_ERRORS])}};
+    }
+
+    std::vector<DebugView> debugViews() const override {
+        return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
+    }
+
+    /// The tree (4n + 1 nodes of 32 bytes) plus the 96-byte counter block: exactly 128 (n + 1) bytes.
+    /// Not counted: the per-pixel debug images (nodes_visited, stack_overflow), which every image
+    /// algorithm could add and which do not depend on the scene.
+    size_t memoryBytes() const override { return nodes_.size() + counters_.size(); }
+
+    /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
+    uint64_t overflowCount() const override {
+        const auto& c = readCounters();
+        return uint64_t(c[PSV_C_STACK_OVERFLOW]) + c[PSV_C_BUILD_ERRORS];
+    }
+
+private:
+    void compile() {
+        auto flag = [&](const char* key) { return params_.getBool(key) ? std::string("1") : std::string("0"); };
+        const ShaderDefines defines = {{"PSV_WEDGE", flag("wedge")},
+                                       {"PSV_RANDOM_ORDER", flag("random_order")},
+                                       {"PSV_FRONT_FACE_CULLING", flag("front_face_culling")},
+                                       {"PSV_DEPTH_SKIP", flag("depth_skip")},
+                                       {"PSV_TRANSPARENCY", flag("transparency")},
+                                       {"PSV_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
+        frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
+        build_ = ShaderProgram::compute("psv/build.comp", defines);
+        query_ = ShaderProgram::compute("psv/query.comp", defines);
+    }
+
+    void setUniforms(const Light& light) {
+        const Bounds& b = scene_->bounds();
+        const float radius = b.empty() ? 1.0f : b.radius();
+        const glm::vec3 center = b.empty() ? glm::vec3(0.0f) : b.center();
+        // Rounding of a plane evaluation grows with the coordinates' magnitude (and the light's:
+        // shadow planes pass through it); 4e-6 of it is well above float error, and only costs
+        // extra intersection-child visits for triangles that close to a plane.
+        float magnitude = glm::length(center) + radius;
+        if (light.type == LightType::Point) magnitude = std::max(magnitude, glm::length(light.position));
+        const float tolerance = 4e-6f * magnitude;
+        const glm::vec3 depthOrigin = center - light.direction() * (2.0f * radius);
+        const float rayOffset = float(params_.getFloat("ray_offset")) * radius;
+        const uint32_t n = uint32_t(scene_->triangleCount());
+        for (const ShaderProgram* p : {&frusta_, &build_, &query_}) {
+            setLightUniforms(*p, light);
+            p->set("uTriangleCount", unsigned(n));
+            p->set("uTolerance", tolerance);
+            p->set("uDepthOrigin", depthOrigin);
+            glProgramUniform4ui(p->id(), p->location("uPermKeys"), permutation_.keys[0], permutation_.keys[1],
+                                permutation_.keys[2], permutation_.keys[3]);
+            p->set("uPermHalfBits", unsigned(permutation_.halfBits));
+        }
+        query_.set("uRayOffset", rayOffset);
+    }
+
+    /// One invocation per triangle, as a 2D grid when n needs more than 65535 groups of 64.
+    void dispatchPerTriangle(const ShaderProgram& p) const {
+        const GLuint groups = GLuint((scene_->triangleCount() + kBuildGroup - 1) / kBuildGroup);
+        const GLuint gx = std::min(groups, kMaxGroups), gy = (groups + gx - 1) / gx;
+        p.set("uInvocationsPerRow", unsigned(gx * kBuildGroup));
+        p.use();
+        glDispatchCompute(gx, gy, 1);
+    }
+
+    const std::array<uint32_t, PSV_COUNTER_WORDS>& readCounters() const {
+        if (!countersRead_ && counters_) {
+            counters_.download(counterValues_.data(), psv::kCounterBytes);
+            countersRead_ = true;
+        }
+        return counterValues_;
+    }
+
+    ParamValues params_;
+    const SceneGpu* scene_ = nullptr;
+    glm::ivec2 resolution_{0, 0};
+    ShaderProgram frusta_, build_, query_;
+    GlBuffer nodes_, counters_;
+    GlTexture nodesVisited_, overflow_;
+    psv::Permutation permutation_;
+    mutable std::array<uint32_t, PSV_COUNTER_WORDS> counterValues_{};
+    mutable bool countersRead_ = false;
+};
+
+} // namespace
+
+AlgorithmInfo psvInfo() {
+    AlgorithmInfo info;
+    info.name = "psv";
+    info.summary = "partitioned shadow volumes: per-frame TOP tree of shadow frusta (compute), per-pixel stack query";
+    info.lights = {LightType::Point, LightType::Directional};
+    info.exact = true;
+    info.schema = &psvSchema;
+    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<Psv>(p); };
+    return info;
+}
+
+} // namespace shadowlab

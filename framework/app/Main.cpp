@@ -1,0 +1,142 @@
+// shadowlab: the headless command line. One binary per GL back end (OSMesa, EGL) links this file.
+#include "algorithms/ShadowAlgorithm.h"
+#include "framework/core/Error.h"
+#include "framework/experiment/Config.h"
+#include "framework/experiment/Runner.h"
+#include "framework/gl/GlContext.h"
+
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace shadowlab;
+
+namespace {
+
+const char* kUsage = R"(shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.
+
+Usage:
+  shadowlab run CONFIG.json [--out DIR] [--force] [--no-progress]
+      Runs the experiment and writes DIR (default: the config's output.dir): config.resolved.json,
+      frames.csv, summary.json, report.md, images/ and plots. An existing DIR is kept unless --force;
+      it is replaced only once the new run has completed.
+  shadowlab validate CONFIG.json
+      Checks the config (and loads its scene) without rendering; prints the resolved config.
+  shadowlab list [--json]
+      Lists the registered algorithms and their parameters.
+  shadowlab --help | --version
+
+Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.
+)";
+
+void printList(bool json) {
+    if (json) {
+        Json out = Json::array();
+        for (const auto& a : algorithmRegistry()) {
+            Json lights = Json::array();
+            for (LightType t : a.lights) lights.push_back(toString(t));
+            out.push_back({{"name", a.name}, {"summary", a.summary}, {"lights", lights}, {"exact", a.exact},
+                           {"params", a.schema().toJson()}});
+        }
+        std::cout << out.dump(2) << "\n";
+        return;
+    }
+    for (const auto& a : algorithmRegistry()) {
+        std::cout << a.name << " — " << a.summary << "\n  lights:";
+        for (LightType t : a.lights) std::cout << " " << toString(t);
+        std::cout << "\n";
+        for (const auto& s : a.schema().specs()) {
+            std::cout << "  " << s.key << " (" << toString(s.type) << ", default " << toString(s.def);
+            if (s.type == ParamType::Int || s.type == ParamType::Float) std::cout << ", range [" << s.min << ", " << s.max << "]";
+            if (s.type == ParamType::Enum) {
+                std::cout << ", one of";
+                for (const auto& c : s.choices) std::cout << " " << c;
+            }
+            if (!s.unit.empty()) std::cout << ", " << s.unit;
+            std::cout << ", " << (s.change == ParamChange::Rebuild ? "rebuild" : "update") << ")\n      " << s.doc << "\n";
+        }
+    }
+}
+
+[[noreturn]] void usageError(const std::string& msg) {
+    std::fprintf(stderr, "shadowlab: %s (see shadowlab --help)\n", msg.c_str());
+    std::exit(2);
+}
+
+int run(const std::vector<std::string>& args) {
+    std::string config;
+    RunOptions opt;
+    for (size_t i = 1; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--out") {
+            if (++i >= args.size()) usageError("--out needs a directory");
+            opt.outputDir = args[i];
+        } else if (a == "--force") {
+            opt.force = true;
+        } else if (a == "--no-progress") {
+            opt.progress = false;
+        } else if (!a.empty() && a[0] == '-') {
+            usageError("unknown option " + a);
+        } else if (config.empty()) {
+            config = a;
+        } else {
+            usageError("unexpected argument " + a);
+        }
+    }
+    if (config.empty()) usageError("run needs a config file");
+    ExperimentConfig cfg = loadConfig(config);
+    auto context = createHeadlessContext(false);
+    installGlDebugCallback(true);
+    std::fprintf(stderr, "shadowlab: %s, %zu triangles, %d×%d, %d frames on %s (%s)\n", cfg.name.c_str(),
+                 cfg.scene->triangleCount(), cfg.resolution.x, cfg.resolution.y, cfg.frames, glRendererString().c_str(),
+                 context->backend().c_str());
+    ExperimentResults r = runExperiment(cfg, opt, context->backend());
+    std::string dir = opt.outputDir.empty() ? cfg.outputDir : opt.outputDir;
+    std::fprintf(stderr, "shadowlab: wrote %s (report.md, summary.json) in %.1f s\n", dir.c_str(),
+                 r.meta["wall_time_s"].get<double>());
+    if (glErrorCount() > 0) {
+        std::fprintf(stderr, "shadowlab: %d OpenGL errors were reported during the run\n", glErrorCount());
+        return 1;
+    }
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> args(argv + 1, argv + argc);
+    try {
+        if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+            std::fputs(kUsage, args.empty() ? stderr : stdout);
+            return args.empty() ? 2 : 0;
+        }
+        if (args[0] == "--version") {
+            std::puts("shadowlab 0.1");
+            return 0;
+        }
+        if (args[0] == "list") {
+            bool json = args.size() > 1 && args[1] == "--json";
+            if (args.size() > (json ? 2u : 1u)) usageError("list takes only --json");
+            printList(json);
+            return 0;
+        }
+        if (args[0] == "validate") {
+            if (args.size() != 2) usageError("validate needs exactly one config file");
+            ExperimentConfig cfg = loadConfig(args[1]);
+            std::cout << cfg.resolved.dump(2) << "\n";
+            std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", args[1].c_str(), cfg.scene->triangleCount(),
+                         cfg.algorithms.size(), cfg.reference ? " + reference" : "");
+            return 0;
+        }
+        if (args[0] == "run") return run(args);
+        usageError("unknown command " + args[0]);
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "shadowlab: error: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "shadowlab: failed: %s\n", e.what());
+        return 1;
+    }
+}

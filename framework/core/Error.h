@@ -1,0 +1,34 @@
+#pragma once
+// Error types that map to the CLI's exit codes: bad input (2) and runtime failure (1).
+#include <stdexcept>
+#include <string>
+
+namespace shadowlab {
+
+/// Bad input: a config, scene file or parameter that cannot be used. Exit code 2.
+/// The message is one line: "FILE: at JSON_PATH: CAUSE" (path omitted when not applicable).
+class InputError : public std::runtime_error {
+public:
+    InputError(const std::string& file, const std::string& jsonPath, const std::string& cause)
+        : std::runtime_error(format(file, jsonPath, cause)), file_(file), path_(jsonPath), cause_(cause) {}
+
+    const std::string& file() const { return file_; }
+    const std::string& jsonPath() const { return path_; }
+    const std::string& cause() const { return cause_; }
+
+private:
+    static std::string format(const std::string& file, const std::string& path, const std::string& cause) {
+        std::string s = file.empty() ? std::string("<input>") : file;
+        if (!path.empty()) s += ": at " + path;
+        return s + ": " + cause;
+    }
+    std::string file_, path_, cause_;
+};
+
+/// Something failed while running (GL error, out of memory, I/O). Exit code 1.
+class RuntimeError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+} // namespace shadowlab

@@ -1,0 +1,244 @@
+#include "framework/core/JsonNode.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace shadowlab {
+
+namespace fs = std::filesystem;
+
+std::string parentDir(const std::string& file) {
+    fs::path p = fs::path(file).parent_path();
+    return p.empty() ? std::string(".") : p.string();
+}
+
+std::string resolvePath(const std::string& baseDir, const std::string& p) {
+    if (p.empty() || fs::path(p).is_absolute()) return p;
+    return (fs::path(baseDir) / p).lexically_normal().string();
+}
+
+JsonNode::JsonNode(std::string file, const Json* value, std::string path, Json* resolved)
+    : file_(std::move(file)), value_(value), path_(std::move(path)), resolved_(resolved) {
+    if (!value_) {
+        emptyObject_ = std::make_shared<Json>(Json::object());
+        value_ = emptyObject_.get();
+    }
+    if (!value_->is_object()) failHere("expected a JSON object, got " + std::string(value_->type_name()));
+    if (resolved_ && !resolved_->is_object()) *resolved_ = Json::object();
+}
+
+Json JsonNode::parseFile(const std::string& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file, "", "cannot open file");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    try {
+        return Json::parse(ss.str());
+    } catch (const Json::parse_error& e) {
+        // nlohmann's message starts with "[json.exception.parse_error.101] "; keep the useful part.
+        std::string msg = e.what();
+        auto pos = msg.find("] ");
+        throw InputError(file, "", "invalid JSON: " + (pos == std::string::npos ? msg : msg.substr(pos + 2)));
+    }
+}
+
+bool JsonNode::has(const std::string& key) const { return value_->contains(key); }
+
+std::string JsonNode::childPath(const std::string& key) const { return path_ + "/" + key; }
+
+void JsonNode::fail(const std::string& key, const std::string& cause) const {
+    throw InputError(file_, childPath(key), cause);
+}
+
+void JsonNode::failHere(const std::string& cause) const {
+    throw InputError(file_, path_.empty() ? "/" : path_, cause);
+}
+
+const Json* JsonNode::lookup(const std::string& key) {
+    read_->insert(key);
+    auto it = value_->find(key);
+    return it == value_->end() ? nullptr : &*it;
+}
+
+void JsonNode::record(const std::string& key, const Json& value) {
+    if (resolved_) (*resolved_)[key] = value;
+}
+
+void JsonNode::markRead(const std::string& key) {
+    read_->insert(key);
+    if (auto it = value_->find(key); it != value_->end()) record(key, *it);
+}
+
+bool JsonNode::getBool(const std::string& key, bool def) {
+    const Json* v = lookup(key);
+    bool out = def;
+    if (v) {
+        if (!v->is_boolean()) fail(key, "expected true or false, got " + v->dump());
+        out = v->get<bool>();
+    }
+    record(key, out);
+    return out;
+}
+
+int JsonNode::getInt(const std::string& key, int def, int minValue, int maxValue) {
+    const Json* v = lookup(key);
+    int out = def;
+    if (v) {
+        if (!v->is_number_integer() && !(v->is_number_float() && std::floor(v->get<double>()) == v->get<double>()))
+            fail(key, "expected an integer, got " + v->dump());
+        double d = v->get<double>();
+        if (d < minValue || d > maxValue)
+            fail(key, "value " + v->dump() + " is out of range [" + std::to_string(minValue) + ", " +
+                          std::to_string(maxValue) + "]");
+        out = static_cast<int>(d);
+    }
+    record(key, out);
+    return out;
+}
+
+double JsonNode::getFloat(const std::string& key, double def, double minValue, double maxValue) {
+    const Json* v = lookup(key);
+    double out = def;
+    if (v) {
+        if (!v->is_number()) fail(key, "expected a number, got " + v->dump());
+        out = v->get<double>();
+        if (!std::isfinite(out) || out < minValue || out > maxValue) {
+            std::ostringstream os;
+            os << "value " << v->dump() << " is out of range [" << minValue << ", " << maxValue << "]";
+            fail(key, os.str());
+        }
+    }
+    record(key, out);
+    return out;
+}
+
+std::string JsonNode::getString(const std::string& key, const std::string& def) {
+    const Json* v = lookup(key);
+    std::string out = def;
+    if (v) {
+        if (!v->is_string()) fail(key, "expected a string, got " + v->dump());
+        out = v->get<std::string>();
+    }
+    record(key, out);
+    return out;
+}
+
+std::string JsonNode::requireString(const std::string& key) {
+    if (!has(key)) fail(key, "required key is missing");
+    return getString(key, "");
+}
+
+std::string JsonNode::getEnum(const std::string& key, const std::string& def, const std::vector<std::string>& choices) {
+    std::string s = getString(key, def);
+    for (const auto& c : choices)
+        if (c == s) return s;
+    std::string list;
+    for (const auto& c : choices) list += (list.empty() ? "" : ", ") + c;
+    fail(key, "unknown value \"" + s + "\"; accepted: " + list);
+}
+
+std::string JsonNode::getPath(const std::string& key, const std::string& def) {
+    std::string s = getString(key, def);
+    return resolvePath(parentDir(file_), s);
+}
+
+template <class T>
+std::vector<T> JsonNode::numberArray(const std::string& key, size_t n, bool integral) {
+    const Json* v = lookup(key);
+    if (!v) return {};
+    if (!v->is_array() || (n && v->size() != n))
+        fail(key, "expected an array of " + (n ? std::to_string(n) + " " : std::string()) + "numbers, got " + v->dump());
+    std::vector<T> out;
+    for (const auto& e : *v) {
+        if (!e.is_number() || (integral && !e.is_number_integer()))
+            fail(key, std::string("expected ") + (integral ? "integers" : "numbers") + ", got " + v->dump());
+        double d = e.get<double>();
+        if (!std::isfinite(d)) fail(key, "non-finite number in " + v->dump());
+        out.push_back(static_cast<T>(d));
+    }
+    return out;
+}
+
+glm::vec3 JsonNode::getVec3(const std::string& key, glm::vec3 def) {
+    auto a = numberArray<float>(key, 3, false);
+    glm::vec3 out = a.empty() ? def : glm::vec3(a[0], a[1], a[2]);
+    record(key, Json::array({out.x, out.y, out.z}));
+    return out;
+}
+
+glm::vec2 JsonNode::getVec2(const std::string& key, glm::vec2 def) {
+    auto a = numberArray<float>(key, 2, false);
+    glm::vec2 out = a.empty() ? def : glm::vec2(a[0], a[1]);
+    record(key, Json::array({out.x, out.y}));
+    return out;
+}
+
+glm::ivec2 JsonNode::getIVec2(const std::string& key, glm::ivec2 def, int minValue, int maxValue) {
+    auto a = numberArray<int>(key, 2, true);
+    glm::ivec2 out = a.empty() ? def : glm::ivec2(a[0], a[1]);
+    if (out.x < minValue || out.y < minValue || out.x > maxValue || out.y > maxValue)
+        fail(key, "values must lie in [" + std::to_string(minValue) + ", " + std::to_string(maxValue) + "]");
+    record(key, Json::array({out.x, out.y}));
+    return out;
+}
+
+glm::ivec3 JsonNode::getIVec3(const std::string& key, glm::ivec3 def, int minValue, int maxValue) {
+    auto a = numberArray<int>(key, 3, true);
+    glm::ivec3 out = a.empty() ? def : glm::ivec3(a[0], a[1], a[2]);
+    for (int i = 0; i < 3; ++i)
+        if (out[i] < minValue || out[i] > maxValue)
+            fail(key, "values must lie in [" + std::to_string(minValue) + ", " + std::to_string(maxValue) + "]");
+    record(key, Json::array({out.x, out.y, out.z}));
+    return out;
+}
+
+std::vector<int> JsonNode::getIntList(const std::string& key, const std::vector<int>& def) {
+    bool present = has(key);
+    auto a = numberArray<int>(key, 0, true);
+    std::vector<int> out = present ? a : def;
+    record(key, out);
+    return out;
+}
+
+JsonNode JsonNode::child(const std::string& key) {
+    const Json* v = lookup(key);
+    if (v && !v->is_object()) fail(key, "expected a JSON object, got " + std::string(v->type_name()));
+    Json* res = nullptr;
+    if (resolved_) {
+        (*resolved_)[key] = Json::object();
+        res = &(*resolved_)[key];
+    }
+    return JsonNode(file_, v, childPath(key), res);
+}
+
+std::vector<JsonNode> JsonNode::objectArray(const std::string& key) {
+    const Json* v = lookup(key);
+    std::vector<JsonNode> out;
+    if (!v) {
+        record(key, Json::array());
+        return out;
+    }
+    if (!v->is_array()) fail(key, "expected an array of objects, got " + std::string(v->type_name()));
+    Json* res = nullptr;
+    if (resolved_) {
+        (*resolved_)[key] = Json::array();
+        res = &(*resolved_)[key];
+        for (size_t i = 0; i < v->size(); ++i) res->push_back(Json::object());
+    }
+    for (size_t i = 0; i < v->size(); ++i)
+        out.emplace_back(file_, &(*v)[i], childPath(key) + "/" + std::to_string(i), res ? &(*res)[i] : nullptr);
+    return out;
+}
+
+void JsonNode::finish() const {
+    for (auto it = value_->begin(); it != value_->end(); ++it) {
+        if (read_->count(it.key())) continue;
+        std::string accepted;
+        for (const auto& k : *read_) accepted += (accepted.empty() ? "" : ", ") + k;
+        fail(it.key(), "unknown key \"" + it.key() + "\"; accepted keys: " + (accepted.empty() ? "(none)" : accepted));
+    }
+}
+
+} // namespace shadowlab

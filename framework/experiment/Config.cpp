@@ -1,0 +1,151 @@
+#include "framework/experiment/Config.h"
+
+#include "framework/scene/SceneConfig.h"
+
+#include <set>
+
+namespace shadowlab {
+
+namespace {
+
+const std::vector<std::string> kLightTypes = {"point", "spot", "directional", "area"};
+
+LightType lightTypeFromString(const std::string& s) {
+    for (size_t i = 0; i < kLightTypes.size(); ++i)
+        if (kLightTypes[i] == s) return LightType(i);
+    return LightType::Point;
+}
+
+void parseCamera(JsonNode node, ExperimentConfig& c) {
+    c.camera.fovYDeg = float(node.getFloat("fov_y_deg", 60.0, 1.0, 179.0));
+    c.camera.nearPlane = float(node.getFloat("near", 0.05, 1e-6, 1e6));
+    c.camera.farPlane = float(node.getFloat("far", 100.0, 1e-6, 1e9));
+    if (c.camera.farPlane <= c.camera.nearPlane) node.fail("far", "must be greater than near");
+    c.camera.position = node.getVec3("position", {0, 2, 6});
+    c.camera.target = node.getVec3("target", {0, 0, 0});
+    if (node.has("path")) c.cameraPath = Path::parse(node.child("path"));
+    node.finish();
+}
+
+void parseLight(JsonNode node, ExperimentConfig& c) {
+    Light& l = c.light;
+    l.type = lightTypeFromString(node.getEnum("type", "point", kLightTypes));
+    l.position = node.getVec3("position", {2, 4, 2});
+    l.target = node.getVec3("target", {0, 0, 0});
+    if (l.type == LightType::Spot) l.coneDeg = float(node.getFloat("cone_deg", 45.0, 0.1, 89.0));
+    if (l.type == LightType::Area) {
+        l.size = node.getVec2("size", {1, 1});
+        if (l.size.x <= 0 || l.size.y <= 0) node.fail("size", "both sides must be positive");
+        l.samples = node.getInt("samples", 16, 1, 1024);
+        l.pattern = node.getEnum("pattern", "stratified", {"stratified", "grid", "random"});
+        l.seed = uint32_t(node.getInt("seed", 1, 0, INT32_MAX));
+    }
+    if (node.has("path")) c.lightPath = Path::parse(node.child("path"));
+    if (c.lightPath.empty() && l.type != LightType::Point && glm::length(l.target - l.position) <= 0.0f)
+        node.fail("target", "must differ from position (it sets the light's direction)");
+    node.finish();
+}
+
+AlgorithmEntry parseEntry(JsonNode node, const std::string& defaultName) {
+    AlgorithmEntry e;
+    e.jsonPath = node.path();
+    std::string name = defaultName.empty() ? node.requireString("algorithm") : defaultName;
+    if (defaultName.empty()) {
+        e.info = findAlgorithm(name);
+        if (!e.info) {
+            std::string list;
+            for (const auto& a : algorithmRegistry()) list += (list.empty() ? "" : ", ") + a.name;
+            node.fail("algorithm", "unknown algorithm \"" + name + "\"; registered: " + list);
+        }
+        e.id = node.getString("id", name);
+    } else {
+        e.info = findAlgorithm(name);
+        e.id = name;
+    }
+    e.params = ParamValues::parse(e.info->schema(), node.child("params"));
+    node.finish();
+    return e;
+}
+
+} // namespace
+
+Camera ExperimentConfig::cameraAt(int frame) const {
+    Camera cam = camera;
+    if (!cameraPath.empty()) {
+        PathSample s = cameraPath.at(cameraPath.frameTime(frame, frames));
+        cam.position = s.position;
+        cam.target = s.target;
+    }
+    return cam;
+}
+
+Light ExperimentConfig::lightAt(int frame) const {
+    Light l = light;
+    if (!lightPath.empty()) {
+        PathSample s = lightPath.at(lightPath.frameTime(frame, frames));
+        l.position = s.position;
+        l.target = s.target;
+    }
+    return l;
+}
+
+ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loadScene) {
+    ExperimentConfig c;
+    c.file = file;
+    c.resolved = Json::object();
+    JsonNode root(file, &json, "", &c.resolved);
+    c.name = root.getString("name", "experiment");
+    c.resolution = root.getIVec2("resolution", {256, 256}, 8, 8192);
+    c.frames = root.getInt("frames", 30, 1, 1000000);
+    c.warmupFrames = root.getInt("warmup_frames", 3, 0, 1000);
+
+    if (!root.has("scene")) root.fail("scene", "required key is missing");
+    JsonNode sceneNode = root.child("scene");
+    if (loadScene) c.scene = std::make_shared<Scene>(buildScene(sceneNode));
+    else root.markRead("scene");
+
+    parseCamera(root.child("camera"), c);
+    parseLight(root.child("light"), c);
+
+    // "reference": true | false | {"params": {...}}
+    if (root.has("reference") && root.raw()["reference"].is_object()) {
+        c.reference = true;
+        c.referenceEntry = parseEntry(root.child("reference"), "reference");
+    } else {
+        c.reference = root.getBool("reference", true);
+        c.referenceEntry.id = "reference";
+        c.referenceEntry.info = findAlgorithm("reference");
+        c.referenceEntry.params = ParamValues(c.referenceEntry.info->schema());
+    }
+
+    std::set<std::string> ids = {"reference"};
+    auto entries = root.objectArray("algorithms");
+    for (auto& node : entries) {
+        AlgorithmEntry e = parseEntry(node, "");
+        if (!ids.insert(e.id).second)
+            throw InputError(file, node.childPath("id"), "duplicate id \"" + e.id + "\" (ids label results, so each must be unique)");
+        if (!e.info->supports(c.light.type))
+            throw InputError(file, node.childPath("algorithm"),
+                             e.info->name + " does not support " + toString(c.light.type) + " lights");
+        c.algorithms.push_back(std::move(e));
+    }
+    if (c.algorithms.empty() && !c.reference) root.fail("algorithms", "nothing to run: no algorithms and no reference");
+
+    JsonNode out = root.child("output");
+    c.outputDir = out.getPath("dir", "results/" + c.name);
+    c.imagesAtFrames = out.getIntList("images_at_frames", {0});
+    for (int f : c.imagesAtFrames)
+        if (f < 0 || f >= c.frames)
+            out.fail("images_at_frames", "frame " + std::to_string(f) + " is outside [0, " + std::to_string(c.frames - 1) + "]");
+    c.plots = out.getBool("plots", true);
+    out.finish();
+    root.finish();
+    return c;
+}
+
+ExperimentConfig loadConfig(const std::string& file, bool loadScene) {
+    Json j = JsonNode::parseFile(file);
+    return parseConfig(j, file, loadScene);
+}
+
+} // namespace shadowlab

@@ -1,0 +1,56 @@
+#pragma once
+// An experiment config (see docs/config.md): scene, camera and light paths, algorithm entries,
+// outputs. Parsing is strict: unknown keys are errors naming their JSON path; missing keys take
+// defaults; `resolved` holds every value actually used (written as config.resolved.json).
+#include "algorithms/ShadowAlgorithm.h"
+#include "framework/scene/Scene.h"
+#include "framework/view/Camera.h"
+#include "framework/view/Light.h"
+#include "framework/view/Path.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace shadowlab {
+
+struct AlgorithmEntry {
+    std::string id;              ///< unique label in results (defaults to the algorithm name)
+    const AlgorithmInfo* info = nullptr;
+    ParamValues params;
+    std::string jsonPath;        ///< where it was declared, for error messages
+};
+
+struct ExperimentConfig {
+    std::string file;            ///< the config file
+    std::string name = "experiment";
+    glm::ivec2 resolution{256, 256};
+    int frames = 30;
+    int warmupFrames = 3;
+
+    std::shared_ptr<Scene> scene;
+    Camera camera;               ///< fov/near/far, and the static pose when there is no path
+    Path cameraPath;
+    Light light;                 ///< type and shape, and the static pose when there is no path
+    Path lightPath;
+
+    bool reference = true;       ///< compare against the `reference` algorithm
+    AlgorithmEntry referenceEntry;
+    std::vector<AlgorithmEntry> algorithms;
+
+    std::string outputDir;       ///< resolved against the config's folder
+    std::vector<int> imagesAtFrames;
+    bool plots = true;
+
+    Json resolved;
+
+    Camera cameraAt(int frame) const;
+    Light lightAt(int frame) const;
+};
+
+/// Reads and validates a config file (and loads its scene unless `loadScene` is false).
+ExperimentConfig loadConfig(const std::string& file, bool loadScene = true);
+/// Same, from JSON already in memory; `file` names it in errors and anchors relative paths.
+ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loadScene = true);
+
+} // namespace shadowlab

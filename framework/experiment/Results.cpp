@@ -1,0 +1,185 @@
+#include "framework/experiment/Results.h"
+
+#include "framework/core/Error.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <set>
+#include <sstream>
+
+namespace shadowlab {
+
+Stats computeStats(std::vector<double> v) {
+    Stats s;
+    if (v.empty()) return s;
+    std::sort(v.begin(), v.end());
+    double sum = 0;
+    for (double x : v) sum += x;
+    s.mean = sum / double(v.size());
+    s.min = v.front();
+    s.max = v.back();
+    s.median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+    return s;
+}
+
+void writeFileAtomic(const std::string& path, const std::string& text) {
+    std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        if (!out) throw RuntimeError("cannot write " + tmp);
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) throw RuntimeError("cannot rename " + tmp + " to " + path);
+}
+
+static std::string num(double v) {
+    std::ostringstream os;
+    os << std::setprecision(6) << v;
+    return os.str();
+}
+
+void ExperimentResults::writeFramesCsv(const std::string& path) const {
+    std::set<std::string> counterNames;
+    for (const auto& a : algorithms)
+        for (const auto& f : a.frames)
+            for (const auto& [k, v] : f.counters) counterNames.insert(k);
+    std::ostringstream os;
+    os << "id,algorithm,frame,stage,gpu_ms,cpu_ms,mismatch_ratio,false_lit,false_shadowed,rmse,overflow";
+    for (const auto& c : counterNames) os << "," << c;
+    os << "\n";
+    for (const auto& a : algorithms)
+        for (const auto& f : a.frames)
+            for (const auto& s : f.stages) {
+                os << a.id << "," << a.algorithm << "," << f.frame << "," << s.name << ","
+                   << (s.gpuMs >= 0 ? num(s.gpuMs) : "") << "," << num(s.cpuMs);
+                // Per-frame values (accuracy, overflow, counters) go on the "total" row only.
+                bool total = s.name == "total";
+                if (total && f.hasAccuracy)
+                    os << "," << num(f.accuracy.mismatchRatio) << "," << num(f.accuracy.falseLit) << ","
+                       << num(f.accuracy.falseShadowed) << "," << num(f.accuracy.rmse);
+                else
+                    os << ",,,,";
+                os << "," << (total ? std::to_string(f.overflow) : "");
+                for (const auto& c : counterNames) {
+                    auto it = f.counters.find(c);
+                    os << "," << (total && it != f.counters.end() ? num(it->second) : "");
+                }
+                os << "\n";
+            }
+    writeFileAtomic(path, os.str());
+}
+
+Json ExperimentResults::summary() const {
+    Json out = meta;
+    Json algs = Json::object();
+    for (const auto& a : algorithms) {
+        std::map<std::string, std::vector<double>> gpu, cpu;
+        std::vector<std::string> order;
+        std::map<std::string, std::vector<double>> counters;
+        std::vector<double> mismatch, falseLit, falseShadowed, rmse;
+        uint64_t overflow = 0;
+        for (const auto& f : a.frames) {
+            for (const auto& s : f.stages) {
+                if (!cpu.count(s.name)) order.push_back(s.name);
+                cpu[s.name].push_back(s.cpuMs);
+                if (s.gpuMs >= 0) gpu[s.name].push_back(s.gpuMs);
+            }
+            for (const auto& [k, v] : f.counters) counters[k].push_back(v);
+            if (f.hasAccuracy) {
+                mismatch.push_back(f.accuracy.mismatchRatio);
+                falseLit.push_back(f.accuracy.falseLit);
+                falseShadowed.push_back(f.accuracy.falseShadowed);
+                rmse.push_back(f.accuracy.rmse);
+            }
+            overflow += f.overflow;
+        }
+        Json j;
+        j["algorithm"] = a.algorithm;
+        j["params"] = a.params;
+        j["preprocess_ms"] = a.preprocessMs;
+        // time_ms: GPU time where the stage has it (timer queries), else CPU time; "total" is the
+        // wall-clock time of the whole visibility computation, GPU finished.
+        Json time = Json::object(), cpuTime = Json::object();
+        for (const auto& name : order) {
+            bool useGpu = name != "total" && gpu.count(name) && gpu[name].size() == cpu[name].size();
+            time[name] = computeStats(useGpu ? gpu[name] : cpu[name]).toJson();
+            cpuTime[name] = computeStats(cpu[name]).toJson();
+        }
+        j["time_ms"] = time;
+        j["cpu_time_ms"] = cpuTime;
+        if (!mismatch.empty()) {
+            Stats m = computeStats(mismatch);
+            j["accuracy"] = {{"mismatch_ratio", m.mean},
+                             {"mismatch_ratio_max", m.max},
+                             {"false_lit", computeStats(falseLit).mean},
+                             {"false_shadowed", computeStats(falseShadowed).mean},
+                             {"rmse", computeStats(rmse).mean},
+                             {"per_frame_mismatch", mismatch}};
+        } else {
+            j["accuracy"] = nullptr;
+        }
+        Json cj = Json::object();
+        for (const auto& [k, v] : counters) cj[k] = computeStats(v).toJson();
+        j["counters"] = cj;
+        j["memory_bytes"] = a.memoryBytes;
+        j["overflow"] = overflow;
+        algs[a.id] = j;
+    }
+    out["algorithms"] = algs;
+    out["complete"] = true;
+    return out;
+}
+
+void ExperimentResults::writeReport(const std::string& path, const Json& s) const {
+    std::ostringstream os;
+    os << std::fixed;
+    os << "# " << s.value("name", std::string("experiment")) << "\n\n";
+    os << "- renderer: " << s.value("renderer", std::string()) << " (" << s.value("backend", std::string()) << ")\n";
+    os << "- resolution: " << s["resolution"][0] << "×" << s["resolution"][1] << ", frames: " << s["frames"]
+       << ", triangles: " << s["triangles"] << "\n";
+    os << "- wall time: " << std::setprecision(1) << s.value("wall_time_s", 0.0) << " s\n\n";
+
+    os << "## Time per frame (ms; GPU timer queries where the stage runs on the GPU, CPU time otherwise)\n\n";
+    os << "| id | algorithm | stage | mean | min | max | median |\n|---|---|---|---:|---:|---:|---:|\n";
+    for (const auto& a : algorithms) {
+        const Json& j = s["algorithms"][a.id];
+        os << "| " << a.id << " | " << a.algorithm << " | preprocess | " << std::setprecision(2) << j["preprocess_ms"].get<double>()
+           << " | | | |\n";
+        // Stages in the order the algorithm ran them (JSON objects sort their keys).
+        std::vector<std::string> stages;
+        if (!a.frames.empty())
+            for (const auto& st : a.frames.front().stages) stages.push_back(st.name);
+        for (const auto& stage : stages) {
+            const Json& st = j["time_ms"][stage];
+            os << "| " << a.id << " | " << a.algorithm << " | " << (stage == "total" ? "**total**" : stage) << " | "
+               << std::setprecision(3) << st["mean"].get<double>() << " | " << st["min"].get<double>() << " | "
+               << st["max"].get<double>() << " | " << st["median"].get<double>() << " |\n";
+        }
+    }
+    os << "\n## Accuracy against the reference (over lit pixels, N·L > 0)\n\n";
+    os << "| id | mismatch (mean) | mismatch (worst frame) | false lit | false shadowed | RMSE |\n|---|---:|---:|---:|---:|---:|\n";
+    for (const auto& a : algorithms) {
+        const Json& acc = s["algorithms"][a.id]["accuracy"];
+        if (acc.is_null()) continue;
+        os << "| " << a.id << " | " << std::setprecision(4) << 100.0 * acc["mismatch_ratio"].get<double>() << " % | "
+           << 100.0 * acc["mismatch_ratio_max"].get<double>() << " % | " << 100.0 * acc["false_lit"].get<double>() << " % | "
+           << 100.0 * acc["false_shadowed"].get<double>() << " % | " << std::setprecision(5) << acc["rmse"].get<double>() << " |\n";
+    }
+    os << "\n## Memory and counters\n\n| id | memory (MiB) | overflow | counters (mean / max) |\n|---|---:|---:|---|\n";
+    for (const auto& a : algorithms) {
+        const Json& j = s["algorithms"][a.id];
+        os << "| " << a.id << " | " << std::setprecision(2) << double(j["memory_bytes"].get<size_t>()) / (1024.0 * 1024.0)
+           << " | " << j["overflow"] << " | ";
+        bool first = true;
+        for (const auto& [k, v] : j["counters"].items()) {
+            os << (first ? "" : "; ") << k << " " << std::setprecision(3) << v["mean"].get<double>() << " / " << v["max"].get<double>();
+            first = false;
+        }
+        os << " |\n";
+    }
+    writeFileAtomic(path, os.str());
+}
+
+} // namespace shadowlab

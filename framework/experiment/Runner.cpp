@@ -1,0 +1,223 @@
+#include "framework/experiment/Runner.h"
+
+#include "framework/core/Error.h"
+#include "framework/experiment/Progress.h"
+#include "framework/gl/GlContext.h"
+#include "framework/gl/Shader.h"
+#include "framework/metrics/Images.h"
+#include "framework/render/ShadingPass.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <unistd.h>
+
+namespace shadowlab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+struct Instance {
+    const AlgorithmEntry* entry;
+    std::unique_ptr<ShadowAlgorithm> algorithm;
+    GlTexture visibility;
+    AlgorithmResults results;
+};
+
+void writeImages(const std::string& dir, const std::string& id, int frame, glm::ivec2 res, ShadingPass& shading,
+                 const std::vector<float>& vis, const std::vector<float>* ref, const std::vector<uint8_t>& lit,
+                 const std::vector<uint8_t>& covered, const ShadowAlgorithm& algorithm) {
+    char tag[32];
+    std::snprintf(tag, sizeof tag, "_f%04d_", frame);
+    std::string base = dir + "/images/" + id + tag;
+    writePngRGBA(base + "shaded.png", res.x, res.y, readTextureRGBA8(shading.output(), res.x, res.y));
+    writePngRGBA(base + "visibility.png", res.x, res.y, visibilityImage(vis, covered));
+    if (ref) writePngRGBA(base + "diff.png", res.x, res.y, differenceImage(vis, *ref, lit));
+    for (const DebugView& view : algorithm.debugViews()) {
+        auto values = readTextureR32F(view.texture, res.x, res.y);
+        writePngRGBA(base + "heat_" + view.name + ".png", res.x, res.y, heatMapImage(values, view.maxValue));
+    }
+}
+
+std::string prepareOutput(const std::string& finalDir, bool force) {
+    if (fs::exists(finalDir) && !force)
+        throw InputError(finalDir, "", "output directory already exists; pass --force to replace it once the new run completes, or --out DIR");
+    std::string partial = finalDir + ".partial-" + std::to_string(::getpid());
+    fs::remove_all(partial);
+    fs::create_directories(partial + "/images");
+    return partial;
+}
+
+void commitOutput(const std::string& partial, const std::string& finalDir) {
+    std::string old = finalDir + ".old-" + std::to_string(::getpid());
+    bool hadOld = fs::exists(finalDir);
+    if (hadOld) fs::rename(finalDir, old);
+    fs::rename(partial, finalDir);
+    if (hadOld) fs::remove_all(old);
+}
+
+/// Removes the partial directory unless the run committed it (an exception or early return).
+struct PartialGuard {
+    std::string dir;
+    bool committed = false;
+    ~PartialGuard() {
+        std::error_code ec;
+        if (!committed && !dir.empty()) fs::remove_all(dir, ec);
+    }
+};
+
+void runPlots(const std::string& dir, const std::string& finalDir) {
+    std::string script = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/plot_results.py";
+    std::string cmd = std::string(SHADOWLAB_PLOT_PYTHON) + " '" + script + "' '" + dir + "' > '" + dir + "/plots.log' 2>&1";
+    if (std::system(cmd.c_str()) != 0)
+        std::fprintf(stderr, "warning: plotting failed (see %s/plots.log); tables and images are complete\n", finalDir.c_str());
+    else
+        std::filesystem::remove(dir + "/plots.log");
+}
+
+} // namespace
+
+ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& opt, const std::string& backend) {
+    auto wallStart = Clock::now();
+    const std::string finalDir = opt.outputDir.empty() ? cfg.outputDir : opt.outputDir;
+    std::string dir;
+    if (opt.writeOutputs) dir = prepareOutput(finalDir, opt.force);
+    PartialGuard guard{dir};
+
+    const glm::ivec2 res = cfg.resolution;
+    SceneGpu sceneGpu(*cfg.scene);
+    GBuffer gbuffer(res);
+    ShadingPass shading(res);
+    StageTimer timer;
+
+    // The reference runs first each frame: every other algorithm is compared with its visibility.
+    std::vector<const AlgorithmEntry*> entries;
+    if (cfg.reference) entries.push_back(&cfg.referenceEntry);
+    for (const auto& e : cfg.algorithms) entries.push_back(&e);
+
+    std::vector<Instance> instances;
+    for (const AlgorithmEntry* e : entries) {
+        Instance inst{e, e->info->create(e->params), makeTexture2D(GL_R32F, res.x, res.y), {}};
+        inst.results.id = e->id;
+        inst.results.algorithm = e->info->name;
+        inst.results.params = e->params.toJson();
+        auto t = Clock::now();
+        inst.algorithm->setScene(sceneGpu);
+        inst.algorithm->resize(res);
+        glFinish();
+        inst.results.preprocessMs = msSince(t);
+        instances.push_back(std::move(inst));
+    }
+
+    ExperimentResults results;
+    results.meta = {{"name", cfg.name},
+                    {"config", cfg.file},
+                    {"renderer", glRendererString()},
+                    {"gl_version", glVersionString()},
+                    {"backend", backend},
+                    {"subgroup_size", querySubgroupSize()},
+                    {"resolution", {res.x, res.y}},
+                    {"frames", cfg.frames},
+                    {"warmup_frames", cfg.warmupFrames},
+                    {"triangles", cfg.scene->triangleCount()},
+                    {"light", toString(cfg.light.type)},
+                    {"reference", cfg.reference}};
+
+    Progress progress(opt.progress, size_t(cfg.frames + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
+    std::optional<CpuGBuffer> cpuG;
+    auto renderFrame = [&](int frame, const Camera& cam) {
+        gbuffer.render(sceneGpu, cam);
+        cpuG.reset();
+        (void)frame;
+    };
+    auto getCpuG = [&]() -> const CpuGBuffer& {
+        if (!cpuG) cpuG = gbuffer.readBack();
+        return *cpuG;
+    };
+
+    // Warm-up: shader compilation, first-touch allocations and caches are kept out of the timings.
+    if (cfg.warmupFrames > 0) {
+        Camera cam = cfg.cameraAt(0);
+        Light light = cfg.lightAt(0);
+        renderFrame(0, cam);
+        for (auto& inst : instances) {
+            progress.step("warm-up " + inst.entry->id);
+            for (int w = 0; w < cfg.warmupFrames; ++w) {
+                inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, 0, inst.visibility.id(), timer});
+                glFinish();
+                timer.collect();
+            }
+        }
+    }
+
+    for (int frame = 0; frame < cfg.frames; ++frame) {
+        Camera cam = cfg.cameraAt(frame);
+        Light light = cfg.lightAt(frame);
+        renderFrame(frame, cam);
+        glFinish();
+        const CpuGBuffer& g = getCpuG();
+        std::vector<uint8_t> lit = litMask(g, light);
+        std::vector<uint8_t> covered(size_t(res.x) * res.y);
+        for (size_t i = 0; i < covered.size(); ++i) covered[i] = g.covered(i);
+        bool saveImages = opt.writeOutputs &&
+                          std::find(cfg.imagesAtFrames.begin(), cfg.imagesAtFrames.end(), frame) != cfg.imagesAtFrames.end();
+        std::vector<float> reference;
+
+        for (auto& inst : instances) {
+            progress.step(inst.entry->id + " frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
+            glFinish();
+            auto t = Clock::now();
+            inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, frame, inst.visibility.id(), timer});
+            glFinish();
+            double wall = msSince(t);
+            FrameRecord rec;
+            rec.frame = frame;
+            rec.stages = timer.collect();
+            double gpuSum = 0;
+            for (const auto& s : rec.stages) gpuSum += std::max(0.0, s.gpuMs);
+            rec.stages.push_back({"total", gpuSum, wall});
+            for (const auto& c : inst.algorithm->counters()) rec.counters[c.name] = c.value;
+            rec.overflow = inst.algorithm->overflowCount();
+            inst.results.memoryBytes = std::max(inst.results.memoryBytes, inst.algorithm->memoryBytes());
+
+            std::vector<float> vis = readTextureR32F(inst.visibility.id(), res.x, res.y);
+            bool isReference = cfg.reference && inst.entry == &cfg.referenceEntry;
+            if (isReference) reference = vis;
+            if (cfg.reference) {
+                rec.hasAccuracy = true;
+                rec.accuracy = compareVisibility(vis, reference, lit);
+            }
+            if (saveImages) {
+                shading.run(gbuffer, inst.visibility.id(), light);
+                writeImages(dir, inst.entry->id, frame, res, shading, vis, cfg.reference && !isReference ? &reference : nullptr,
+                            lit, covered, *inst.algorithm);
+            }
+            inst.results.frames.push_back(std::move(rec));
+        }
+    }
+    progress.finish();
+
+    for (auto& inst : instances) results.algorithms.push_back(std::move(inst.results));
+    results.meta["wall_time_s"] = msSince(wallStart) / 1000.0;
+    if (!opt.writeOutputs) return results;
+
+    // Order matters: the resolved config and tables first, plots next, summary.json last; the
+    // rename that follows makes the whole directory appear at once.
+    writeFileAtomic(dir + "/config.resolved.json", cfg.resolved.dump(2) + "\n");
+    results.writeFramesCsv(dir + "/frames.csv");
+    Json summary = results.summary();
+    results.writeReport(dir + "/report.md", summary);
+    if (cfg.plots) runPlots(dir, finalDir);
+    writeFileAtomic(dir + "/summary.json", summary.dump(2) + "\n");
+    commitOutput(dir, finalDir);
+    guard.committed = true;
+    return results;
+}
+
+} // namespace shadowlab

@@ -1,0 +1,23 @@
+#pragma once
+// Runs an experiment: scene → G-buffer → each algorithm → visibility → shading → metrics → results.
+#include "framework/experiment/Config.h"
+#include "framework/experiment/Results.h"
+
+#include <string>
+
+namespace shadowlab {
+
+struct RunOptions {
+    std::string outputDir;  ///< overrides the config's output.dir when not empty
+    bool force = false;     ///< replace an existing output directory (only once the new run is complete)
+    bool progress = true;   ///< progress bar on stderr
+    bool writeOutputs = true;
+};
+
+/// Runs the experiment on the current GL context and writes its output directory.
+/// The directory is assembled under DIR.partial-PID and renamed into place at the end, so an
+/// interrupted run never leaves a summary that looks complete, and an existing DIR is never
+/// replaced unless `force` (an InputError otherwise).
+ExperimentResults runExperiment(const ExperimentConfig& config, const RunOptions& options, const std::string& backend);
+
+} // namespace shadowlab

@@ -1,0 +1,56 @@
+#pragma once
+// GLSL programs built from files under the shader folder. One source per stage; variants are
+// `#define`s prepended after the #version line, and `#include "common/x.glsl"` is expanded here
+// (relative to the shader folder), so shared GLSL lives once in shaders/common/.
+#include "framework/gl/GlObjects.h"
+
+#include <glm/glm.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace shadowlab {
+
+using ShaderDefines = std::vector<std::pair<std::string, std::string>>;
+
+/// The shader folder: $SHADOWLAB_SHADER_DIR if set, else the source tree's shaders/ (compiled in).
+std::string shaderDir();
+
+/// Loads a stage source with includes expanded and defines prepended.
+std::string loadShaderSource(const std::string& relPath, const ShaderDefines& defines);
+
+class ShaderProgram {
+public:
+    ShaderProgram() = default;
+    /// Compute program from one .comp file.
+    static ShaderProgram compute(const std::string& comp, const ShaderDefines& defines = {});
+    /// Vertex + fragment program.
+    static ShaderProgram graphics(const std::string& vert, const std::string& frag, const ShaderDefines& defines = {});
+
+    GLuint id() const { return program_.id(); }
+    explicit operator bool() const { return bool(program_); }
+    void use() const { glUseProgram(id()); }
+
+    GLint location(const char* name) const { return glGetUniformLocation(id(), name); }
+    void set(const char* name, int v) const { glProgramUniform1i(id(), location(name), v); }
+    void set(const char* name, unsigned v) const { glProgramUniform1ui(id(), location(name), v); }
+    void set(const char* name, float v) const { glProgramUniform1f(id(), location(name), v); }
+    void set(const char* name, glm::vec2 v) const { glProgramUniform2f(id(), location(name), v.x, v.y); }
+    void set(const char* name, glm::vec3 v) const { glProgramUniform3f(id(), location(name), v.x, v.y, v.z); }
+    void set(const char* name, glm::vec4 v) const { glProgramUniform4f(id(), location(name), v.x, v.y, v.z, v.w); }
+    void set(const char* name, glm::ivec2 v) const { glProgramUniform2i(id(), location(name), v.x, v.y); }
+    void set(const char* name, const glm::mat4& m) const { glProgramUniformMatrix4fv(id(), location(name), 1, GL_FALSE, &m[0][0]); }
+
+    /// Dispatches enough work groups of (localX × localY) to cover width × height.
+    void dispatch2D(int width, int height, int localX, int localY) const;
+
+private:
+    GlProgramName program_;
+};
+
+/// The subgroup (warp) width of the current context, read at run time (ARB_shader_ballot's
+/// gl_SubGroupSizeARB through a tiny compute shader); 0 when the extension is absent.
+int querySubgroupSize();
+bool hasExtension(const char* name);
+
+} // namespace shadowlab

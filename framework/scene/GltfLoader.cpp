@@ -1,0 +1,586 @@
+#include "framework/scene/GltfLoader.h"
+
+#include "framework/core/JsonNode.h"
+
+#include <tiny_gltf.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+// Loading runs in three stages, each making the next one safe:
+//  1. a JSON type check of the glTF document (tinygltf 2.7 silently ignores most wrongly typed
+//     properties, e.g. "primitives": {} or "index": -1, and would hand us a quietly different model);
+//  2. tinygltf parses the document and fetches buffers; its errors become InputErrors;
+//  3. every index, range and type we are about to use is validated before any buffer byte is read,
+//     so a malformed file can throw but never crash or read out of bounds.
+
+namespace shadowlab {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Stage 1: JSON type check against the parts of the glTF 2.0 schema that describe types.
+// Keys not listed are not checked (extras and extension contents are free-form by design).
+
+enum class Kind { String, Uint, Number, Bool, UintArray, NumberArray, StringArray, Object, ObjectArray, UintMap, UintMapArray };
+struct Prop {
+    const char* key;
+    Kind kind;
+    const std::vector<Prop>* schema = nullptr;  // for Object / ObjectArray
+};
+using Schema = std::vector<Prop>;
+
+const Schema kAsset{{"version", Kind::String}, {"generator", Kind::String}, {"minVersion", Kind::String}, {"copyright", Kind::String}};
+const Schema kSceneS{{"nodes", Kind::UintArray}};
+const Schema kNodeS{{"camera", Kind::Uint}, {"skin", Kind::Uint}, {"mesh", Kind::Uint}, {"children", Kind::UintArray},
+                    {"matrix", Kind::NumberArray}, {"translation", Kind::NumberArray}, {"rotation", Kind::NumberArray},
+                    {"scale", Kind::NumberArray}, {"weights", Kind::NumberArray}};
+const Schema kPrimitiveS{{"attributes", Kind::UintMap}, {"indices", Kind::Uint}, {"material", Kind::Uint},
+                         {"mode", Kind::Uint}, {"targets", Kind::UintMapArray}};
+const Schema kMeshS{{"primitives", Kind::ObjectArray, &kPrimitiveS}, {"weights", Kind::NumberArray}};
+const Schema kSparseIndicesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint}};
+const Schema kSparseValuesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}};
+const Schema kSparseS{{"count", Kind::Uint}, {"indices", Kind::Object, &kSparseIndicesS}, {"values", Kind::Object, &kSparseValuesS}};
+const Schema kAccessorS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint},
+                        {"normalized", Kind::Bool}, {"count", Kind::Uint}, {"type", Kind::String},
+                        {"max", Kind::NumberArray}, {"min", Kind::NumberArray}, {"sparse", Kind::Object, &kSparseS}};
+const Schema kBufferViewS{{"buffer", Kind::Uint}, {"byteOffset", Kind::Uint}, {"byteLength", Kind::Uint},
+                          {"byteStride", Kind::Uint}, {"target", Kind::Uint}};
+const Schema kBufferS{{"uri", Kind::String}, {"byteLength", Kind::Uint}};
+const Schema kTexInfoS{{"index", Kind::Uint}, {"texCoord", Kind::Uint}};
+const Schema kNormalTexS{{"index", Kind::Uint}, {"texCoord", Kind::Uint}, {"scale", Kind::Number}};
+const Schema kOcclusionTexS{{"index", Kind::Uint}, {"texCoord", Kind::Uint}, {"strength", Kind::Number}};
+const Schema kPbrS{{"baseColorFactor", Kind::NumberArray}, {"baseColorTexture", Kind::Object, &kTexInfoS},
+                   {"metallicFactor", Kind::Number}, {"roughnessFactor", Kind::Number},
+                   {"metallicRoughnessTexture", Kind::Object, &kTexInfoS}};
+const Schema kMaterialS{{"pbrMetallicRoughness", Kind::Object, &kPbrS}, {"normalTexture", Kind::Object, &kNormalTexS},
+                        {"occlusionTexture", Kind::Object, &kOcclusionTexS}, {"emissiveTexture", Kind::Object, &kTexInfoS},
+                        {"emissiveFactor", Kind::NumberArray}, {"alphaMode", Kind::String},
+                        {"alphaCutoff", Kind::Number}, {"doubleSided", Kind::Bool}};
+const Schema kTextureS{{"sampler", Kind::Uint}, {"source", Kind::Uint}};
+const Schema kImageS{{"uri", Kind::String}, {"mimeType", Kind::String}, {"bufferView", Kind::Uint}};
+const Schema kSamplerS{{"magFilter", Kind::Uint}, {"minFilter", Kind::Uint}, {"wrapS", Kind::Uint}, {"wrapT", Kind::Uint}};
+const Schema kOrthoS{{"xmag", Kind::Number}, {"ymag", Kind::Number}, {"zfar", Kind::Number}, {"znear", Kind::Number}};
+const Schema kPerspS{{"aspectRatio", Kind::Number}, {"yfov", Kind::Number}, {"zfar", Kind::Number}, {"znear", Kind::Number}};
+const Schema kCameraS{{"type", Kind::String}, {"orthographic", Kind::Object, &kOrthoS}, {"perspective", Kind::Object, &kPerspS}};
+const Schema kSkinS{{"inverseBindMatrices", Kind::Uint}, {"skeleton", Kind::Uint}, {"joints", Kind::UintArray}};
+const Schema kTargetS{{"node", Kind::Uint}, {"path", Kind::String}};
+const Schema kChannelS{{"sampler", Kind::Uint}, {"target", Kind::Object, &kTargetS}};
+const Schema kAnimSamplerS{{"input", Kind::Uint}, {"interpolation", Kind::String}, {"output", Kind::Uint}};
+const Schema kAnimationS{{"channels", Kind::ObjectArray, &kChannelS}, {"samplers", Kind::ObjectArray, &kAnimSamplerS}};
+const Schema kRoot{{"asset", Kind::Object, &kAsset}, {"scene", Kind::Uint}, {"scenes", Kind::ObjectArray, &kSceneS},
+                   {"nodes", Kind::ObjectArray, &kNodeS}, {"meshes", Kind::ObjectArray, &kMeshS},
+                   {"accessors", Kind::ObjectArray, &kAccessorS}, {"bufferViews", Kind::ObjectArray, &kBufferViewS},
+                   {"buffers", Kind::ObjectArray, &kBufferS}, {"materials", Kind::ObjectArray, &kMaterialS},
+                   {"textures", Kind::ObjectArray, &kTextureS}, {"images", Kind::ObjectArray, &kImageS},
+                   {"samplers", Kind::ObjectArray, &kSamplerS}, {"cameras", Kind::ObjectArray, &kCameraS},
+                   {"skins", Kind::ObjectArray, &kSkinS}, {"animations", Kind::ObjectArray, &kAnimationS},
+                   {"extensionsUsed", Kind::StringArray}, {"extensionsRequired", Kind::StringArray}};
+
+/// JSON pointer escaping (RFC 6901), for keys such as attribute names that end up in error paths.
+std::string escapeKey(const std::string& key) {
+    std::string out;
+    for (char c : key) out += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
+    return out;
+}
+
+std::string shortDump(const Json& v) {
+    std::string s = v.dump();
+    return s.size() > 60 ? s.substr(0, 57) + "..." : s;
+}
+
+bool isUint(const Json& v) {
+    if (v.is_number_unsigned()) return true;
+    if (v.is_number_integer()) return v.get<int64_t>() >= 0;
+    // 2.0 is an integer in JSON Schema's sense; tinygltf reads it as one too.
+    return v.is_number_float() && v.get<double>() >= 0 && std::floor(v.get<double>()) == v.get<double>() &&
+           v.get<double>() < 9.0e15;
+}
+
+class TypeChecker {
+public:
+    explicit TypeChecker(const std::string& file) : file_(file) {}
+
+    void checkObject(const Json& obj, const Schema& schema, const std::string& path) const {
+        if (!obj.is_object()) fail(path, "expected an object, got " + shortDump(obj));
+        for (auto it = obj.begin(); it != obj.end(); ++it) {
+            std::string p = path + "/" + escapeKey(it.key());
+            if (it.key() == "name") expect(it->is_string(), *it, p, "a string");
+            if (it.key() == "extensions") {
+                // Extension payloads are free-form, but each one must be an object (extension.schema.json).
+                expect(it->is_object(), *it, p, "an object");
+                for (auto e = it->begin(); e != it->end(); ++e)
+                    expect(e->is_object(), *e, p + "/" + escapeKey(e.key()), "an object");
+            }
+            for (const Prop& prop : schema)
+                if (it.key() == prop.key) checkValue(*it, prop, p);
+        }
+    }
+
+private:
+    [[noreturn]] void fail(const std::string& path, const std::string& cause) const { throw InputError(file_, path, cause); }
+    void expect(bool ok, const Json& v, const std::string& path, const char* what) const {
+        if (!ok) fail(path, std::string("expected ") + what + ", got " + shortDump(v));
+    }
+    template <class Pred> void expectArray(const Json& v, const std::string& path, const char* what, Pred pred) const {
+        expect(v.is_array(), v, path, what);
+        for (size_t i = 0; i < v.size(); ++i) expect(pred(v[i]), v[i], path + "/" + std::to_string(i), what);
+    }
+    void checkUintMap(const Json& v, const std::string& path) const {
+        expect(v.is_object(), v, path, "an object of accessor indices");
+        for (auto it = v.begin(); it != v.end(); ++it)
+            expect(isUint(*it), *it, path + "/" + escapeKey(it.key()), "a non-negative integer");
+    }
+    void checkValue(const Json& v, const Prop& prop, const std::string& path) const {
+        switch (prop.kind) {
+        case Kind::String: return expect(v.is_string(), v, path, "a string");
+        case Kind::Uint: return expect(isUint(v), v, path, "a non-negative integer");
+        case Kind::Number: return expect(v.is_number(), v, path, "a number");
+        case Kind::Bool: return expect(v.is_boolean(), v, path, "true or false");
+        case Kind::UintArray: return expectArray(v, path, "an array of non-negative integers", isUint);
+        case Kind::NumberArray: return expectArray(v, path, "an array of numbers", [](const Json& e) { return e.is_number(); });
+        case Kind::StringArray: return expectArray(v, path, "an array of strings", [](const Json& e) { return e.is_string(); });
+        case Kind::Object: return checkObject(v, *prop.schema, path);
+        case Kind::ObjectArray:
+            expect(v.is_array(), v, path, "an array of objects");
+            for (size_t i = 0; i < v.size(); ++i) checkObject(v[i], *prop.schema, path + "/" + std::to_string(i));
+            return;
+        case Kind::UintMap: return checkUintMap(v, path);
+        case Kind::UintMapArray:
+            expect(v.is_array(), v, path, "an array of objects");
+            for (size_t i = 0; i < v.size(); ++i) checkUintMap(v[i], path + "/" + std::to_string(i));
+            return;
+        }
+    }
+    const std::string& file_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Stage 2 helpers: reading the file and calling tinygltf.
+
+std::string oneLine(const std::string& s) {
+    std::string out;
+    std::istringstream in(s);
+    for (std::string line; std::getline(in, line);) {
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+        if (!line.empty()) out += (out.empty() ? "" : "; ") + line;
+    }
+    return out;
+}
+
+uint32_t readU32(const std::vector<unsigned char>& b, size_t at) {
+    uint32_t v;
+    std::memcpy(&v, b.data() + at, 4);
+    return v;  // GLB is little-endian, as is every platform we build for
+}
+
+/// The JSON chunk of a GLB container, with the header checked so nothing is read past the end.
+std::string glbJson(const std::string& file, const std::vector<unsigned char>& bytes) {
+    if (bytes.size() < 20) throw InputError(file, "", "GLB file is truncated (" + std::to_string(bytes.size()) + " bytes)");
+    uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8), chunkLen = readU32(bytes, 12), chunkType = readU32(bytes, 16);
+    if (version != 2) throw InputError(file, "", "unsupported GLB version " + std::to_string(version) + " (need 2)");
+    if (length > bytes.size()) throw InputError(file, "", "GLB header declares " + std::to_string(length) + " bytes, file has " + std::to_string(bytes.size()));
+    if (chunkType != 0x4E4F534Au || uint64_t(chunkLen) + 20 > length) throw InputError(file, "", "GLB file has no valid JSON chunk");
+    return std::string(reinterpret_cast<const char*>(bytes.data() + 20), chunkLen);
+}
+
+// Images are never used (only geometry and base colour factors), so skip decoding them.
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) { return true; }
+
+// ---------------------------------------------------------------------------------------------
+// Stage 3: validation and geometry extraction.
+
+constexpr size_t kMaxUnbackedCount = size_t(1) << 27;  // accessors without a bufferView are zero-filled
+
+class Loader {
+public:
+    Loader(const std::string& file, const tinygltf::Model& model) : file_(file), m_(model) {}
+
+    Scene run(GltfStats* stats);
+
+private:
+    [[noreturn]] void fail(const std::string& path, const std::string& cause) const { throw InputError(file_, path, cause); }
+    static std::string at(const char* array, size_t i) { return std::string("/") + array + "/" + std::to_string(i); }
+    template <class Vec> void checkIndex(int index, const Vec& v, const std::string& path, const char* what) const {
+        if (index < 0 || size_t(index) >= v.size())
+            fail(path, std::string(what) + " index " + std::to_string(index) + " is out of range (the file has " + std::to_string(v.size()) + ")");
+    }
+    /// offset + stride*(count-1) + elem <= limit, in 128 bits so that huge declared values cannot wrap.
+    static bool fits(uint64_t offset, uint64_t stride, uint64_t count, uint64_t elem, uint64_t limit) {
+        if (count == 0) return offset <= limit;
+        return static_cast<unsigned __int128>(offset) + static_cast<unsigned __int128>(stride) * (count - 1) + elem <= limit;
+    }
+    size_t elementSize(const tinygltf::Accessor& a) const {
+        return size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType))) * size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type)));
+    }
+
+    void validateStructure();
+    void validateAccessor(size_t i);
+    void validateNodes();
+    std::vector<unsigned char> gather(int accessor) const;
+    const std::vector<glm::vec3>& positions(int accessor);
+    Material material(int index) const;
+    glm::mat4 localMatrix(const tinygltf::Node& n) const;
+    size_t emitPrimitive(Scene& scene, size_t meshIndex, size_t primIndex, const glm::mat4& world);
+
+    const std::string& file_;
+    const tinygltf::Model& m_;
+    std::vector<int> parent_;
+    std::map<int, std::vector<glm::vec3>> positionCache_;
+};
+
+void Loader::validateStructure() {
+    // These extensions replace or add geometry; loading without them would silently give wrong shapes.
+    for (const auto& ext : m_.extensionsRequired)
+        if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression" || ext == "KHR_mesh_quantization" ||
+            ext == "EXT_mesh_gpu_instancing")
+            fail("/extensionsRequired", "requires extension " + ext + ", which changes geometry and is not supported");
+    for (size_t i = 0; i < m_.bufferViews.size(); ++i) {
+        const auto& bv = m_.bufferViews[i];
+        checkIndex(bv.buffer, m_.buffers, at("bufferViews", i) + "/buffer", "buffer");
+        size_t size = m_.buffers[size_t(bv.buffer)].data.size();
+        if (!fits(bv.byteOffset, 0, 1, bv.byteLength, size))
+            fail(at("bufferViews", i), "byte range [" + std::to_string(bv.byteOffset) + ", +" + std::to_string(bv.byteLength) +
+                                           ") exceeds buffer " + std::to_string(bv.buffer) + " (" + std::to_string(size) + " bytes)");
+        if (bv.byteStride != 0 && (bv.byteStride < 4 || bv.byteStride > 252))
+            fail(at("bufferViews", i) + "/byteStride", "byteStride " + std::to_string(bv.byteStride) + " is outside [4, 252]");
+    }
+    for (size_t i = 0; i < m_.accessors.size(); ++i) validateAccessor(i);
+    for (size_t i = 0; i < m_.materials.size(); ++i) {
+        const auto& f = m_.materials[i].pbrMetallicRoughness.baseColorFactor;
+        bool ok = f.size() == 4;
+        for (double c : f) ok = ok && std::isfinite(c) && c >= 0.0 && c <= 1.0;
+        if (!ok) fail(at("materials", i) + "/pbrMetallicRoughness/baseColorFactor", "expected 4 numbers in [0, 1]");
+    }
+    for (size_t mi = 0; mi < m_.meshes.size(); ++mi) {
+        for (size_t pi = 0; pi < m_.meshes[mi].primitives.size(); ++pi) {
+            const auto& p = m_.meshes[mi].primitives[pi];
+            std::string path = at("meshes", mi) + "/primitives/" + std::to_string(pi);
+            for (const auto& [name, acc] : p.attributes) checkIndex(acc, m_.accessors, path + "/attributes/" + escapeKey(name), "accessor");
+            if (p.material != -1) checkIndex(p.material, m_.materials, path + "/material", "material");
+            if (p.mode < -1 || p.mode > TINYGLTF_MODE_TRIANGLE_FAN) fail(path + "/mode", "unknown primitive mode " + std::to_string(p.mode));
+            if (auto it = p.attributes.find("POSITION"); it != p.attributes.end()) {
+                const auto& a = m_.accessors[size_t(it->second)];
+                if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != TINYGLTF_TYPE_VEC3)
+                    fail(path + "/attributes/POSITION", "POSITION accessor " + std::to_string(it->second) + " must be FLOAT VEC3");
+            }
+            if (p.indices != -1) {
+                checkIndex(p.indices, m_.accessors, path + "/indices", "accessor");
+                const auto& a = m_.accessors[size_t(p.indices)];
+                bool intType = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                               a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+                               a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+                if (!intType || a.type != TINYGLTF_TYPE_SCALAR)
+                    fail(path + "/indices", "index accessor " + std::to_string(p.indices) + " must be UNSIGNED_BYTE/SHORT/INT SCALAR");
+            }
+        }
+    }
+}
+
+void Loader::validateAccessor(size_t i) {
+    const auto& a = m_.accessors[i];
+    std::string path = at("accessors", i);
+    if (tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) <= 0 || tinygltf::GetNumComponentsInType(uint32_t(a.type)) <= 0)
+        fail(path, "unknown componentType " + std::to_string(a.componentType) + " or type " + std::to_string(a.type));
+    size_t elem = elementSize(a);
+    if (a.bufferView == -1) {
+        if (a.count > kMaxUnbackedCount) fail(path + "/count", "count " + std::to_string(a.count) + " is too large for an accessor without bufferView");
+    } else {
+        checkIndex(a.bufferView, m_.bufferViews, path + "/bufferView", "bufferView");
+        const auto& bv = m_.bufferViews[size_t(a.bufferView)];
+        size_t stride = bv.byteStride ? bv.byteStride : elem;
+        if (stride < elem) fail(path, "bufferView byteStride " + std::to_string(stride) + " is smaller than the element size " + std::to_string(elem));
+        if (!fits(a.byteOffset, stride, a.count, elem, bv.byteLength))
+            fail(path, std::to_string(a.count) + " elements of " + std::to_string(elem) + " bytes (stride " + std::to_string(stride) +
+                           ", offset " + std::to_string(a.byteOffset) + ") exceed bufferView " + std::to_string(a.bufferView) + " (" +
+                           std::to_string(bv.byteLength) + " bytes)");
+    }
+    if (!a.sparse.isSparse) return;
+    const auto& s = a.sparse;
+    if (s.count < 1 || size_t(s.count) > a.count) fail(path + "/sparse/count", "sparse count " + std::to_string(s.count) + " is outside [1, count]");
+    checkIndex(s.indices.bufferView, m_.bufferViews, path + "/sparse/indices/bufferView", "bufferView");
+    checkIndex(s.values.bufferView, m_.bufferViews, path + "/sparse/values/bufferView", "bufferView");
+    int isz = tinygltf::GetComponentSizeInBytes(uint32_t(s.indices.componentType));
+    if (s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        fail(path + "/sparse/indices/componentType", "sparse indices must be UNSIGNED_BYTE/SHORT/INT");
+    if (s.indices.byteOffset < 0 || !fits(uint64_t(s.indices.byteOffset), uint64_t(isz), uint64_t(s.count), uint64_t(isz),
+                                          m_.bufferViews[size_t(s.indices.bufferView)].byteLength))
+        fail(path + "/sparse/indices", "sparse indices exceed their bufferView");
+    if (s.values.byteOffset < 0 || !fits(uint64_t(s.values.byteOffset), elem, uint64_t(s.count), elem,
+                                         m_.bufferViews[size_t(s.values.bufferView)].byteLength))
+        fail(path + "/sparse/values", "sparse values exceed their bufferView");
+}
+
+void Loader::validateNodes() {
+    parent_.assign(m_.nodes.size(), -1);
+    for (size_t i = 0; i < m_.nodes.size(); ++i) {
+        const auto& n = m_.nodes[i];
+        std::string path = at("nodes", i);
+        if (n.mesh != -1) checkIndex(n.mesh, m_.meshes, path + "/mesh", "mesh");
+        for (size_t c = 0; c < n.children.size(); ++c) checkIndex(n.children[c], m_.nodes, path + "/children/" + std::to_string(c), "node");
+        auto checkVec = [&](const std::vector<double>& v, size_t n, const char* key) {
+            bool ok = v.empty() || v.size() == n;
+            for (double d : v) ok = ok && std::isfinite(d);
+            if (!ok) fail(path + "/" + key, "expected " + std::to_string(n) + " finite numbers");
+        };
+        checkVec(n.matrix, 16, "matrix");
+        checkVec(n.translation, 3, "translation");
+        checkVec(n.rotation, 4, "rotation");
+        checkVec(n.scale, 3, "scale");
+        if (n.rotation.size() == 4 && n.rotation[0] == 0 && n.rotation[1] == 0 && n.rotation[2] == 0 && n.rotation[3] == 0)
+            fail(path + "/rotation", "rotation quaternion is zero");
+    }
+    // Cycles first (the clearer message for a RecursiveNodes-style file): depth-first over children
+    // with an explicit stack, so that deep hierarchies cannot overflow the call stack.
+    enum : char { Unvisited, Visiting, Done };
+    std::vector<char> state(m_.nodes.size(), Unvisited);
+    for (size_t start = 0; start < m_.nodes.size(); ++start) {
+        if (state[start] != Unvisited) continue;
+        std::vector<std::pair<size_t, size_t>> stack{{start, 0}};  // node, next child position
+        state[start] = Visiting;
+        while (!stack.empty()) {
+            auto& [node, next] = stack.back();
+            const auto& children = m_.nodes[node].children;
+            if (next == children.size()) {
+                state[node] = Done;
+                stack.pop_back();
+                continue;
+            }
+            size_t child = size_t(children[next++]);
+            if (state[child] == Visiting)
+                fail(at("nodes", node) + "/children", "node hierarchy has a cycle (node " + std::to_string(node) + " -> node " +
+                                                          std::to_string(child) + ", which is its own ancestor)");
+            if (state[child] == Unvisited) {
+                state[child] = Visiting;
+                stack.emplace_back(child, 0);
+            }
+        }
+    }
+    // glTF requires disjoint strict trees; a shared child would also make traversal cost explode.
+    for (size_t i = 0; i < m_.nodes.size(); ++i)
+        for (int c : m_.nodes[i].children) {
+            if (parent_[size_t(c)] != -1)
+                fail(at("nodes", i) + "/children", "node " + std::to_string(c) + " has two parents (nodes " +
+                                                       std::to_string(parent_[size_t(c)]) + " and " + std::to_string(i) + ")");
+            parent_[size_t(c)] = int(i);
+        }
+}
+
+/// The accessor's elements, tightly packed, with sparse substitutions applied. Ranges were validated.
+std::vector<unsigned char> Loader::gather(int index) const {
+    const auto& a = m_.accessors[size_t(index)];
+    size_t elem = elementSize(a);
+    std::vector<unsigned char> out(a.count * elem, 0);
+    if (a.bufferView != -1) {
+        const auto& bv = m_.bufferViews[size_t(a.bufferView)];
+        size_t stride = bv.byteStride ? bv.byteStride : elem;
+        const unsigned char* base = m_.buffers[size_t(bv.buffer)].data.data() + bv.byteOffset + a.byteOffset;
+        for (size_t k = 0; k < a.count; ++k) std::memcpy(out.data() + k * elem, base + k * stride, elem);
+    }
+    if (a.sparse.isSparse) {
+        const auto& s = a.sparse;
+        const auto& ibv = m_.bufferViews[size_t(s.indices.bufferView)];
+        const auto& vbv = m_.bufferViews[size_t(s.values.bufferView)];
+        const unsigned char* ib = m_.buffers[size_t(ibv.buffer)].data.data() + ibv.byteOffset + size_t(s.indices.byteOffset);
+        const unsigned char* vb = m_.buffers[size_t(vbv.buffer)].data.data() + vbv.byteOffset + size_t(s.values.byteOffset);
+        size_t isz = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(s.indices.componentType)));
+        for (size_t k = 0; k < size_t(s.count); ++k) {
+            uint32_t target = 0;
+            std::memcpy(&target, ib + k * isz, isz);  // little-endian: low bytes first
+            if (target >= a.count)
+                fail(at("accessors", size_t(index)) + "/sparse/indices", "sparse index " + std::to_string(target) + " is out of range");
+            std::memcpy(out.data() + target * elem, vb + k * elem, elem);
+        }
+    }
+    return out;
+}
+
+const std::vector<glm::vec3>& Loader::positions(int accessor) {
+    auto it = positionCache_.find(accessor);
+    if (it != positionCache_.end()) return it->second;
+    std::vector<unsigned char> bytes = gather(accessor);
+    std::vector<glm::vec3> pos(bytes.size() / sizeof(glm::vec3));
+    std::memcpy(pos.data(), bytes.data(), pos.size() * sizeof(glm::vec3));
+    for (size_t k = 0; k < pos.size(); ++k)
+        if (!std::isfinite(pos[k].x) || !std::isfinite(pos[k].y) || !std::isfinite(pos[k].z))
+            fail(at("accessors", size_t(accessor)), "POSITION element " + std::to_string(k) + " is not finite");
+    return positionCache_.emplace(accessor, std::move(pos)).first->second;
+}
+
+Material Loader::material(int index) const {
+    Material out;  // no material: the project default (0.8 grey, opaque)
+    if (index < 0) return out;
+    const auto& mat = m_.materials[size_t(index)];
+    const auto& f = mat.pbrMetallicRoughness.baseColorFactor;
+    out.albedo = glm::vec3(float(f[0]), float(f[1]), float(f[2]));
+    // Only BLEND makes alpha a transmittance; MASK and OPAQUE surfaces block all light they cover.
+    out.opacity = mat.alphaMode == "BLEND" ? float(f[3]) : 1.0f;
+    return out;
+}
+
+glm::mat4 Loader::localMatrix(const tinygltf::Node& n) const {
+    if (n.matrix.size() == 16) {
+        glm::mat4 m;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m[c][r] = float(n.matrix[size_t(c * 4 + r)]);  // glTF is column-major too
+        return m;
+    }
+    glm::mat4 t(1.0f), r(1.0f), s(1.0f);
+    if (n.translation.size() == 3) t[3] = glm::vec4(float(n.translation[0]), float(n.translation[1]), float(n.translation[2]), 1.0f);
+    if (n.rotation.size() == 4) {
+        // Quaternion (x, y, z, w) to matrix, written out to avoid any doubt about glm's quat argument order.
+        double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
+        float x = float(n.rotation[0] / len), y = float(n.rotation[1] / len), z = float(n.rotation[2] / len), w = float(n.rotation[3] / len);
+        r[0] = glm::vec4(1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y), 0);
+        r[1] = glm::vec4(2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x), 0);
+        r[2] = glm::vec4(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y), 0);
+    }
+    if (n.scale.size() == 3) s = glm::mat4(glm::vec4(float(n.scale[0]), 0, 0, 0), glm::vec4(0, float(n.scale[1]), 0, 0), glm::vec4(0, 0, float(n.scale[2]), 0), glm::vec4(0, 0, 0, 1));
+    return t * r * s;
+}
+
+/// Appends one primitive instance; returns its triangle count before degenerate ones are dropped.
+size_t Loader::emitPrimitive(Scene& scene, size_t mi, size_t pi, const glm::mat4& world) {
+    const auto& p = m_.meshes[mi].primitives[pi];
+    std::string path = at("meshes", mi) + "/primitives/" + std::to_string(pi);
+    int mode = p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+    auto posIt = p.attributes.find("POSITION");
+    if (mode < TINYGLTF_MODE_TRIANGLES || posIt == p.attributes.end()) return 0;  // points, lines, or nothing to place
+    const std::vector<glm::vec3>& pos = positions(posIt->second);
+
+    std::vector<uint32_t> seq;
+    if (p.indices != -1) {
+        std::vector<unsigned char> bytes = gather(p.indices);
+        size_t isz = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(m_.accessors[size_t(p.indices)].componentType)));
+        seq.resize(bytes.size() / isz);
+        for (size_t k = 0; k < seq.size(); ++k) {
+            uint32_t v = 0;
+            std::memcpy(&v, bytes.data() + k * isz, isz);
+            if (v >= pos.size())
+                fail(path + "/indices", "index " + std::to_string(v) + " at element " + std::to_string(k) +
+                                            " is out of range (POSITION has " + std::to_string(pos.size()) + " vertices)");
+            seq[k] = v;
+        }
+    } else {
+        seq.resize(pos.size());
+        for (size_t k = 0; k < seq.size(); ++k) seq[k] = uint32_t(k);
+    }
+    if (mode == TINYGLTF_MODE_TRIANGLES && seq.size() % 3 != 0)
+        fail(path, "TRIANGLES primitive has " + std::to_string(seq.size()) + " vertices, not a multiple of 3");
+
+    // Triangle k as three positions in seq; strips alternate winding and fans pivot on vertex 0 (glTF 2.0 spec, 3.7.2.1).
+    size_t triCount = mode == TINYGLTF_MODE_TRIANGLES ? seq.size() / 3 : seq.size() >= 3 ? seq.size() - 2 : 0;
+    auto corner = [&](size_t k, int c) -> uint32_t {
+        if (mode == TINYGLTF_MODE_TRIANGLES) return seq[3 * k + size_t(c)];
+        if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) return seq[k + (c == 0 ? 0 : c == 1 ? 1 + k % 2 : 2 - k % 2)];
+        return c == 0 ? seq[k + 1] : c == 1 ? seq[k + 2] : seq[0];
+    };
+    // A mirroring node transform flips the winding; glTF says to flip it back so fronts stay fronts.
+    bool mirrored = glm::determinant(glm::mat3(world)) < 0.0f;
+    std::vector<glm::vec3> tri;
+    tri.reserve(triCount * 3);
+    for (size_t k = 0; k < triCount; ++k) {
+        glm::vec3 v[3];
+        for (int c = 0; c < 3; ++c) v[c] = glm::vec3(world * glm::vec4(pos[corner(k, c)], 1.0f));
+        if (mirrored) std::swap(v[1], v[2]);
+        tri.insert(tri.end(), {v[0], v[1], v[2]});
+    }
+    scene.addTriangles(tri, material(p.material));
+    return triCount;
+}
+
+Scene Loader::run(GltfStats* stats) {
+    validateStructure();
+    validateNodes();
+    std::vector<int> roots;
+    if (m_.defaultScene != -1) checkIndex(m_.defaultScene, m_.scenes, "/scene", "scene");
+    if (!m_.scenes.empty()) {
+        size_t si = m_.defaultScene >= 0 ? size_t(m_.defaultScene) : 0;
+        const auto& nodes = m_.scenes[si].nodes;
+        for (size_t k = 0; k < nodes.size(); ++k) {
+            std::string path = at("scenes", si) + "/nodes/" + std::to_string(k);
+            checkIndex(nodes[k], m_.nodes, path, "node");
+            // Keeps traversal a forest walk: each node is visited (and instanced) once per root.
+            if (parent_[size_t(nodes[k])] != -1)
+                fail(path, "node " + std::to_string(nodes[k]) + " is not a root node (its parent is node " + std::to_string(parent_[size_t(nodes[k])]) + ")");
+            roots.push_back(nodes[k]);
+        }
+    } else {
+        for (size_t i = 0; i < m_.nodes.size(); ++i)
+            if (parent_[i] == -1) roots.push_back(int(i));
+    }
+    Scene scene;
+    GltfStats counts;
+    std::vector<bool> meshCounted(m_.meshes.size(), false);
+    for (int root : roots) {
+        std::vector<std::pair<int, glm::mat4>> stack{{root, glm::mat4(1.0f)}};
+        while (!stack.empty()) {
+            auto [node, parentMatrix] = stack.back();
+            stack.pop_back();
+            const auto& n = m_.nodes[size_t(node)];
+            glm::mat4 world = parentMatrix * localMatrix(n);
+            if (n.mesh != -1) {
+                size_t meshTris = 0;
+                for (size_t pi = 0; pi < m_.meshes[size_t(n.mesh)].primitives.size(); ++pi)
+                    meshTris += emitPrimitive(scene, size_t(n.mesh), pi, world);
+                counts.instanceTriangles += meshTris;
+                if (!meshCounted[size_t(n.mesh)]) counts.meshTriangles += meshTris;
+                meshCounted[size_t(n.mesh)] = true;
+            }
+            for (int c : n.children) stack.emplace_back(c, world);
+        }
+    }
+    if (stats) *stats = counts;
+    if (scene.triangleCount() == 0)
+        fail("", counts.instanceTriangles ? "no triangles (all " + std::to_string(counts.instanceTriangles) + " are degenerate)"
+                                          : std::string("no triangles"));
+    return scene;
+}
+
+} // namespace
+
+Scene loadGltf(const std::string& file) { return loadGltf(file, nullptr); }
+
+Scene loadGltf(const std::string& file, GltfStats* stats) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file, "", "cannot open file");
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (bytes.size() > 0xFFFFFFF0u) throw InputError(file, "", "file is larger than 4 GiB");
+
+    bool magic = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+    std::string ext = file.size() >= 4 ? file.substr(file.size() - 4) : "";
+    for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    bool binary = magic || ext == ".glb";
+
+    std::string jsonText = binary ? glbJson(file, bytes) : std::string(bytes.begin(), bytes.end());
+    Json doc;
+    try {
+        doc = Json::parse(jsonText);
+    } catch (const Json::exception& e) {
+        std::string msg = e.what();
+        auto pos = msg.find("] ");
+        throw InputError(file, "", "invalid JSON: " + oneLine(pos == std::string::npos ? msg : msg.substr(pos + 2)));
+    }
+    if (!doc.is_object()) throw InputError(file, "", "not a glTF file (the JSON document is not an object)");
+    TypeChecker(file).checkObject(doc, kRoot, "");
+
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(skipImage, nullptr);
+    tinygltf::Model model;
+    std::string err, warn, baseDir = parentDir(file);
+    bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir)
+                     : loader.LoadASCIIFromString(&model, &err, &warn, jsonText.data(), unsigned(jsonText.size()), baseDir);
+    // tinygltf sometimes returns true with a non-empty err (a property it could not use): treat as malformed.
+    if (!ok || !err.empty()) {
+        std::string cause = oneLine(err + "\n" + warn);
+        throw InputError(file, "", cause.empty() ? std::string("tinygltf could not load the file") : cause);
+    }
+    return Loader(file, model).run(stats);
+}
+
+} // namespace shadowlab

@@ -1,0 +1,238 @@
+#include "framework/scene/Procedural.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+// Every generator writes its triangles straight into the Scene (instead of building a temporary
+// vector for Scene::addTriangles) so a 10 M triangle object costs one copy of the data, not two.
+// Closed shapes compute each grid vertex once and index it, so triangles that share an edge share
+// bit-identical endpoints: the soup stays watertight (every edge used by exactly two triangles).
+
+namespace shadowlab {
+namespace {
+
+constexpr float kTwoPi = 6.28318530717958647692f;
+constexpr float kPi = 3.14159265358979323846f;
+
+/// Appends triangles with the same rule as Scene::addTriangles (zero-area ones dropped), material 0.
+class Writer {
+public:
+    Writer(Scene& scene, const Material& m, size_t expectedTriangles) : s_(scene) {
+        s_.materials = {m};
+        s_.positions.reserve(3 * expectedTriangles);
+        s_.normals.reserve(expectedTriangles);
+        s_.materialIds.reserve(expectedTriangles);
+    }
+    void add(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+        glm::vec3 n = glm::cross(b - a, c - a);
+        float len = glm::length(n);
+        if (!(len > 0.0f) || !std::isfinite(len)) return;
+        s_.positions.insert(s_.positions.end(), {a, b, c});
+        s_.normals.push_back(n / len);
+        s_.materialIds.push_back(0);
+        s_.bounds.extend(a);
+        s_.bounds.extend(b);
+        s_.bounds.extend(c);
+    }
+    /// Quad a-b-c-d (counter-clockwise seen from the front) as two triangles.
+    void quad(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d) {
+        add(a, b, c);
+        add(a, c, d);
+    }
+
+private:
+    Scene& s_;
+};
+
+int roundPositive(double x, int minimum) { return std::max(minimum, static_cast<int>(std::lround(x))); }
+
+} // namespace
+
+Scene makePlane(glm::vec2 size, int subdivisions, const Material& m) {
+    int s = std::max(1, subdivisions);
+    Scene scene;
+    Writer w(scene, m, 2 * size_t(s) * size_t(s));
+    auto x = [&](int i) { return size.x * (float(i) / float(s) - 0.5f); };
+    auto z = [&](int k) { return size.y * (float(k) / float(s) - 0.5f); };
+    for (int k = 0; k < s; ++k)
+        for (int i = 0; i < s; ++i)
+            // (x0,z0) → (x0,z1) → (x1,z1) → (x1,z0) turns counter-clockwise seen from +Y.
+            w.quad({x(i), 0, z(k)}, {x(i), 0, z(k + 1)}, {x(i + 1), 0, z(k + 1)}, {x(i + 1), 0, z(k)});
+    return scene;
+}
+
+Scene makeSphere(float radius, int triangles, const Material& m) {
+    // A UV sphere with `stacks` latitude bands and `slices` longitude segments has a fan of
+    // `slices` triangles at each pole and 2·slices per inner band: T = 2·slices·(stacks − 1).
+    // Near-square cells want slices ≈ 2·stacks, so T ≈ 4·stacks·(stacks − 1), i.e.
+    // stacks = (1 + √(1 + T)) / 2; slices is then re-fitted to T / (2·(stacks − 1)). The remaining
+    // error comes from rounding slices: at most 1 / (2·slices), under 1.6 % for T ≥ 1000.
+    // Minimum 3 stacks × 4 slices = 16 triangles.
+    double t = std::max(1, triangles);
+    int stacks = roundPositive((1.0 + std::sqrt(1.0 + t)) / 2.0, 3);
+    int slices = roundPositive(t / (2.0 * (stacks - 1)), 4);
+    // Ring vertices once: rings 1..stacks-1, poles separate. Column `slices` wraps to column 0.
+    std::vector<glm::vec3> ring(size_t(stacks - 1) * size_t(slices));
+    for (int i = 1; i < stacks; ++i) {
+        float theta = kPi * float(i) / float(stacks);
+        for (int j = 0; j < slices; ++j) {
+            float phi = kTwoPi * float(j) / float(slices);
+            ring[size_t(i - 1) * size_t(slices) + size_t(j)] =
+                radius * glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+        }
+    }
+    auto v = [&](int i, int j) -> const glm::vec3& { return ring[size_t(i - 1) * size_t(slices) + size_t(j % slices)]; };
+    glm::vec3 north(0, radius, 0), south(0, -radius, 0);
+    Scene scene;
+    Writer w(scene, m, 2 * size_t(slices) * size_t(stacks - 1));
+    // With θ growing southwards and φ eastwards, (p, p + dφ, p + dθ) is counter-clockwise from outside.
+    for (int j = 0; j < slices; ++j) w.add(north, v(1, j + 1), v(1, j));
+    for (int i = 1; i + 1 < stacks; ++i)
+        for (int j = 0; j < slices; ++j) w.quad(v(i, j), v(i, j + 1), v(i + 1, j + 1), v(i + 1, j));
+    for (int j = 0; j < slices; ++j) w.add(v(stacks - 1, j), v(stacks - 1, j + 1), south);
+    return scene;
+}
+
+Scene makeTorus(float majorRadius, float minorRadius, int triangles, const Material& m) {
+    // A (major × minor) grid of quads: T = 2·U·V. Cells are kept roughly square by making the
+    // segment counts proportional to the circumferences, U/V = k = R/r (clamped to [1, 8]):
+    // V = √(T / (2k)), then U re-fitted to T / (2V). The error is at most 1 / (2U): under 2 %
+    // for T ≥ 1000 (U ≥ 29 there). Minimum 3 × 3 = 18 triangles.
+    double t = std::max(1, triangles);
+    double k = std::clamp(double(majorRadius) / std::max(double(minorRadius), 1e-9), 1.0, 8.0);
+    int minor = roundPositive(std::sqrt(t / (2.0 * k)), 3);
+    int major = roundPositive(t / (2.0 * minor), 3);
+    std::vector<glm::vec3> grid(size_t(major) * size_t(minor));
+    for (int i = 0; i < major; ++i) {
+        float u = kTwoPi * float(i) / float(major);
+        for (int j = 0; j < minor; ++j) {
+            float vAngle = kTwoPi * float(j) / float(minor);
+            float rr = majorRadius + minorRadius * std::cos(vAngle);
+            grid[size_t(i) * size_t(minor) + size_t(j)] = {rr * std::cos(u), minorRadius * std::sin(vAngle), rr * std::sin(u)};
+        }
+    }
+    auto p = [&](int i, int j) -> const glm::vec3& { return grid[size_t(i % major) * size_t(minor) + size_t(j % minor)]; };
+    Scene scene;
+    Writer w(scene, m, 2 * size_t(major) * size_t(minor));
+    // Outward normal is ∂v × ∂u here, so walk v first: (p, p + dv, p + du + dv, p + du).
+    for (int i = 0; i < major; ++i)
+        for (int j = 0; j < minor; ++j) w.quad(p(i, j), p(i, j + 1), p(i + 1, j + 1), p(i + 1, j));
+    return scene;
+}
+
+Scene makeCylinder(float radius, float height, int triangles, const Material& m) {
+    // `slices` around, `stacks` bands up the side, a fan on each cap: T = 2·slices·(stacks + 1).
+    // Near-square side cells want stacks ≈ slices·h / (2πr), so T ≈ slices²·h / (πr):
+    // slices = √(T·πr / h); then stacks + 1 = T / (2·slices) and slices is re-fitted to
+    // T / (2·(stacks + 1)). The error is at most 1 / (2·slices): under 2 % for T ≥ 1000 unless
+    // the cylinder is extremely long and thin (then slices is small and stacks takes the load).
+    // Minimum 3 slices × 1 stack = 12 triangles.
+    double t = std::max(1, triangles);
+    double aspect = double(height) / std::max(double(radius), 1e-9);
+    int slices = roundPositive(std::sqrt(t * kPi / std::max(aspect, 1e-9)), 3);
+    int stacks = roundPositive(t / (2.0 * slices) - 1.0, 1);
+    slices = roundPositive(t / (2.0 * (stacks + 1)), 3);
+    std::vector<glm::vec3> grid(size_t(stacks + 1) * size_t(slices));
+    for (int i = 0; i <= stacks; ++i)
+        for (int j = 0; j < slices; ++j) {
+            float phi = kTwoPi * float(j) / float(slices);
+            // The top ring uses `height` itself so cap and side share exact vertices.
+            float y = i == stacks ? height : height * float(i) / float(stacks);
+            grid[size_t(i) * size_t(slices) + size_t(j)] = {radius * std::cos(phi), y, radius * std::sin(phi)};
+        }
+    auto p = [&](int i, int j) -> const glm::vec3& { return grid[size_t(i) * size_t(slices) + size_t(j % slices)]; };
+    Scene scene;
+    Writer w(scene, m, 2 * size_t(slices) * size_t(stacks + 1));
+    glm::vec3 bottom(0, 0, 0), top(0, height, 0);
+    for (int j = 0; j < slices; ++j) {
+        w.add(bottom, p(0, j), p(0, j + 1));            // faces −Y
+        w.add(top, p(stacks, j + 1), p(stacks, j));     // faces +Y
+        for (int i = 0; i < stacks; ++i) w.quad(p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));  // ∂y × ∂φ is outward
+    }
+    return scene;
+}
+
+Scene makeFence(int posts, float spacing, float height, float radius, int rails, int trianglesPerCylinder, const Material& m) {
+    Scene scene;
+    posts = std::max(1, posts);
+    Scene post = makeCylinder(radius, height, trianglesPerCylinder, m);
+    float firstX = -0.5f * float(posts - 1) * spacing;
+    for (int i = 0; i < posts; ++i) scene.append(post, glm::translate(glm::mat4(1.0f), {firstX + float(i) * spacing, 0, 0}));
+    float length = float(posts - 1) * spacing;
+    if (rails > 0 && length > 0.0f) {
+        // A cylinder along +Y turned −90° about Z lies along +X, starting at the first post.
+        Scene rail = makeCylinder(radius, length, trianglesPerCylinder, m);
+        glm::mat4 toX = glm::rotate(glm::mat4(1.0f), -0.5f * kPi, glm::vec3(0, 0, 1));
+        // Rails split the height evenly and leave a gap at the ground: y = height·(k + 1)/(rails + 1).
+        for (int k = 0; k < rails; ++k) {
+            float y = height * float(k + 1) / float(rails + 1);
+            scene.append(rail, glm::translate(glm::mat4(1.0f), {firstX, y, 0}) * toX);
+        }
+    }
+    // append() copies the material per copy; one material is enough since they are all `m`.
+    scene.materials = {m};
+    std::fill(scene.materialIds.begin(), scene.materialIds.end(), 0u);
+    return scene;
+}
+
+Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint32_t seed, const Material& m) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(-0.5f, 0.5f);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    // Vertices at distance r = size/√3 from the centre in random directions: an equilateral triangle
+    // with that circumradius has edge `size`, random ones have edges of that order.
+    float r = triangleSize / std::sqrt(3.0f);
+    // Keep whole triangles inside the box: centres stay r away from its faces where there is room.
+    glm::vec3 half = glm::max(0.5f * extent - glm::vec3(r), glm::vec3(0.0f));
+    glm::vec3 boxHalf = 0.5f * extent;
+    Scene scene;
+    int n = std::max(0, triangles);
+    Writer w(scene, m, size_t(n));
+    float minCross = 1e-4f * triangleSize * triangleSize;
+    for (int t = 0; t < n; ++t) {
+        // Retry the rare (near) degenerate draw so the count is exactly the request; a box too flat to
+        // hold any triangle (zero extent in two axes) gives up instead of looping forever.
+        size_t before = scene.triangleCount();
+        for (int attempt = 0; attempt < 100 && scene.triangleCount() == before; ++attempt) {
+            glm::vec3 c = 2.0f * half * glm::vec3(unit(rng), unit(rng), unit(rng));
+            glm::vec3 v[3];
+            for (auto& p : v) {
+                glm::vec3 d(gauss(rng), gauss(rng), gauss(rng));
+                float len = glm::length(d);
+                d = len > 1e-6f ? d / len : glm::vec3(1, 0, 0);
+                p = glm::clamp(c + r * d, -boxHalf, boxHalf);
+            }
+            if (glm::length(glm::cross(v[1] - v[0], v[2] - v[0])) > minCross) w.add(v[0], v[1], v[2]);
+        }
+    }
+    return scene;
+}
+
+Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing) {
+    count = glm::max(count, glm::ivec3(1));
+    Scene scene;
+    size_t copies = size_t(count.x) * size_t(count.y) * size_t(count.z);
+    scene.positions.reserve(copies * object.positions.size());
+    scene.normals.reserve(copies * object.normals.size());
+    scene.materialIds.reserve(copies * object.materialIds.size());
+    // Centred in X and Z, stacked upwards from the object's own height in Y.
+    glm::vec3 first(-0.5f * float(count.x - 1) * spacing.x, 0.0f, -0.5f * float(count.z - 1) * spacing.z);
+    for (int y = 0; y < count.y; ++y)
+        for (int z = 0; z < count.z; ++z)
+            for (int x = 0; x < count.x; ++x) {
+                glm::vec3 offset = first + glm::vec3(x, y, z) * spacing;
+                size_t matBase = scene.materials.size(), triBase = scene.triangleCount();
+                scene.append(object, glm::translate(glm::mat4(1.0f), offset));
+                // The copies share the object's materials: drop the duplicates append() made.
+                if (matBase > 0) {
+                    scene.materials.resize(matBase);
+                    for (size_t t = triBase; t < scene.triangleCount(); ++t) scene.materialIds[t] -= uint32_t(matBase);
+                }
+            }
+    return scene;
+}
+
+} // namespace shadowlab

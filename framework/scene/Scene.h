@@ -1,0 +1,48 @@
+#pragma once
+// The scene as every algorithm sees it: one world-space triangle soup with per-triangle normals
+// and materials, plus bounds. Built once from the config (glTF files and procedural generators).
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace shadowlab {
+
+struct Material {
+    glm::vec3 albedo{0.8f};  ///< diffuse reflectance, linear RGB in [0, 1]
+    float opacity = 1.0f;    ///< 1 = opaque caster; < 1 lets light through ("x-ray" casters), in [0, 1]
+};
+
+struct Bounds {
+    glm::vec3 min{1e30f}, max{-1e30f};
+    void extend(glm::vec3 p) { min = glm::min(min, p); max = glm::max(max, p); }
+    void extend(const Bounds& b) { min = glm::min(min, b.min); max = glm::max(max, b.max); }
+    bool empty() const { return min.x > max.x; }
+    glm::vec3 center() const { return 0.5f * (min + max); }
+    glm::vec3 extent() const { return max - min; }
+    float radius() const { return 0.5f * glm::length(max - min); } ///< of the bounding sphere around center()
+};
+
+/// A triangle soup in world space: triangle i has vertices positions[3i..3i+2].
+struct Scene {
+    std::vector<glm::vec3> positions;     ///< 3 per triangle
+    std::vector<glm::vec3> normals;       ///< 1 per triangle, unit length (geometric, from the winding)
+    std::vector<uint32_t> materialIds;    ///< 1 per triangle, index into materials
+    std::vector<Material> materials;
+    Bounds bounds;
+
+    size_t triangleCount() const { return normals.size(); }
+
+    /// Appends triangles (already in world space) using `material`; degenerate triangles
+    /// (zero area) are dropped since they cast no shadow and have no normal.
+    void addTriangles(const std::vector<glm::vec3>& triPositions, const Material& material);
+    /// Appends another scene, transformed by `m`.
+    void append(const Scene& other, const glm::mat4& m);
+    /// Recomputes bounds from positions.
+    void updateBounds();
+    /// A 64-bit content hash (positions and materials), for on-disk caches keyed by scene content.
+    uint64_t contentHash() const;
+};
+
+} // namespace shadowlab

@@ -1,0 +1,242 @@
+// The "scene" object of a config (full reference with examples: docs/scene.md).
+//
+//   {"objects": [OBJECT, ...]}                                   at least one object
+//   OBJECT = {"gltf": "file.glb", "transform": T, "material": M}  path relative to the config file;
+//                                                                 M replaces the file's materials only if given
+//          | {"procedural": KIND, ...generator keys..., "transform": T, "material": M}
+//   KIND and its keys (lengths in scene units, metres by convention):
+//     plane     size [w, d] = [10, 10] (> 0), subdivisions = 1 (1..4096)      2·subdivisions² triangles
+//     sphere    radius = 1, triangles = 2000                                  UV sphere at the origin
+//     torus     major_radius = 1, minor_radius = 0.3, triangles = 2000        around the Y axis
+//     cylinder  radius = 0.5, height = 1, triangles = 500                     along Y from y = 0, capped
+//     fence     posts = 10, spacing = 0.5, height = 1.5, radius = 0.03, rails = 2, triangles_per_cylinder = 64
+//     soup      triangles = 1000, extent [4, 4, 4], triangle_size = 0.2, seed = 1
+//     grid      object = OBJECT (any, recursively), count [nx, ny, nz] = [2, 1, 2] (1..100000),
+//               spacing [sx, sy, sz] = [2, 2, 2]; M replaces the object's materials only if given
+//     triangle requests are 1..100,000,000; generated counts are within 5 % of them (>= 1000)
+//   T = {"translate": [0, 0, 0], "rotate_deg": [0, 0, 0] (Euler degrees: X first, then Y, then Z),
+//        "scale": 1 or [sx, sy, sz] (non-zero; negative mirrors),
+//        "fit_size": 0 (off; > 0: scale uniformly so the largest bounding-box extent is fit_size and
+//                       put the box centred on the origin in X/Z with its bottom at y = 0, before the rest)}
+//   M = {"albedo": [0.8, 0.8, 0.8] (linear RGB in [0, 1]), "opacity": 1 (in [0, 1])}
+//
+// The whole config is read and checked (unknown keys included) before anything is generated or
+// loaded, so a typo in the last object fails at once instead of after building a 10 M triangle sphere.
+#include "framework/scene/SceneConfig.h"
+
+#include "framework/scene/GltfLoader.h"
+#include "framework/scene/Procedural.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <utility>
+
+namespace shadowlab {
+namespace {
+
+const std::vector<std::string> kKinds = {"plane", "sphere", "torus", "cylinder", "fence", "soup", "grid"};
+constexpr int kMaxTriangles = 100'000'000;  // ~5 GB of scene data: beyond that is a typo, not an experiment
+constexpr int kMaxGridDepth = 8;
+
+using Builder = std::function<Scene()>;
+
+float positive(JsonNode& node, const std::string& key, double def) {
+    double v = node.getFloat(key, def, 0.0);
+    if (!(v > 0.0)) node.fail(key, "must be greater than 0");
+    return float(v);
+}
+
+Material readMaterial(JsonNode node) {
+    Material m;
+    m.albedo = node.getVec3("albedo", glm::vec3(0.8f));
+    if (glm::any(glm::lessThan(m.albedo, glm::vec3(0.0f))) || glm::any(glm::greaterThan(m.albedo, glm::vec3(1.0f))))
+        node.fail("albedo", "values must lie in [0, 1]");
+    m.opacity = float(node.getFloat("opacity", 1.0, 0.0, 1.0));
+    node.finish();
+    return m;
+}
+
+struct Transform {
+    glm::mat4 matrix{1.0f};  // translate · rotate · scale, applied after the fit
+    float fitSize = 0.0f;
+};
+
+Transform readTransform(JsonNode node) {
+    glm::vec3 translate = node.getVec3("translate", glm::vec3(0.0f));
+    glm::vec3 rot = glm::radians(node.getVec3("rotate_deg", glm::vec3(0.0f)));
+    glm::vec3 scale(1.0f);
+    // "scale" is a number or three numbers; JsonNode has no getter for "either", so dispatch on the type.
+    const Json* raw = node.has("scale") ? &node.raw().at("scale") : nullptr;
+    if (!raw || raw->is_number()) scale = glm::vec3(float(node.getFloat("scale", 1.0)));
+    else if (raw->is_array()) scale = node.getVec3("scale", glm::vec3(1.0f));
+    else node.fail("scale", "expected a number or an array of 3 numbers, got " + raw->dump());
+    if (glm::any(glm::equal(scale, glm::vec3(0.0f)))) node.fail("scale", "scale factors must be non-zero");
+    Transform t;
+    t.fitSize = float(node.getFloat("fit_size", 0.0, 0.0));
+    node.finish();
+    glm::mat4 r = glm::rotate(glm::mat4(1.0f), rot.z, {0, 0, 1}) * glm::rotate(glm::mat4(1.0f), rot.y, {0, 1, 0}) *
+                  glm::rotate(glm::mat4(1.0f), rot.x, {1, 0, 0});
+    t.matrix = glm::translate(glm::mat4(1.0f), translate) * r * glm::scale(glm::mat4(1.0f), scale);
+    return t;
+}
+
+/// Transforms a scene in place (no second copy of a big scene), with Scene::append's rules:
+/// mirroring flips the winding back, triangles that become degenerate are dropped.
+void transformInPlace(Scene& s, const glm::mat4& m) {
+    bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;
+    size_t kept = 0;
+    for (size_t t = 0; t < s.triangleCount(); ++t) {
+        glm::vec3 v[3];
+        for (int k = 0; k < 3; ++k) v[k] = glm::vec3(m * glm::vec4(s.positions[3 * t + size_t(k)], 1.0f));
+        if (mirrored) std::swap(v[1], v[2]);
+        glm::vec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+        float len = glm::length(n);
+        if (!(len > 0.0f) || !std::isfinite(len)) continue;
+        for (int k = 0; k < 3; ++k) s.positions[3 * kept + size_t(k)] = v[k];
+        s.normals[kept] = n / len;
+        s.materialIds[kept] = s.materialIds[t];
+        ++kept;
+    }
+    s.positions.resize(3 * kept);
+    s.normals.resize(kept);
+    s.materialIds.resize(kept);
+    s.updateBounds();
+}
+
+void overrideMaterials(Scene& s, const Material& m) {
+    s.materials = {m};
+    std::fill(s.materialIds.begin(), s.materialIds.end(), 0u);
+}
+
+Builder parseObject(JsonNode node, int depth);
+
+/// Reads a procedural object's generator keys; returns the generator (run later).
+Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& m, int depth) {
+    auto triangles = [&](int def) { return node.getInt("triangles", def, 1, kMaxTriangles); };
+    if (kind == "plane") {
+        glm::vec2 size = node.getVec2("size", glm::vec2(10.0f));
+        if (!(size.x > 0.0f && size.y > 0.0f)) node.fail("size", "both sizes must be greater than 0");
+        int sub = node.getInt("subdivisions", 1, 1, 4096);
+        return [=] { return makePlane(size, sub, m); };
+    }
+    if (kind == "sphere") {
+        float r = positive(node, "radius", 1.0);
+        int n = triangles(2000);
+        return [=] { return makeSphere(r, n, m); };
+    }
+    if (kind == "torus") {
+        float major = positive(node, "major_radius", 1.0), minor = positive(node, "minor_radius", 0.3);
+        int n = triangles(2000);
+        return [=] { return makeTorus(major, minor, n, m); };
+    }
+    if (kind == "cylinder") {
+        float r = positive(node, "radius", 0.5), h = positive(node, "height", 1.0);
+        int n = triangles(500);
+        return [=] { return makeCylinder(r, h, n, m); };
+    }
+    if (kind == "fence") {
+        int posts = node.getInt("posts", 10, 1, 100000);
+        float spacing = positive(node, "spacing", 0.5), height = positive(node, "height", 1.5);
+        float radius = positive(node, "radius", 0.03);
+        int rails = node.getInt("rails", 2, 0, 1000);
+        int perCylinder = node.getInt("triangles_per_cylinder", 64, 1, 1'000'000);
+        if (double(posts + rails) * perCylinder > kMaxTriangles)
+            node.fail("triangles_per_cylinder", "(posts + rails) × triangles_per_cylinder exceeds " + std::to_string(kMaxTriangles));
+        return [=] { return makeFence(posts, spacing, height, radius, rails, perCylinder, m); };
+    }
+    if (kind == "soup") {
+        int n = triangles(1000);
+        glm::vec3 extent = node.getVec3("extent", glm::vec3(4.0f));
+        if (glm::any(glm::lessThan(extent, glm::vec3(0.0f)))) node.fail("extent", "extents must not be negative");
+        float size = positive(node, "triangle_size", 0.2);
+        uint32_t seed = uint32_t(node.getInt("seed", 1, 0));
+        return [=] { return makeTriangleSoup(n, extent, size, seed, m); };
+    }
+    // grid
+    if (depth >= kMaxGridDepth) node.fail("object", "grids nest deeper than " + std::to_string(kMaxGridDepth) + " levels");
+    if (!node.has("object")) node.fail("object", "a grid needs the \"object\" to repeat");
+    Builder inner = parseObject(node.child("object"), depth + 1);
+    glm::ivec3 count = node.getIVec3("count", glm::ivec3(2, 1, 2), 1, 100000);
+    glm::vec3 spacing = node.getVec3("spacing", glm::vec3(2.0f));
+    return [=] {
+        Scene object = inner();
+        double total = double(object.triangleCount()) * count.x * count.y * count.z;
+        if (total > kMaxTriangles)
+            node.fail("count", "the grid would have " + std::to_string(size_t(total)) + " triangles (limit " + std::to_string(kMaxTriangles) + ")");
+        return makeGrid(object, count, spacing);
+    };
+}
+
+/// Reads and checks one OBJECT (and, for grids, the objects inside it) without building anything.
+Builder parseObject(JsonNode node, int depth) {
+    bool isGltf = node.has("gltf"), isProcedural = node.has("procedural");
+    if (isGltf && isProcedural) node.failHere("an object takes either \"gltf\" or \"procedural\", not both");
+    if (!isGltf && !isProcedural)
+        node.failHere("an object needs \"gltf\" (a file) or \"procedural\" (plane, sphere, torus, cylinder, fence, soup or grid)");
+
+    Builder build;
+    std::string kind = isGltf ? "gltf" : node.getEnum("procedural", "", kKinds);
+    // Generated objects always have a material (defaults included); files and grids keep their own unless given one.
+    bool overrideMaterial = node.has("material");
+    bool readMat = overrideMaterial || (kind != "gltf" && kind != "grid");
+    Material material = readMat ? readMaterial(node.child("material")) : Material{};
+    if (isGltf) {
+        std::string path = node.getPath("gltf", "");
+        if (path.empty()) node.fail("gltf", "expected the path of a .gltf or .glb file");
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(path, ec)) node.fail("gltf", "glTF file not found: " + path);
+        std::string where = node.file() + " at " + node.childPath("gltf");
+        build = [path, where] {
+            try {
+                return loadGltf(path);
+            } catch (const InputError& e) {
+                // Still an error about the glTF file; the suffix says which config entry asked for it.
+                throw InputError(e.file(), e.jsonPath(), e.cause() + " (loaded from " + where + ")");
+            }
+        };
+    } else {
+        build = parseGenerator(node, kind, material, depth);
+    }
+    JsonNode transformNode = node.child("transform");
+    Transform transform = readTransform(transformNode);
+    node.finish();
+
+    return [=]() mutable {
+        Scene s = build();
+        if (overrideMaterial && (kind == "gltf" || kind == "grid")) overrideMaterials(s, material);
+        glm::mat4 m = transform.matrix;
+        if (transform.fitSize > 0.0f) {
+            s.updateBounds();
+            glm::vec3 ext = s.bounds.extent();
+            float largest = std::max({ext.x, ext.y, ext.z});
+            if (s.bounds.empty() || !(largest > 0.0f)) transformNode.fail("fit_size", "the object has no extent to fit");
+            float k = transform.fitSize / largest;
+            glm::vec3 anchor(s.bounds.center().x, s.bounds.min.y, s.bounds.center().z);
+            m = m * glm::scale(glm::mat4(1.0f), glm::vec3(k)) * glm::translate(glm::mat4(1.0f), -anchor);
+        }
+        if (m != glm::mat4(1.0f)) transformInPlace(s, m);
+        return s;
+    };
+}
+
+} // namespace
+
+Scene buildScene(JsonNode sceneNode) {
+    std::vector<Builder> builders;
+    for (JsonNode& object : sceneNode.objectArray("objects")) builders.push_back(parseObject(object, 0));
+    sceneNode.finish();
+    if (builders.empty()) sceneNode.fail("objects", "scene has no objects");
+    Scene scene;
+    for (size_t i = 0; i < builders.size(); ++i) {
+        Scene s = builders[i]();
+        if (i == 0) scene = std::move(s);
+        else scene.append(s, glm::mat4(1.0f));
+    }
+    scene.updateBounds();
+    return scene;
+}
+
+} // namespace shadowlab

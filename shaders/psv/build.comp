@@ -1,0 +1,103 @@
+#version 450
+// PSV build, pass 2 of 2: Algorithm 1 of the paper. Invocation k merges triangle perm(k) into the
+// TOP tree: it filters the triangle down from the root and replaces the empty leaf it reaches by
+// its own frustum's first node, with a compare-and-swap on the leaf's child field. A failed CAS
+// returns the frustum another invocation linked there first; the descent simply goes on from it,
+// so concurrent insertions never lose a triangle and never wait for each other (lock-free).
+// The nodes themselves were written by frusta.comp, before this dispatch.
+#include "common/light.glsl"
+#include "common/scene.glsl"
+#include "psv/tree.glsl"
+layout(local_size_x = 64) in;
+
+uniform uint uInvocationsPerRow; // gl_NumWorkGroups.x * 64: 2D dispatch past 65535 groups
+
+#define SLOT_POS 0u
+#define SLOT_INTER 1u
+#define SLOT_NEG 2u // capping nodes only: a shadow plane's negative child is its index + 1
+
+uint psvChild(uint node, uint slot) {
+    return slot == SLOT_POS ? psvNodes[node].pos : (slot == SLOT_INTER ? psvNodes[node].inter : psvNodes[node].wedgeOrNeg);
+}
+
+uint psvLinkChild(uint node, uint slot, uint child) {
+    if (slot == SLOT_POS) return atomicCompSwap(psvNodes[node].pos, 0u, child);
+    if (slot == SLOT_INTER) return atomicCompSwap(psvNodes[node].inter, 0u, child);
+    return atomicCompSwap(psvNodes[node].wedgeOrNeg, 0u, child);
+}
+
+// Merges triangle t; returns the counter its outcome adds to (PSV_C_*), and the nodes it tested.
+uint insertTriangle(uint t, out uint tested) {
+    tested = 0u;
+    vec3 v0 = sceneVertex(t, 0u), v1 = sceneVertex(t, 1u), v2 = sceneVertex(t, 2u);
+    PsvFrustum f = psvFrustum(v0, v1, v2);
+    if (f.status == PSV_CASTER_EDGE_ON) return PSV_C_CULLED_EDGE_ON;
+    if (f.status == PSV_CASTER_FACING) return PSV_C_CULLED_FACING;
+    uint root = PSV_NODES_PER_TRIANGLE * t + 1u;
+    uint nodeCount = PSV_NODES_PER_TRIANGLE * uTriangleCount + 1u;
+#if PSV_DEPTH_SKIP
+    uint depthBits = floatBitsToUint(psvTriangleMinDepth(v0, v1, v2));
+#endif
+    uint node = 0u, slot = SLOT_POS; // the sentinel's `pos` holds the root
+    while (true) {
+        uint child = psvChild(node, slot); // a stale 0 only makes the CAS below fail
+        if (child == 0u) {
+            child = psvLinkChild(node, slot, root);
+            if (child == 0u) return PSV_C_INSERTED;
+        }
+        // Every link points at the first node of a frustum; anything else is a corrupt tree.
+        if (child >= nodeCount || child % PSV_NODES_PER_TRIANGLE != 1u) return PSV_C_BUILD_ERRORS;
+        node = child;
+        while (true) { // down the frustum's own nodes until a child field has to be followed
+            // A frustum adds at most 4 levels, so a longer descent can only be a cycle.
+            if (++tested > nodeCount) return PSV_C_BUILD_ERRORS;
+            vec4 plane = psvNodes[node].plane;
+            int c = psvClassify(plane, v0, v1, v2);
+            if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
+                if (c < 0) { ++node; continue; }
+                if (c == 0) {
+#if PSV_WEDGE
+                    // Non-negative floats order like their bit patterns: an integer max suffices.
+                    atomicMax(psvNodes[node].wedgeOrNeg, floatBitsToUint(psvWedge(plane, v0, v1, v2)));
+#endif
+                    slot = SLOT_INTER;
+                } else {
+                    slot = SLOT_POS;
+                }
+                break;
+            }
+#if !PSV_TRANSPARENCY
+            // Strictly behind an opaque caster inside its frustum: this triangle's own frustum lies
+            // inside that one, and the opaque query never visits a capping node's negative child.
+            if (c < 0) return PSV_C_CULLED_OCCLUDED;
+#endif
+#if PSV_DEPTH_SKIP
+            atomicMin(psvNodes[node].minDepth, depthBits);
+#endif
+            slot = c > 0 ? SLOT_POS : (c == 0 ? SLOT_INTER : SLOT_NEG);
+            break;
+        }
+    }
+    return PSV_C_BUILD_ERRORS; // not reached
+}
+
+shared uint sOutcomes[5]; // PSV_C_INSERTED .. PSV_C_BUILD_ERRORS
+shared uint sTestedMax;
+
+void main() {
+    // Counters are summed per work group first: one global atomic per group and outcome.
+    if (gl_LocalInvocationIndex < 5u) sOutcomes[gl_LocalInvocationIndex] = 0u;
+    if (gl_LocalInvocationIndex == 0u) sTestedMax = 0u;
+    barrier();
+    uint k = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x;
+    if (k < uTriangleCount) {
+        uint tested;
+        uint outcome = insertTriangle(psvPermute(k), tested);
+        atomicAdd(sOutcomes[outcome], 1u);
+        atomicMax(sTestedMax, tested);
+    }
+    barrier();
+    if (gl_LocalInvocationIndex < 5u && sOutcomes[gl_LocalInvocationIndex] != 0u)
+        atomicAdd(psvCounters[gl_LocalInvocationIndex], sOutcomes[gl_LocalInvocationIndex]);
+    if (gl_LocalInvocationIndex == 0u) atomicMax(psvCounters[PSV_C_INSERT_DEPTH_MAX], sTestedMax);
+}

@@ -1,0 +1,24 @@
+#version 450
+// PSV build, pass 1 of 2: every triangle writes its shadow frustum (4 nodes, children empty) into
+// the slots it owns, 4t+1 .. 4t+4. Writing all nodes before any insertion (pass 2, build.comp)
+// means a thread that loses a compare-and-swap and descends into another triangle's subtree never
+// reads half-written planes, without relying on memory ordering between the node writes and the
+// atomic that publishes them (GLSL atomics carry no acquire/release semantics).
+#include "common/light.glsl"
+#include "common/scene.glsl"
+#include "psv/tree.glsl"
+layout(local_size_x = 64) in;
+
+uniform uint uInvocationsPerRow; // gl_NumWorkGroups.x * 64: 2D dispatch past 65535 groups
+
+void main() {
+    uint t = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x;
+    if (t >= uTriangleCount) return;
+    vec3 v0 = sceneVertex(t, 0u), v1 = sceneVertex(t, 1u), v2 = sceneVertex(t, 2u);
+    PsvFrustum f = psvFrustum(v0, v1, v2);
+    if (f.status != PSV_CASTER_OK) return; // never linked into the tree, so never read
+    uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
+    for (uint i = 0u; i < 3u; ++i) psvNodes[base + i] = PsvNode(f.planes[i], 0u, 0u, 0u, 0u);
+    // The capping node's depth starts at its own triangle's: the subtree it roots includes it.
+    psvNodes[base + 3u] = PsvNode(f.planes[3], 0u, 0u, 0u, floatBitsToUint(psvTriangleMinDepth(v0, v1, v2)));
+}

@@ -1,0 +1,216 @@
+// The TOP tree of Partitioned Shadow Volumes (Gerhards et al. 2015): node layout, the per-triangle
+// shadow frustum, and the geometric predicates shared by the build and the query.
+// Needs common/scene.glsl and common/light.glsl included before it.
+#include "psv/layout.glsl"
+
+// 32 bytes (std430), mirrored by PsvNodeGpu in algorithms/psv/PsvGpuLayout.h.
+struct PsvNode {
+    vec4 plane;       // unit normal.xyz, offset w: dot(plane.xyz, x) + plane.w; frustum inside < 0
+    uint pos;         // positive child (0 = empty leaf)
+    uint inter;       // intersection child
+    uint wedgeOrNeg;  // shadow plane: float bits of the wedge (see psvWedge); capping: negative child
+    uint minDepth;    // capping: float bits of the smallest light depth in its subtree (depth skip)
+};
+
+layout(std430, binding = PSV_NODE_BINDING) coherent buffer PsvNodes { PsvNode psvNodes[]; };
+layout(std430, binding = PSV_COUNTER_BINDING) coherent buffer PsvCounters { uint psvCounters[]; };
+
+uniform uint uTriangleCount;
+uniform float uTolerance;   // world units: vertices this close to a plane count as touching it
+uniform vec3 uDepthOrigin;  // directional light: depth is measured along the light from here
+
+bool psvDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
+
+// ---- Insertion order: a keyed bijection on [0, n) ------------------------------------------------
+// A 4-round Feistel network on 2h bits (the smallest even width covering n) with cycle walking, so
+// the "random permutation" of the paper costs no buffer (memory stays 128 (n + 1) bytes).
+// Mirrored on the CPU by psvPermute() in algorithms/psv/PsvPermutation.h.
+uniform uvec4 uPermKeys;
+uniform uint uPermHalfBits;
+
+uint psvHash(uint x) { // "lowbias32" integer hash (C. Wellons)
+    x ^= x >> 16; x *= 0x7feb352du;
+    x ^= x >> 15; x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+uint psvFeistel(uint x) {
+    uint mask = (1u << uPermHalfBits) - 1u;
+    uint l = x >> uPermHalfBits, r = x & mask;
+    for (int round = 0; round < 4; ++round) {
+        uint f = psvHash(r ^ uPermKeys[round]) & mask;
+        uint nl = r;
+        r = l ^ f;
+        l = nl;
+    }
+    return (l << uPermHalfBits) | r;
+}
+
+uint psvPermute(uint k) {
+#if PSV_RANDOM_ORDER
+    uint x = psvFeistel(k);
+    while (x >= uTriangleCount) x = psvFeistel(x); // ends: k < n lies on x's cycle
+    return x;
+#else
+    return k;
+#endif
+}
+
+// ---- Shadow frustum of one triangle ------------------------------------------------------------
+struct PsvFrustum {
+    vec4 planes[4]; // three shadow planes, then the capping plane; inside negative
+    int status;     // PSV_CASTER_* below
+};
+#define PSV_CASTER_OK 0
+#define PSV_CASTER_EDGE_ON 1
+#define PSV_CASTER_FACING 2
+
+// Lexicographic order of two points: makes an edge's plane independent of which triangle asks.
+bool psvLexLess(vec3 a, vec3 b) {
+    return a.x != b.x ? a.x < b.x : (a.y != b.y ? a.y < b.y : a.z < b.z);
+}
+
+// Plane through the light and edge a→b (a, b in the triangle's winding order). Both triangles that
+// share an edge evaluate the same expression on the same (lexicographically ordered) operands, so
+// their planes are bit-identical up to an exact negation: no crack along the edge can let light
+// through a closed mesh. cross(b - a, a - light) has the triangle on its negative side when the
+// light is on the negative side of the winding normal (flip = 1); swapping a and b negates it.
+vec4 psvShadowPlane(vec3 a, vec3 b, float flip) {
+    bool swapped = psvLexLess(b, a);
+    vec3 lo = swapped ? b : a, hi = swapped ? a : b;
+    vec3 n = psvDirectional() ? cross(hi - lo, uLightDirection) : cross(hi - lo, lo - uLightPosition);
+    float len = length(n);
+    if (!(len > 0.0)) return vec4(0.0);
+    n /= len;
+    float w = psvDirectional() ? -dot(n, lo) : -dot(n, uLightPosition);
+    vec4 p = vec4(n, w);
+    // Negation is exact, so the two triangles of an edge still hold opposite copies of one plane.
+    return (swapped ? -flip : flip) > 0.0 ? p : -p;
+}
+
+PsvFrustum psvFrustum(vec3 v0, vec3 v1, vec3 v2) {
+    PsvFrustum f;
+    f.status = PSV_CASTER_OK;
+    vec3 n = cross(v1 - v0, v2 - v0);
+    float len = length(n);
+    n = len > 0.0 ? n / len : vec3(0.0);
+    // Signed distance of the light to the triangle's plane (directional: cosine to the light).
+    vec3 toLight = psvDirectional() ? -uLightDirection : uLightPosition - v0;
+    float side = dot(n, toLight);
+    // Light (almost) in the triangle's plane: the frustum is empty, and the planes' orientation
+    // would rest on rounding. 1e-6 rad cannot hide a visible shadow.
+    if (!(abs(side) > 1e-6 * length(toLight))) { f.status = PSV_CASTER_EDGE_ON; return f; }
+#if PSV_FRONT_FACE_CULLING
+    if (side > 0.0) { f.status = PSV_CASTER_FACING; return f; }
+#endif
+    float flip = side < 0.0 ? 1.0 : -1.0;
+    f.planes[0] = psvShadowPlane(v0, v1, flip);
+    f.planes[1] = psvShadowPlane(v1, v2, flip);
+    f.planes[2] = psvShadowPlane(v2, v0, flip);
+    if (f.planes[0].xyz == vec3(0.0) || f.planes[1].xyz == vec3(0.0) || f.planes[2].xyz == vec3(0.0)) {
+        f.status = PSV_CASTER_EDGE_ON;
+        return f;
+    }
+    vec3 nc = side > 0.0 ? n : -n; // the light side of the capping plane is positive
+    f.planes[3] = vec4(nc, -dot(nc, v0));
+    return f;
+}
+
+// ---- Predicates ----------------------------------------------------------------------------------
+float psvSigned(vec4 plane, vec3 x) { return dot(plane.xyz, x) + plane.w; }
+
+// Where a triangle lies with respect to a plane: 1 strictly positive, -1 strictly negative, 0 it
+// touches or crosses it. The tolerance only ever moves triangles to the intersection child, which
+// the query may always visit, so it costs a little speed and never correctness.
+int psvClassify(vec4 plane, vec3 v0, vec3 v1, vec3 v2) {
+    vec3 s = vec3(psvSigned(plane, v0), psvSigned(plane, v1), psvSigned(plane, v2));
+    if (all(greaterThan(s, vec3(uTolerance)))) return 1;
+    if (all(lessThan(s, vec3(-uTolerance)))) return -1;
+    return 0;
+}
+
+// Depth from the light: distance for a point light, distance along the light for a directional
+// one (measured from uDepthOrigin, behind the scene, so it is positive and its float bits order).
+float psvDepth(vec3 x) {
+    return psvDirectional() ? dot(x - uDepthOrigin, uLightDirection) : length(x - uLightPosition);
+}
+
+// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+vec3 psvClosestPoint(vec3 p, vec3 a, vec3 b, vec3 c) {
+    vec3 ab = b - a, ac = c - a, ap = p - a;
+    float d1 = dot(ab, ap), d2 = dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) return a;
+    vec3 bp = p - b;
+    float d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) return b;
+    float vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + d1 / (d1 - d3) * ab;
+    vec3 cp = p - c;
+    float d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) return c;
+    float vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + d2 / (d2 - d6) * ac;
+    float va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+    float denom = 1.0 / (va + vb + vc);
+    return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// Smallest depth of any point of the triangle, lowered by a relative margin so that rounding can
+// only make the depth skip more conservative.
+float psvTriangleMinDepth(vec3 v0, vec3 v1, vec3 v2) {
+    float d = psvDirectional() ? min(psvDepth(v0), min(psvDepth(v1), psvDepth(v2)))
+                               : length(psvClosestPoint(uLightPosition, v0, v1, v2) - uLightPosition);
+    return max(0.0, d * (1.0 - 1e-5) - uTolerance);
+}
+
+// ---- Wedge (section 3.5) -------------------------------------------------------------------------
+// Point light: the wedge is the largest |sin| of the angle between the shadow plane and any ray
+// from the light through the triangle; the query compares |signed distance| / distance with it.
+// The paper takes the vertices' angles, but the largest angle of a triangle seen from the light
+// can lie inside an edge (or inside the triangle, when it covers the plane's normal direction):
+// the maximum over the spherical triangle is computed exactly below, so the test is conservative.
+
+// Largest |n·u| over the great-circle arc a→b (unit vectors, arc shorter than π), endpoints excluded.
+float psvArcMax(vec3 n, vec3 a, vec3 b) {
+    vec3 g = cross(a, b);
+    float gl = length(g);
+    if (!(gl > 1e-12)) return 0.0; // a point-like arc: its endpoints cover it
+    g /= gl;
+    vec3 p = n - dot(n, g) * g;    // direction of the circle closest to n
+    float pl = length(p);
+    if (!(pl > 1e-12)) return 0.0; // n is normal to the circle: n·u = 0 on all of it
+    p /= pl;
+    bool onArc = dot(cross(a, p), g) >= 0.0 && dot(cross(p, b), g) >= 0.0;
+    bool oppositeOnArc = dot(cross(a, -p), g) >= 0.0 && dot(cross(-p, b), g) >= 0.0;
+    return onArc || oppositeOnArc ? pl : 0.0;
+}
+
+// Whether the unit direction u lies inside the spherical triangle abc.
+bool psvInsideCone(vec3 u, vec3 a, vec3 b, vec3 c) {
+    float s0 = dot(u, cross(a, b)), s1 = dot(u, cross(b, c)), s2 = dot(u, cross(c, a));
+    bool sameSign = (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0);
+    return sameSign && dot(u, a + b + c) > 0.0;
+}
+
+// The wedge value a triangle needs in a shadow-plane node (see the top of this section), with a
+// margin so rounding only widens it. Directional light: the shadow plane contains the light
+// direction, so the distance to the plane is constant along a shadow ray and the wedge is the
+// largest |distance| of the vertices (exact, the distance being linear over the triangle).
+float psvWedge(vec4 plane, vec3 v0, vec3 v1, vec3 v2) {
+    if (psvDirectional())
+        return max(abs(psvSigned(plane, v0)), max(abs(psvSigned(plane, v1)), abs(psvSigned(plane, v2)))) + uTolerance;
+    vec3 n = plane.xyz;
+    vec3 a = normalize(v0 - uLightPosition), b = normalize(v1 - uLightPosition), c = normalize(v2 - uLightPosition);
+    float m = max(abs(dot(n, a)), max(abs(dot(n, b)), abs(dot(n, c))));
+    m = max(m, max(psvArcMax(n, a, b), max(psvArcMax(n, b, c), psvArcMax(n, c, a))));
+    if (psvInsideCone(n, a, b, c) || psvInsideCone(-n, a, b, c)) m = 1.0;
+    return min(1.0, m * (1.0 + 1e-5) + 1e-6);
+}
+
+// Whether a query point is inside a node's intersection wedge (same units as psvWedge).
+bool psvInWedge(float s, vec3 q, float wedge) {
+    float scale = psvDirectional() ? 1.0 : length(q - uLightPosition);
+    return abs(s) <= wedge * scale + uTolerance;
+}

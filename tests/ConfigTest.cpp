@@ -1,0 +1,104 @@
+// Config parsing and validation: defaults fill in, and every bad input is one InputError naming
+// the file, the JSON path and the cause.
+#include "framework/experiment/Config.h"
+
+#include <gtest/gtest.h>
+
+namespace shadowlab {
+namespace {
+
+Json minimal() {
+    return Json::parse(R"({
+        "scene": {"objects": [{"procedural": "plane"}, {"procedural": "sphere", "triangles": 200}]},
+        "algorithms": [{"algorithm": "shadow_map"}]
+    })");
+}
+
+TEST(ConfigTest, MissingKeysTakeDefaults) {
+    ExperimentConfig c = parseConfig(minimal(), "/tmp/x/cfg.json");
+    EXPECT_EQ(c.resolution, glm::ivec2(256, 256));
+    EXPECT_EQ(c.frames, 30);
+    EXPECT_TRUE(c.reference);
+    ASSERT_EQ(c.algorithms.size(), 1u);
+    EXPECT_EQ(c.algorithms[0].id, "shadow_map");
+    EXPECT_EQ(c.algorithms[0].params.getInt("resolution"), 2048);
+    EXPECT_EQ(c.outputDir, "/tmp/x/results/experiment"); // relative to the config's folder
+    // The resolved config names every value used, defaults included.
+    EXPECT_EQ(c.resolved["algorithms"][0]["params"]["pcf"], 1);
+    EXPECT_EQ(c.resolved["camera"]["fov_y_deg"], 60.0);
+    EXPECT_EQ(c.resolved["light"]["type"], "point");
+}
+
+TEST(ConfigTest, ResolvedConfigParsesToTheSameExperiment) {
+    ExperimentConfig a = parseConfig(minimal(), "/tmp/x/cfg.json");
+    ExperimentConfig b = parseConfig(a.resolved, "/tmp/x/cfg.json");
+    EXPECT_EQ(a.resolved, b.resolved);
+}
+
+struct BadCase {
+    const char* name;
+    const char* patch;     ///< JSON merged into minimal() (merge_patch)
+    const char* path;      ///< expected JSON path in the message
+    const char* cause;     ///< expected fragment of the cause
+};
+
+const BadCase kBad[] = {
+    {"unknown_top_key", R"({"framez": 3})", "/framez", "accepted keys"},
+    {"wrong_type", R"({"frames": "ten"})", "/frames", "expected an integer"},
+    {"out_of_range", R"({"resolution": [0, 64]})", "/resolution", "must lie in"},
+    {"unknown_algorithm", R"({"algorithms": [{"algorithm": "magic"}]})", "/algorithms/0/algorithm", "registered: shadow_map"},
+    {"unknown_param", R"({"algorithms": [{"algorithm": "shadow_map", "params": {"resolutoin": 512}}]})",
+     "/algorithms/0/params/resolutoin", "accepted keys"},
+    {"param_out_of_range", R"({"algorithms": [{"algorithm": "shadow_map", "params": {"pcf": 99}}]})",
+     "/algorithms/0/params/pcf", "out of range"},
+    {"duplicate_id", R"({"algorithms": [{"algorithm": "shadow_map"}, {"algorithm": "shadow_map"}]})", "/algorithms/1/id",
+     "duplicate id"},
+    {"unsupported_light", R"({"light": {"type": "area"}})", "/algorithms/0/algorithm", "does not support area"},
+    {"bad_light_type", R"({"light": {"type": "laser"}})", "/light/type", "accepted: point, spot"},
+    {"image_frame_outside", R"({"frames": 5, "output": {"images_at_frames": [7]}})", "/output/images_at_frames", "outside"},
+    {"unknown_camera_key", R"({"camera": {"fov": 60}})", "/camera/fov", "accepted keys"},
+    {"keyframes_not_increasing", R"({"camera": {"path": {"keyframes": [{"time": 1, "position": [0,0,0]}, {"time": 1, "position": [1,0,0]}]}}})",
+     "/camera/path/keyframes/1/time", "increase"},
+    {"keyframe_missing_position", R"({"light": {"path": {"keyframes": [{"time": 0}]}}})", "/light/path/keyframes/0/position",
+     "missing"},
+    {"unknown_scene_object_key", R"({"scene": {"objects": [{"procedural": "sphere", "radiuss": 1}]}})", "/scene/objects/0/radiuss",
+     "accepted keys"},
+    {"no_scene_objects", R"({"scene": {"objects": []}})", "/scene", "no objects"},
+};
+
+class ConfigErrorTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(ConfigErrorTest, NamesFilePathAndCause) {
+    const BadCase& c = GetParam();
+    Json j = minimal();
+    j.merge_patch(Json::parse(c.patch));
+    try {
+        parseConfig(j, "configs/bad.json");
+        FAIL() << "accepted a bad config";
+    } catch (const InputError& e) {
+        std::string msg = e.what();
+        EXPECT_EQ(msg.rfind("configs/bad.json: at ", 0), 0u) << msg;
+        EXPECT_NE(msg.find(c.path), std::string::npos) << msg;
+        EXPECT_NE(msg.find(c.cause), std::string::npos) << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << "error must be one line: " << msg;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, ConfigErrorTest, ::testing::ValuesIn(kBad), [](const auto& info) { return std::string(info.param.name); });
+
+TEST(ConfigTest, InvalidJsonFileNamesTheFile) {
+    EXPECT_THROW(
+        {
+            try {
+                JsonNode::parseFile(std::string(SHADOWLAB_TEST_DATA) + "/broken.json");
+            } catch (const InputError& e) {
+                EXPECT_NE(std::string(e.what()).find("broken.json"), std::string::npos);
+                EXPECT_NE(std::string(e.what()).find("invalid JSON"), std::string::npos);
+                throw;
+            }
+        },
+        InputError);
+}
+
+} // namespace
+} // namespace shadowlab

@@ -1,0 +1,126 @@
+// End-to-end: the shadowlab binary runs configs headless on OSMesa; outputs are complete and
+// parseable, and each algorithm agrees with the reference within the thresholds of kAccuracy.
+#include "framework/core/JsonNode.h"
+#include "tests/TestSupport.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::string configPath(const std::string& name) { return std::string(SHADOWLAB_SOURCE_DIR) + "/configs/" + name; }
+
+/// Runs `shadowlab run CONFIG --out DIR` once per config for the whole test binary.
+const Json& runOnce(const std::string& config, std::string* dirOut = nullptr) {
+    static std::map<std::string, std::pair<std::string, Json>> cache;
+    auto it = cache.find(config);
+    if (it == cache.end()) {
+        std::string dir = test::makeTempDir("exp") + "/out";
+        std::string out;
+        int rc = test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + configPath(config) + " --no-progress --out " + dir, out);
+        EXPECT_EQ(rc, 0) << out;
+        Json summary = fs::exists(dir + "/summary.json") ? Json::parse(slurp(dir + "/summary.json")) : Json::object();
+        it = cache.emplace(config, std::make_pair(dir, summary)).first;
+    }
+    if (dirOut) *dirOut = it->second.first;
+    return it->second.second;
+}
+
+// Accuracy against the reference, per config × algorithm id, on every frame.
+struct AccuracyCase {
+    const char* config;
+    const char* id;
+    double maxMismatchPerFrame; ///< share of lit pixels
+};
+const AccuracyCase kAccuracy[] = {
+    // The reference compared with itself must agree exactly.
+    {"smoke.json", "reference", 0.0},
+    // Shadow maps are approximate: at 128² and a 1024² cube map, PCF edges and bias at contact
+    // points (fence posts, torus on the ground) flip a few percent of lit pixels.
+    {"smoke.json", "shadow_map", 0.05},
+};
+
+class ExperimentGLTest : public ::testing::TestWithParam<AccuracyCase> {};
+
+TEST_P(ExperimentGLTest, AgreesWithReferenceOnEveryFrame) {
+    const AccuracyCase& c = GetParam();
+    const Json& s = runOnce(c.config);
+    ASSERT_TRUE(s.contains("algorithms")) << "no summary";
+    ASSERT_TRUE(s["algorithms"].contains(c.id));
+    const Json& acc = s["algorithms"][c.id]["accuracy"];
+    ASSERT_TRUE(acc.is_object());
+    ASSERT_EQ(acc["per_frame_mismatch"].size(), s["frames"].get<size_t>());
+    for (size_t f = 0; f < acc["per_frame_mismatch"].size(); ++f)
+        EXPECT_LE(acc["per_frame_mismatch"][f].get<double>(), c.maxMismatchPerFrame) << c.id << " frame " << f;
+    EXPECT_EQ(s["algorithms"][c.id]["overflow"].get<uint64_t>(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, ExperimentGLTest, ::testing::ValuesIn(kAccuracy),
+                         [](const auto& info) { return std::string(info.param.id) + "_" + std::to_string(info.index); });
+
+TEST(ExperimentOutputGLTest, SmokeWritesEveryOutput) {
+    std::string dir;
+    const Json& s = runOnce("smoke.json", &dir);
+    ASSERT_TRUE(s.value("complete", false));
+    for (const char* f : {"config.resolved.json", "frames.csv", "summary.json", "report.md", "plot_frame_time.png",
+                          "plot_accuracy.png", "plot_stages.png"})
+        EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+    EXPECT_FALSE(s["renderer"].get<std::string>().empty());
+    EXPECT_GT(s["triangles"].get<size_t>(), 1000u);
+    // Every registered algorithm appears in the smoke config.
+    std::string list;
+    ASSERT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " list --json", list), 0);
+    for (const auto& a : Json::parse(list)) {
+        bool found = false;
+        for (const auto& [id, v] : s["algorithms"].items()) found |= v["algorithm"] == a["name"];
+        EXPECT_TRUE(found) << a["name"] << " is missing from configs/smoke.json";
+    }
+    // Per-stage times, counters and memory are present and sane.
+    for (const auto& [id, a] : s["algorithms"].items()) {
+        ASSERT_TRUE(a["time_ms"].contains("total")) << id;
+        EXPECT_GT(a["time_ms"]["total"]["mean"].get<double>(), 0.0) << id;
+        EXPECT_GT(a["memory_bytes"].get<size_t>(), 0u) << id;
+    }
+    // Images at the requested frames: shaded, visibility, and a difference image for non-reference entries.
+    EXPECT_TRUE(fs::exists(dir + "/images/shadow_map_f0000_shaded.png"));
+    EXPECT_TRUE(fs::exists(dir + "/images/shadow_map_f0003_diff.png"));
+    EXPECT_TRUE(fs::exists(dir + "/images/reference_f0000_visibility.png"));
+    // frames.csv: header + one row per algorithm × frame × stage, parseable numbers.
+    std::istringstream csv(slurp(dir + "/frames.csv"));
+    std::string header, line;
+    std::getline(csv, header);
+    EXPECT_EQ(header.rfind("id,algorithm,frame,stage,gpu_ms,cpu_ms,mismatch_ratio", 0), 0u);
+    size_t totals = 0;
+    while (std::getline(csv, line))
+        if (line.find(",total,") != std::string::npos) ++totals;
+    EXPECT_EQ(totals, s["algorithms"].size() * s["frames"].get<size_t>());
+    // The resolved config is itself a valid config (every default filled in).
+    Json resolved = Json::parse(slurp(dir + "/config.resolved.json"));
+    EXPECT_EQ(resolved["resolution"], Json::array({128, 128}));
+    EXPECT_TRUE(resolved["algorithms"][0]["params"].contains("pcf"));
+}
+
+TEST(ExperimentOutputGLTest, ExistingOutputIsNeverOverwrittenSilently) {
+    std::string dir = test::makeTempDir("keep") + "/out";
+    fs::create_directories(dir);
+    std::ofstream(dir + "/summary.json") << "{\"earlier\": true}";
+    std::string out;
+    int rc = test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + configPath("smoke.json") + " --no-progress --out " + dir, out);
+    EXPECT_EQ(rc, 2) << out;
+    EXPECT_NE(out.find("--force"), std::string::npos) << out;
+    EXPECT_EQ(slurp(dir + "/summary.json"), "{\"earlier\": true}");
+}
+
+} // namespace
+} // namespace shadowlab

@@ -1,0 +1,30 @@
+#pragma once
+// Shared test helpers: a GL context with a debug callback that fails the test on any GL error,
+// and paths to the real test data.
+#include "framework/gl/GlContext.h"
+
+#include <gtest/gtest.h>
+#include <memory>
+#include <string>
+
+namespace shadowlab::test {
+
+/// Fixture for *GLTest: makes an OSMesa GL 4.5 context (skips the test with a message where none
+/// can be made) and fails the test if the GL debug output reported any error.
+class GLTest : public ::testing::Test {
+protected:
+    void SetUp() override;
+    void TearDown() override;
+    std::unique_ptr<GlContext> context_;
+};
+
+/// Debian's assimp-testmodels glTF folder.
+inline const std::string kAssimpGltf = "/usr/share/assimp/models/glTF2";
+inline const std::string kEngineGlb = kAssimpGltf + "/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+
+/// Runs a shell command, returns its exit code; stdout+stderr go to `output`.
+int runCommand(const std::string& command, std::string& output);
+/// A fresh empty temporary directory for this test.
+std::string makeTempDir(const std::string& tag);
+
+} // namespace shadowlab::test
