@@ -1,5 +1,7 @@
 // The list of algorithms. Adding one is a folder under algorithms/ and one line here.
 #include "algorithms/ShadowAlgorithm.h"
+#include "algorithms/bvh_raytrace/BvhRaytrace.h"
+#include "algorithms/line_space/LineSpace.h"
 #include "algorithms/psv/Psv.h"
 #include "algorithms/reference/Reference.h"
 #include "algorithms/shadow_map/ShadowMap.h"
@@ -13,6 +15,8 @@ const std::vector<AlgorithmInfo>& algorithmRegistry() {
         shadowMapInfo(),
         referenceInfo(),
         psvInfo(),
+        bvhRaytraceInfo(),
+        lineSpaceInfo(),
     };
     return registry;
 }

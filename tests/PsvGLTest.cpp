@@ -27,7 +27,7 @@ glm::mat4 rotate(float deg, glm::vec3 axis) { return glm::rotate(glm::mat4(1.0f)
 
 Scene ground(float size = 10.0f) { return makePlane({size, size}, 4, Material{glm::vec3(0.7f), 1.0f}); }
 
-struct Setup {
+struct Shot {
     Scene scene;
     Camera camera;
     Light light;
@@ -51,8 +51,8 @@ Light pointLight(glm::vec3 p) {
 }
 
 // Three big triangles crossing one another, one of them also piercing the ground they shadow.
-Setup intersectingTriangles() {
-    Setup s;
+Shot intersectingTriangles() {
+    Shot s;
     s.scene = ground();
     Material m{glm::vec3(0.8f, 0.4f, 0.3f), 1.0f};
     s.scene.addTriangles({{-1.2f, 0.4f, -0.6f}, {1.2f, 0.4f, -0.6f}, {0.0f, 1.2f, 0.9f},     // gently sloped
@@ -66,8 +66,8 @@ Setup intersectingTriangles() {
 
 // A sphere shell with six holes around a point light, inside a closed room: light escapes in every
 // direction (floor, ceiling, four walls), so every side of the omni light is exercised.
-Setup omniInsideShell() {
-    Setup s;
+Shot omniInsideShell() {
+    Shot s;
     const glm::vec3 c(0.0f, 1.5f, 0.0f);
     Scene sphere = makeSphere(0.6f, 800, Material{});
     std::vector<glm::vec3> kept;
@@ -94,8 +94,8 @@ Setup omniInsideShell() {
 }
 
 // Closed objects on a plane under an oblique directional light.
-Setup directionalObjects() {
-    Setup s;
+Shot directionalObjects() {
+    Shot s;
     s.scene = ground();
     s.scene.append(makeSphere(0.6f, 600, Material{}), translate({-0.8f, 0.8f, 0}));
     s.scene.append(makeTorus(0.5f, 0.15f, 500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
@@ -108,8 +108,8 @@ Setup directionalObjects() {
 }
 
 // The camera sits under a roof, inside the roof's shadow volume, looking out at the lit ground.
-Setup cameraInsideShadow() {
-    Setup s;
+Shot cameraInsideShadow() {
+    Shot s;
     s.scene = ground();
     s.scene.append(makePlane({3, 3}, 2, Material{}), translate({0, 1.5f, 0}));
     s.scene.append(makeSphere(0.3f, 300, Material{}), translate({0.8f, 0.3f, 0.8f}));
@@ -119,8 +119,8 @@ Setup cameraInsideShadow() {
 }
 
 // A few thousand triangles of closed meshes (the wedge and stack tests).
-Setup thousandsOfTriangles() {
-    Setup s;
+Shot thousandsOfTriangles() {
+    Shot s;
     s.scene = ground();
     s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
     s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
@@ -130,8 +130,8 @@ Setup thousandsOfTriangles() {
 }
 
 // Overlapping semi-transparent spheres and an opaque box-like cylinder (x-ray shadows).
-Setup transparentCasters() {
-    Setup s;
+Shot transparentCasters() {
+    Shot s;
     s.scene = ground();
     s.scene.append(makeSphere(0.5f, 400, Material{glm::vec3(0.2f, 0.5f, 0.9f), 0.5f}), translate({-0.3f, 0.9f, 0}));
     s.scene.append(makeSphere(0.4f, 300, Material{glm::vec3(0.9f, 0.4f, 0.2f), 0.3f}), translate({0.3f, 1.2f, 0.2f}));
@@ -152,14 +152,14 @@ struct Outcome {
     std::map<std::string, double> counters;
     uint64_t overflow = 0;
     size_t memory = 0;
-    double buildMs = 0, traverseMs = 0;
+    StageTime build, traverse; ///< GL timer and CPU clock per stage
     Accuracy accuracy;
     std::vector<psv::NodeGpu> nodes; ///< the TOP tree, read back from the SSBO psv left bound
 };
 
 class PsvGLTest : public test::GLTest {
 protected:
-    Outcome run(const Setup& s, const std::map<std::string, ParamValue>& overrides = {}, bool withReference = true) {
+    Outcome run(const Shot& s, const std::map<std::string, ParamValue>& overrides = {}, bool withReference = true) {
         const AlgorithmInfo info = psvInfo();
         ParamValues params(info.schema());
         for (const auto& [k, v] : overrides) params.set(k, v);
@@ -172,9 +172,15 @@ protected:
         GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
         StageTimer timer;
         CpuGBuffer cpu = gbuffer.readBack();
-        psv->computeVisibility({gbuffer, [&]() -> const CpuGBuffer& { return cpu; }, s.camera, s.light, 0, visibility.id(), timer});
+        const FrameInputs frame{gbuffer, [&]() -> const CpuGBuffer& { return cpu; }, s.camera, s.light, 0, visibility.id(), timer};
+        // A first, untimed frame: llvmpipe compiles shaders at their first dispatch, and rasterises
+        // the G-buffer lazily, so neither belongs in psv's stage times.
+        psv->computeVisibility(frame);
+        glFinish();
+        timer.collect();
+        psv->computeVisibility(frame);
         Outcome o;
-        for (const StageTime& t : timer.collect()) (t.name == "build" ? o.buildMs : o.traverseMs) = t.gpuMs;
+        for (const StageTime& t : timer.collect()) (t.name == "build" ? o.build : o.traverse) = t;
         o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
         for (const Counter& c : psv->counters()) o.counters[c.name] = c.value;
         o.overflow = psv->overflowCount();
@@ -200,14 +206,15 @@ protected:
 
 struct AccuracyCase {
     const char* name;
-    Setup (*make)();
+    Shot (*make)();
     std::map<std::string, ParamValue> params;
     double maxMismatch; ///< share of lit pixels whose binary visibility differs from the reference
     double maxRmse;     ///< root mean square visibility difference over lit pixels
 };
 
-// psv is exact: every row is held to the goal (0.01 % of lit pixels, i.e. not one pixel of
-// the ~5000 lit ones at 96²). Where that is not met, a row says why.
+// psv is exact: every row is held to the goal of 0.01 % of lit pixels (the requirement is 0.1 %),
+// which at 96² (5,000 to 9,000 lit pixels) allows no mismatching pixel at all; llvmpipe meets it
+// on every row. RMSE 1e-2 leaves room for x-ray products rounded differently, none seen so far.
 const AccuracyCase kAccuracy[] = {
     {"intersecting_triangles", intersectingTriangles, {}, 1e-4, 1e-2},
     {"omni_inside_shell", omniInsideShell, {}, 1e-4, 1e-2},
@@ -220,8 +227,7 @@ const AccuracyCase kAccuracy[] = {
     {"scene_order", thousandsOfTriangles, {{"random_order", false}}, 1e-4, 1e-2},
     {"no_depth_skip", thousandsOfTriangles, {{"depth_skip", false}}, 1e-4, 1e-2},
     {"seed_7", thousandsOfTriangles, {{"seed", 7}}, 1e-4, 1e-2},
-    // x-ray: the binary test (≥ 0.5) flips where a product lands on either side of 0.5 by rounding
-    // (0.5 × 1 behind exactly one half-opaque surface): none expected, but RMSE is the real check.
+    // x-ray (opacities 0.5 and 0.3, and an opaque cylinder): RMSE is the real check here.
     {"transparency", transparentCasters, {{"transparency", true}, {"stack_size", 64}}, 1e-4, 1e-2},
 };
 
@@ -230,20 +236,25 @@ class PsvAccuracyGLTest : public PsvGLTest, public ::testing::WithParamInterface
 TEST_P(PsvAccuracyGLTest, MatchesReference) {
     const AccuracyCase& c = GetParam();
     Outcome o = run(c.make(), c.params);
-    std::printf("[psv] %-24s lit %5zu mismatch %.5f%% (false lit %.5f%%) rmse %.5f nodes/px %.1f (max %.0f) build %.2f ms "
-                "traverse %.2f ms\n",
+    std::printf("[psv] %-24s lit %5zu mismatch %.5f%% (false lit %.5f%%) rmse %.5f nodes/px %.1f (max %.0f) build %.2f/%.2f ms "
+                "traverse %.2f/%.2f ms (GL timer/CPU)\n",
                 c.name, o.accuracy.litPixels, 100 * o.accuracy.mismatchRatio, 100 * o.accuracy.falseLit, o.accuracy.rmse,
-                o.counters["nodes_visited_mean"], o.counters["nodes_visited_max"], o.buildMs, o.traverseMs);
+                o.counters["nodes_visited_mean"], o.counters["nodes_visited_max"], o.build.gpuMs, o.build.cpuMs, o.traverse.gpuMs, o.traverse.cpuMs);
     EXPECT_GT(o.accuracy.litPixels, size_t(kRes * kRes / 8)) << "the view should show lit surfaces";
     EXPECT_LE(o.accuracy.mismatchRatio, c.maxMismatch);
     EXPECT_LE(o.accuracy.rmse, c.maxRmse);
     EXPECT_EQ(o.overflow, 0u);
     EXPECT_EQ(o.counters["build_errors"], 0.0);
-    // Both shadowed and lit pixels must exist, or the scene tests nothing.
-    size_t shadowed = 0;
-    for (size_t i = 0; i < o.lit.size(); ++i) shadowed += o.lit[i] && o.reference[i] < 0.5f;
+    // Both shadowed and lit pixels must exist, or the scene tests nothing; x-ray shadows must
+    // also have partly lit pixels (products of 1 - opacity).
+    size_t shadowed = 0, partial = 0;
+    for (size_t i = 0; i < o.lit.size(); ++i) {
+        shadowed += o.lit[i] && o.reference[i] < 0.5f;
+        partial += o.lit[i] && o.reference[i] > 0.01f && o.reference[i] < 0.99f;
+    }
     EXPECT_GT(shadowed, size_t(50));
     EXPECT_LT(shadowed + 50, o.accuracy.litPixels);
+    if (c.params.count("transparency")) EXPECT_GT(partial, size_t(200));
 }
 
 INSTANTIATE_TEST_SUITE_P(Table, PsvAccuracyGLTest, ::testing::ValuesIn(kAccuracy),
@@ -251,20 +262,26 @@ INSTANTIATE_TEST_SUITE_P(Table, PsvAccuracyGLTest, ::testing::ValuesIn(kAccuracy
 
 // ---- Structure, cost and robustness ---------------------------------------------------------------
 
+// The paper's Figure 6 "No opt" comparison, in its configuration: front faces culled (exact here:
+// closed meshes, and a ground plane facing the light, which shadows nothing). Without culling the
+// gain is smaller (about ×4 on this scene): the two faces of a closed mesh straddle each other's
+// shadow planes, so wedges are wider; docs/algorithms/psv.md has the numbers.
 TEST_F(PsvGLTest, WedgeVisitsFiveTimesFewerNodes) {
-    Setup s = thousandsOfTriangles();
-    Outcome on = run(s, {}, false), off = run(s, {{"wedge", false}}, false);
+    Shot s = thousandsOfTriangles();
+    Outcome on = run(s, {{"front_face_culling", true}}), off = run(s, {{"front_face_culling", true}, {"wedge", false}});
     double ratio = off.counters["nodes_visited_mean"] / on.counters["nodes_visited_mean"];
-    std::printf("[psv] %zu triangles: nodes/px wedge on %.1f (max %.0f), off %.1f (max %.0f): x%.1f; "
-                "traverse %.2f vs %.2f ms\n",
+    std::printf("[psv] %zu triangles, culled front faces: nodes/px wedge on %.1f (max %.0f), off %.1f (max %.0f): x%.1f\n",
                 s.scene.triangleCount(), on.counters["nodes_visited_mean"], on.counters["nodes_visited_max"],
-                off.counters["nodes_visited_mean"], off.counters["nodes_visited_max"], ratio, on.traverseMs, off.traverseMs);
+                off.counters["nodes_visited_mean"], off.counters["nodes_visited_max"], ratio);
     EXPECT_GE(ratio, 5.0);
+    // Both are exact: the wedge only prunes subtrees that cannot contain the point.
+    EXPECT_LE(on.accuracy.mismatchRatio, 1e-4);
+    EXPECT_LE(off.accuracy.mismatchRatio, 1e-4);
 }
 
 TEST_F(PsvGLTest, MemoryIs128BytesPerTrianglePlusOne) {
-    for (Setup (*make)() : {intersectingTriangles, thousandsOfTriangles}) {
-        Setup s = make();
+    for (Shot (*make)() : {intersectingTriangles, thousandsOfTriangles}) {
+        Shot s = make();
         Outcome o = run(s, {}, false);
         const size_t n = s.scene.triangleCount();
         EXPECT_EQ(o.memory, 128 * (n + 1)) << n << " triangles";
@@ -291,87 +308,99 @@ TEST_F(PsvGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
 // The tree built by concurrent compare-and-swap, checked against the TOP tree's definition: every
 // caster linked exactly once, every child on the side of its parent's plane that its link says,
 // wedges covering every point of the triangles below them, depth bounds below every triangle.
-TEST_F(PsvGLTest, ConcurrentBuildYieldsAValidTopTree) {
-    for (bool directional : {false, true}) {
-        Setup s = thousandsOfTriangles();
-        if (directional) s.light = directionalObjects().light;
-        Outcome o = run(s, {}, false);
-        const auto& nodes = o.nodes;
-        const size_t n = s.scene.triangleCount();
-        auto vertex = [&](size_t t, int k) { return s.scene.positions[3 * t + k]; };
-        auto eval = [](const psv::NodeGpu& nd, glm::vec3 x) {
-            return nd.plane[0] * x.x + nd.plane[1] * x.y + nd.plane[2] * x.z + nd.plane[3];
-        };
-        auto asFloat = [](uint32_t bits) { float f; std::memcpy(&f, &bits, 4); return f; };
-        const glm::vec3 L = s.light.position, D = s.light.direction();
-        const glm::vec3 depthOrigin = s.scene.bounds.center() - D * (2.0f * s.scene.bounds.radius());
-        auto samples = [&](uint32_t x) { // 45 points over the triangle, vertices included
-            std::vector<glm::vec3> ps;
-            for (int a = 0; a <= 8; ++a)
-                for (int b = 0; a + b <= 8; ++b)
-                    ps.push_back(vertex(x, 0) + (vertex(x, 1) - vertex(x, 0)) * (a / 8.0f) + (vertex(x, 2) - vertex(x, 0)) * (b / 8.0f));
-            return ps;
-        };
-        std::function<void(uint32_t, std::vector<uint32_t>&)> children;
+void expectValidTopTree(const Shot& s, const Outcome& o) {
+    const bool directional = s.light.type == LightType::Directional;
+    const auto& nodes = o.nodes;
+    const size_t n = s.scene.triangleCount();
+    auto vertex = [&](size_t t, int k) { return s.scene.positions[3 * t + k]; };
+    auto eval = [](const psv::NodeGpu& nd, glm::vec3 x) {
+        return nd.plane[0] * x.x + nd.plane[1] * x.y + nd.plane[2] * x.z + nd.plane[3];
+    };
+    auto asFloat = [](uint32_t bits) { float f; std::memcpy(&f, &bits, 4); return f; };
+    const glm::vec3 L = s.light.position, D = s.light.direction();
+    const glm::vec3 depthOrigin = s.scene.bounds.center() - D * (2.0f * s.scene.bounds.radius());
+    auto samples = [&](uint32_t x) { // 45 points over the triangle, vertices included
+        std::vector<glm::vec3> ps;
+        for (int a = 0; a <= 8; ++a)
+            for (int b = 0; a + b <= 8; ++b)
+                ps.push_back(vertex(x, 0) + (vertex(x, 1) - vertex(x, 0)) * (a / 8.0f) + (vertex(x, 2) - vertex(x, 0)) * (b / 8.0f));
+        return ps;
+    };
+    std::function<void(uint32_t, std::vector<uint32_t>&)> children;
+    // Triangles (frustum owners) in the subtree under child link `root`.
+    std::function<void(uint32_t, std::vector<uint32_t>&)> gather = [&](uint32_t root, std::vector<uint32_t>& out) {
+        ASSERT_EQ(root % 4, 1u) << "a link must point at a frustum's first node";
+        out.push_back((root - 1) / 4);
+        for (uint32_t i = 0; i < 4; ++i) children(root + i, out);
+    };
+    // Everything hanging off node `idx` through its stored child fields.
+    children = [&](uint32_t idx, std::vector<uint32_t>& out) {
+        const psv::NodeGpu& nd = nodes[idx];
+        if (nd.pos) gather(nd.pos, out);
+        if (nd.inter) gather(nd.inter, out);
+        if (idx % 4 == 0 && nd.wedgeOrNeg) gather(nd.wedgeOrNeg, out);
+    };
+    std::vector<uint32_t> all;
+    if (nodes[0].pos) gather(nodes[0].pos, all);
+    std::set<uint32_t> unique(all.begin(), all.end());
+    EXPECT_EQ(unique.size(), all.size()) << "a frustum is linked twice";
+    EXPECT_EQ(double(all.size()), o.counters.at("casters_inserted"));
+    EXPECT_EQ(o.counters.at("casters_inserted") + o.counters.at("culled_occluded") + o.counters.at("culled_edge_on") +
+                  o.counters.at("culled_front_facing"), double(n));
+    EXPECT_EQ(o.counters.at("build_errors"), 0.0);
 
-        // Triangles (frustum owners) in the subtree under child link `root`.
-        std::function<void(uint32_t, std::vector<uint32_t>&)> gather = [&](uint32_t root, std::vector<uint32_t>& out) {
-            ASSERT_EQ(root % 4, 1u) << "a link must point at a frustum's first node";
-            out.push_back((root - 1) / 4);
-            for (uint32_t i = 0; i < 4; ++i) children(root + i, out);
-        };
-        // Everything hanging off node `idx` through its stored child fields.
-        children = [&](uint32_t idx, std::vector<uint32_t>& out) {
+    size_t failures = 0; // stop after a few: one bad node would otherwise print thousands of lines
+    auto expect = [&](bool ok, const char* what, uint32_t node, uint32_t x) {
+        if (ok || ++failures > 5) return;
+        ADD_FAILURE() << what << ": node " << node << ", triangle " << x;
+    };
+    for (uint32_t t : all) {
+        for (uint32_t i = 0; i < 4; ++i) {
+            const uint32_t idx = 4 * t + 1 + i;
             const psv::NodeGpu& nd = nodes[idx];
-            if (nd.pos) gather(nd.pos, out);
-            if (nd.inter) gather(nd.inter, out);
-            if (idx % 4 == 0 && nd.wedgeOrNeg) gather(nd.wedgeOrNeg, out);
-        };
-        std::vector<uint32_t> all;
-        if (nodes[0].pos) gather(nodes[0].pos, all);
-        std::set<uint32_t> unique(all.begin(), all.end());
-        EXPECT_EQ(unique.size(), all.size()) << "a frustum is linked twice";
-        EXPECT_EQ(double(all.size()), o.counters["casters_inserted"]);
-        EXPECT_EQ(o.counters["casters_inserted"] + o.counters["culled_occluded"] + o.counters["culled_edge_on"] +
-                      o.counters["culled_front_facing"], double(n));
-
-        for (uint32_t t : all) {
-            for (uint32_t i = 0; i < 4; ++i) {
-                const uint32_t idx = 4 * t + 1 + i;
-                const psv::NodeGpu& nd = nodes[idx];
-                for (int k = 0; k < 3; ++k) EXPECT_LE(eval(nd, vertex(t, k)), 1e-4f) << "own triangle outside its frustum";
-                std::vector<uint32_t> below;
+            for (int k = 0; k < 3; ++k) expect(eval(nd, vertex(t, k)) <= 1e-4f, "own triangle outside its frustum", idx, t);
+            std::vector<uint32_t> below;
+            if (nd.pos) gather(nd.pos, below);
+            for (uint32_t x : below)
+                for (int k = 0; k < 3; ++k) expect(eval(nd, vertex(x, k)) > 0.0f, "positive child crosses its plane", idx, x);
+            below.clear();
+            for (uint32_t j = idx + 1; i < 3 && j <= 4 * t + 4; ++j) children(j, below); // implicit negative child
+            if (i == 3 && nd.wedgeOrNeg) gather(nd.wedgeOrNeg, below);
+            for (uint32_t x : below)
+                for (int k = 0; k < 3; ++k) expect(eval(nd, vertex(x, k)) < 0.0f, "negative child crosses its plane", idx, x);
+            below.clear();
+            if (nd.inter) gather(nd.inter, below);
+            if (i < 3) // the wedge covers every point of the triangles in the intersection child
+                for (uint32_t x : below)
+                    for (glm::vec3 p : samples(x)) {
+                        float sine = directional ? std::abs(eval(nd, p)) : std::abs(eval(nd, p)) / glm::length(p - L);
+                        expect(sine <= asFloat(nd.wedgeOrNeg) + 1e-6f, "wedge misses a triangle", idx, x);
+                    }
+            if (i == 3) { // the depth bound lies below the triangle and everything under the node
                 if (nd.pos) gather(nd.pos, below);
+                below.push_back(t);
                 for (uint32_t x : below)
-                    for (int k = 0; k < 3; ++k) EXPECT_GT(eval(nd, vertex(x, k)), 0.0f) << "positive child crosses its plane";
-                below.clear();
-                for (uint32_t j = idx + 1; i < 3 && j <= 4 * t + 4; ++j) children(j, below); // implicit negative child
-                if (i == 3 && nd.wedgeOrNeg) gather(nd.wedgeOrNeg, below);
-                for (uint32_t x : below)
-                    for (int k = 0; k < 3; ++k) EXPECT_LT(eval(nd, vertex(x, k)), 0.0f) << "negative child crosses its plane";
-                below.clear();
-                if (nd.inter) gather(nd.inter, below);
-                if (i < 3) // the wedge covers every point of the triangles in the intersection child
-                    for (uint32_t x : below)
-                        for (glm::vec3 p : samples(x)) {
-                            float sine = directional ? std::abs(eval(nd, p)) : std::abs(eval(nd, p)) / glm::length(p - L);
-                            EXPECT_LE(sine, asFloat(nd.wedgeOrNeg) + 1e-6f) << "wedge misses triangle " << x;
-                        }
-                if (i == 3) { // the depth bound lies below the triangle and everything under the node
-                    if (nd.pos) gather(nd.pos, below);
-                    below.push_back(t);
-                    for (uint32_t x : below)
-                        for (glm::vec3 p : samples(x)) {
-                            float depth = directional ? glm::dot(p - depthOrigin, D) : glm::length(p - L);
-                            EXPECT_LE(asFloat(nd.minDepth), depth) << "depth bound above triangle " << x;
-                        }
-                }
+                    for (glm::vec3 p : samples(x)) {
+                        float depth = directional ? glm::dot(p - depthOrigin, D) : glm::length(p - L);
+                        expect(asFloat(nd.minDepth) <= depth, "depth bound above a triangle", idx, x);
+                    }
             }
         }
-        std::printf("[psv] %s tree: %zu frusta linked, %.0f occluded dropped, depth %.0f\n",
-                    directional ? "directional" : "point", all.size(), o.counters["culled_occluded"],
-                    o.counters["insert_depth_max"]);
     }
+    std::printf("[psv] %s light: %zu frusta linked, %.0f occluded dropped, insertion depth %.0f\n",
+                directional ? "directional" : "point", all.size(), o.counters.at("culled_occluded"),
+                o.counters.at("insert_depth_max"));
+}
+
+TEST_F(PsvGLTest, ConcurrentBuildYieldsAValidTopTree) {
+    for (bool directional : {false, true}) {
+        Shot s = thousandsOfTriangles();
+        if (directional) s.light = directionalObjects().light;
+        expectValidTopTree(s, run(s, {}, false));
+    }
+    // Transparency keeps the triangles behind capping planes (negative children): checked too.
+    Shot x = transparentCasters();
+    expectValidTopTree(x, run(x, {{"transparency", true}}, false));
 }
 
 // ---- CPU-only pieces --------------------------------------------------------------------------------

@@ -104,12 +104,14 @@ TEST(GltfTest, MissingFileIsAnInputError) {
 }
 
 TEST(GltfTest, NonGltfFilesAreInputErrors) {
+    using namespace std::string_literals;  // keeps the embedded NULs
     std::string dir = test::makeTempDir("gltf-junk");
     const std::pair<const char*, std::string> files[] = {
         {"text.gltf", "hello, not JSON\nsecond line\n"},
         {"array.gltf", "[1, 2, 3]"},
-        {"truncated.glb", std::string("glTF\x02\0\0\0", 8)},
-        {"badchunk.glb", std::string("glTF\x02\0\0\0\x40\0\0\0\xff\0\0\0JSON{}", 24)},
+        {"truncated.glb", "glTF\x02\0\0\0"s},                               // header cut short
+        {"badchunk.glb", "glTF\x02\0\0\0\x40\0\0\0\xff\0\0\0JSON{}"s},  // declares more than it has
+        {"notglb.glb", R"({"asset": {"version": "2.0"}})"},                // JSON behind a .glb name
         {"noasset.gltf", R"({"meshes": []})"},
     };
     for (const auto& [name, bytes] : files) {
@@ -184,7 +186,8 @@ TEST(GltfTest, SharedChildrenAndBadNodeIndicesAreRejected) {
 template <class F> ::testing::AssertionResult pointsOutward(const Scene& s, F centerOf) {
     for (size_t t = 0; t < s.triangleCount(); ++t) {
         glm::vec3 c = (s.positions[3 * t] + s.positions[3 * t + 1] + s.positions[3 * t + 2]) / 3.0f;
-        if (glm::dot(s.normals[t], c - centerOf(c)) <= 0.0f) return ::testing::AssertionFailure() << "triangle " << t << " faces inwards";
+        if (glm::dot(s.normals[t], c - centerOf(c)) <= 0.0f)
+            return ::testing::AssertionFailure() << "triangle " << t << " faces inwards";
     }
     return ::testing::AssertionSuccess();
 }
@@ -352,7 +355,9 @@ TEST(SceneConfigTest, BadInputsAreInputErrorsWithPaths) {
         {R"({"objects": [{"procedural": "plane", "material": {"albedo": [2, 0, 0]}}]})", {"/scene/objects/0/material/albedo"}},
         {R"({"objects": [{"procedural": "plane", "material": {"opacity": -1}}]})", {"/scene/objects/0/material/opacity"}},
         {R"({"objects": [{"procedural": "torus", "minor_radius": 0}]})", {"/scene/objects/0/minor_radius"}},
-        {R"({"objects": [{"procedural": "grid", "object": {"procedural": "plane", "typo": 1}}]})", {"/scene/objects/0/object/typo"}},
+        {R"({"objects": [{"procedural": "torus", "minor_radius": 1}]})", {"/scene/objects/0/minor_radius", "smaller"}},
+        {R"({"objects": [{"procedural": "grid", "object": {"procedural": "plane", "typo": 1}}]})",
+         {"/scene/objects/0/object/typo"}},
         {R"({"objects": [{"procedural": "plane", "gltf": "x.glb"}]})", {"/scene/objects/0", "not both"}},
         {R"({"objects": [{"transform": {}}]})", {"/scene/objects/0", "needs"}},
         {R"({"objects": [{"gltf": "models/nothere.glb"}]})", {"nothere.glb", "/scene/objects/0/gltf"}},

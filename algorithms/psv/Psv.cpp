@@ -57,6 +57,7 @@ public:
         nodes_.clearUint(0);
         counters_.clearUint(0);
         permutation_ = psv::makePermutation(uint32_t(n), uint32_t(params_.getInt("seed")));
+        countersRead_ = false;
     }
 
     void resize(glm::ivec2 resolution) override {
@@ -68,8 +69,7 @@ public:
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         params_ = p;
         if (change != ParamChange::Rebuild) return;
-        compile();
-        if (scene_) setScene(*scene_);
+        compile(); // setScene() follows a Rebuild (ShadowAlgorithm.h) and picks up the new seed
     }
 
     void computeVisibility(const FrameInputs& f) override {

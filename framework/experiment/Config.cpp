@@ -69,23 +69,23 @@ AlgorithmEntry parseEntry(JsonNode node, const std::string& defaultName) {
 
 } // namespace
 
+/// Moves (position, target) along `path` to frame `frame` of `frames`; a missing path keeps them.
+static void followPath(const Path& path, int frame, int frames, glm::vec3& position, glm::vec3& target) {
+    if (path.empty()) return;
+    PathSample s = path.at(path.frameTime(frame, frames));
+    position = s.position;
+    target = s.target;
+}
+
 Camera ExperimentConfig::cameraAt(int frame) const {
     Camera cam = camera;
-    if (!cameraPath.empty()) {
-        PathSample s = cameraPath.at(cameraPath.frameTime(frame, frames));
-        cam.position = s.position;
-        cam.target = s.target;
-    }
+    followPath(cameraPath, frame, frames, cam.position, cam.target);
     return cam;
 }
 
 Light ExperimentConfig::lightAt(int frame) const {
     Light l = light;
-    if (!lightPath.empty()) {
-        PathSample s = lightPath.at(lightPath.frameTime(frame, frames));
-        l.position = s.position;
-        l.target = s.target;
-    }
+    followPath(lightPath, frame, frames, l.position, l.target);
     return l;
 }
 

@@ -70,7 +70,7 @@ static GLuint compileStage(GLenum stage, const std::string& relPath, const Shade
     GLint ok = 0;
     glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
     if (!ok) {
-        char log[8192];
+        char log[8192] = {};
         glGetShaderInfoLog(s, sizeof log, nullptr, log);
         glDeleteShader(s);
         throw RuntimeError("GLSL compile error in " + relPath + ":\n" + log);
@@ -86,7 +86,7 @@ static GLuint link(const std::vector<GLuint>& stages, const std::string& what) {
     GLint ok = 0;
     glGetProgramiv(prog, GL_LINK_STATUS, &ok);
     if (!ok) {
-        char log[8192];
+        char log[8192] = {};
         glGetProgramInfoLog(prog, sizeof log, nullptr, log);
         glDeleteProgram(prog);
         throw RuntimeError("GLSL link error in " + what + ":\n" + log);

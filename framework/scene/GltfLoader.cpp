@@ -4,9 +4,11 @@
 
 #include <tiny_gltf.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -34,7 +36,8 @@ struct Prop {
 };
 using Schema = std::vector<Prop>;
 
-const Schema kAsset{{"version", Kind::String}, {"generator", Kind::String}, {"minVersion", Kind::String}, {"copyright", Kind::String}};
+const Schema kAsset{{"version", Kind::String}, {"generator", Kind::String}, {"minVersion", Kind::String},
+                    {"copyright", Kind::String}};
 const Schema kSceneS{{"nodes", Kind::UintArray}};
 const Schema kNodeS{{"camera", Kind::Uint}, {"skin", Kind::Uint}, {"mesh", Kind::Uint}, {"children", Kind::UintArray},
                     {"matrix", Kind::NumberArray}, {"translation", Kind::NumberArray}, {"rotation", Kind::NumberArray},
@@ -44,7 +47,8 @@ const Schema kPrimitiveS{{"attributes", Kind::UintMap}, {"indices", Kind::Uint},
 const Schema kMeshS{{"primitives", Kind::ObjectArray, &kPrimitiveS}, {"weights", Kind::NumberArray}};
 const Schema kSparseIndicesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint}};
 const Schema kSparseValuesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}};
-const Schema kSparseS{{"count", Kind::Uint}, {"indices", Kind::Object, &kSparseIndicesS}, {"values", Kind::Object, &kSparseValuesS}};
+const Schema kSparseS{{"count", Kind::Uint}, {"indices", Kind::Object, &kSparseIndicesS},
+                      {"values", Kind::Object, &kSparseValuesS}};
 const Schema kAccessorS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint},
                         {"normalized", Kind::Bool}, {"count", Kind::Uint}, {"type", Kind::String},
                         {"max", Kind::NumberArray}, {"min", Kind::NumberArray}, {"sparse", Kind::Object, &kSparseS}};
@@ -93,12 +97,18 @@ std::string shortDump(const Json& v) {
     return s.size() > 60 ? s.substr(0, 57) + "..." : s;
 }
 
-bool isUint(const Json& v) {
-    if (v.is_number_unsigned()) return true;
-    if (v.is_number_integer()) return v.get<int64_t>() >= 0;
-    // 2.0 is an integer in JSON Schema's sense; tinygltf reads it as one too.
-    return v.is_number_float() && v.get<double>() >= 0 && std::floor(v.get<double>()) == v.get<double>() &&
-           v.get<double>() < 9.0e15;
+/// A non-negative integer up to `max` (2.0 counts: it is an integer in JSON Schema's sense).
+bool isUint(const Json& v, double max) {
+    if (!v.is_number()) return false;
+    double d = v.get<double>();
+    return d >= 0 && d <= max && std::floor(d) == d;
+}
+// tinygltf keeps indices and enums in `int`: a larger value would wrap to another, valid-looking
+// index. Only byte offsets, lengths and counts are size_t; they stay below 2^53 (exact in a double).
+bool isIndex(const Json& v) { return isUint(v, 2147483647.0); }
+double uintLimit(const char* key) {
+    std::string k = key;
+    return k == "byteOffset" || k == "byteLength" || k == "count" ? 9007199254740992.0 : 2147483647.0;
 }
 
 class TypeChecker {
@@ -133,15 +143,17 @@ private:
     void checkUintMap(const Json& v, const std::string& path) const {
         expect(v.is_object(), v, path, "an object of accessor indices");
         for (auto it = v.begin(); it != v.end(); ++it)
-            expect(isUint(*it), *it, path + "/" + escapeKey(it.key()), "a non-negative integer");
+            expect(isIndex(*it), *it, path + "/" + escapeKey(it.key()), "an accessor index (integer in [0, 2147483647])");
     }
     void checkValue(const Json& v, const Prop& prop, const std::string& path) const {
         switch (prop.kind) {
         case Kind::String: return expect(v.is_string(), v, path, "a string");
-        case Kind::Uint: return expect(isUint(v), v, path, "a non-negative integer");
+        case Kind::Uint:
+            return expect(isUint(v, uintLimit(prop.key)), v, path,
+                          uintLimit(prop.key) > 2147483647.0 ? "a non-negative integer" : "an integer in [0, 2147483647]");
         case Kind::Number: return expect(v.is_number(), v, path, "a number");
         case Kind::Bool: return expect(v.is_boolean(), v, path, "true or false");
-        case Kind::UintArray: return expectArray(v, path, "an array of non-negative integers", isUint);
+        case Kind::UintArray: return expectArray(v, path, "an array of integers in [0, 2147483647]", isIndex);
         case Kind::NumberArray: return expectArray(v, path, "an array of numbers", [](const Json& e) { return e.is_number(); });
         case Kind::StringArray: return expectArray(v, path, "an array of strings", [](const Json& e) { return e.is_string(); });
         case Kind::Object: return checkObject(v, *prop.schema, path);
@@ -181,15 +193,24 @@ uint32_t readU32(const std::vector<unsigned char>& b, size_t at) {
 /// The JSON chunk of a GLB container, with the header checked so nothing is read past the end.
 std::string glbJson(const std::string& file, const std::vector<unsigned char>& bytes) {
     if (bytes.size() < 20) throw InputError(file, "", "GLB file is truncated (" + std::to_string(bytes.size()) + " bytes)");
-    uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8), chunkLen = readU32(bytes, 12), chunkType = readU32(bytes, 16);
+    uint32_t version = readU32(bytes, 4), length = readU32(bytes, 8), chunkLen = readU32(bytes, 12),
+             chunkType = readU32(bytes, 16);
     if (version != 2) throw InputError(file, "", "unsupported GLB version " + std::to_string(version) + " (need 2)");
-    if (length > bytes.size()) throw InputError(file, "", "GLB header declares " + std::to_string(length) + " bytes, file has " + std::to_string(bytes.size()));
-    if (chunkType != 0x4E4F534Au || uint64_t(chunkLen) + 20 > length) throw InputError(file, "", "GLB file has no valid JSON chunk");
-    return std::string(reinterpret_cast<const char*>(bytes.data() + 20), chunkLen);
+    if (length > bytes.size())
+        throw InputError(file, "",
+                         "GLB header declares " + std::to_string(length) + " bytes, file has " + std::to_string(bytes.size()));
+    if (chunkType != 0x4E4F534Au || uint64_t(chunkLen) + 20 > length)
+        throw InputError(file, "", "GLB file has no valid JSON chunk");
+    std::string json(reinterpret_cast<const char*>(bytes.data() + 20), chunkLen);
+    // The chunk is padded to 4 bytes with spaces; some exporters pad with NULs, which JSON parsers reject.
+    while (!json.empty() && json.back() == '\0') json.pop_back();
+    return json;
 }
 
 // Images are never used (only geometry and base colour factors), so skip decoding them.
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) { return true; }
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+    return true;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Stage 3: validation and geometry extraction.
@@ -207,7 +228,8 @@ private:
     static std::string at(const char* array, size_t i) { return std::string("/") + array + "/" + std::to_string(i); }
     template <class Vec> void checkIndex(int index, const Vec& v, const std::string& path, const char* what) const {
         if (index < 0 || size_t(index) >= v.size())
-            fail(path, std::string(what) + " index " + std::to_string(index) + " is out of range (the file has " + std::to_string(v.size()) + ")");
+            fail(path, std::string(what) + " index " + std::to_string(index) + " is out of range (the file has " +
+                           std::to_string(v.size()) + ")");
     }
     /// offset + stride*(count-1) + elem <= limit, in 128 bits so that huge declared values cannot wrap.
     static bool fits(uint64_t offset, uint64_t stride, uint64_t count, uint64_t elem, uint64_t limit) {
@@ -215,7 +237,8 @@ private:
         return static_cast<unsigned __int128>(offset) + static_cast<unsigned __int128>(stride) * (count - 1) + elem <= limit;
     }
     size_t elementSize(const tinygltf::Accessor& a) const {
-        return size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType))) * size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type)));
+        return size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType))) *
+               size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type)));
     }
 
     void validateStructure();
@@ -231,6 +254,7 @@ private:
     const tinygltf::Model& m_;
     std::vector<int> parent_;
     std::map<int, std::vector<glm::vec3>> positionCache_;
+    size_t skipped_ = 0;  // primitive instances without triangles (points, lines, no POSITION)
 };
 
 void Loader::validateStructure() {
@@ -245,7 +269,8 @@ void Loader::validateStructure() {
         size_t size = m_.buffers[size_t(bv.buffer)].data.size();
         if (!fits(bv.byteOffset, 0, 1, bv.byteLength, size))
             fail(at("bufferViews", i), "byte range [" + std::to_string(bv.byteOffset) + ", +" + std::to_string(bv.byteLength) +
-                                           ") exceeds buffer " + std::to_string(bv.buffer) + " (" + std::to_string(size) + " bytes)");
+                                           ") exceeds buffer " + std::to_string(bv.buffer) + " (" + std::to_string(size) +
+                                           " bytes)");
         if (bv.byteStride != 0 && (bv.byteStride < 4 || bv.byteStride > 252))
             fail(at("bufferViews", i) + "/byteStride", "byteStride " + std::to_string(bv.byteStride) + " is outside [4, 252]");
     }
@@ -260,13 +285,16 @@ void Loader::validateStructure() {
         for (size_t pi = 0; pi < m_.meshes[mi].primitives.size(); ++pi) {
             const auto& p = m_.meshes[mi].primitives[pi];
             std::string path = at("meshes", mi) + "/primitives/" + std::to_string(pi);
-            for (const auto& [name, acc] : p.attributes) checkIndex(acc, m_.accessors, path + "/attributes/" + escapeKey(name), "accessor");
+            for (const auto& [name, acc] : p.attributes)
+                checkIndex(acc, m_.accessors, path + "/attributes/" + escapeKey(name), "accessor");
             if (p.material != -1) checkIndex(p.material, m_.materials, path + "/material", "material");
-            if (p.mode < -1 || p.mode > TINYGLTF_MODE_TRIANGLE_FAN) fail(path + "/mode", "unknown primitive mode " + std::to_string(p.mode));
+            if (p.mode < -1 || p.mode > TINYGLTF_MODE_TRIANGLE_FAN)
+                fail(path + "/mode", "unknown primitive mode " + std::to_string(p.mode));
             if (auto it = p.attributes.find("POSITION"); it != p.attributes.end()) {
                 const auto& a = m_.accessors[size_t(it->second)];
                 if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != TINYGLTF_TYPE_VEC3)
-                    fail(path + "/attributes/POSITION", "POSITION accessor " + std::to_string(it->second) + " must be FLOAT VEC3");
+                    fail(path + "/attributes/POSITION",
+                         "POSITION accessor " + std::to_string(it->second) + " must be FLOAT VEC3");
             }
             if (p.indices != -1) {
                 checkIndex(p.indices, m_.accessors, path + "/indices", "accessor");
@@ -275,7 +303,8 @@ void Loader::validateStructure() {
                                a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
                                a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
                 if (!intType || a.type != TINYGLTF_TYPE_SCALAR)
-                    fail(path + "/indices", "index accessor " + std::to_string(p.indices) + " must be UNSIGNED_BYTE/SHORT/INT SCALAR");
+                    fail(path + "/indices",
+                         "index accessor " + std::to_string(p.indices) + " must be UNSIGNED_BYTE/SHORT/INT SCALAR");
             }
         }
     }
@@ -284,28 +313,34 @@ void Loader::validateStructure() {
 void Loader::validateAccessor(size_t i) {
     const auto& a = m_.accessors[i];
     std::string path = at("accessors", i);
-    if (tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) <= 0 || tinygltf::GetNumComponentsInType(uint32_t(a.type)) <= 0)
+    if (tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) <= 0 ||
+        tinygltf::GetNumComponentsInType(uint32_t(a.type)) <= 0)
         fail(path, "unknown componentType " + std::to_string(a.componentType) + " or type " + std::to_string(a.type));
     size_t elem = elementSize(a);
     if (a.bufferView == -1) {
-        if (a.count > kMaxUnbackedCount) fail(path + "/count", "count " + std::to_string(a.count) + " is too large for an accessor without bufferView");
+        if (a.count > kMaxUnbackedCount)
+            fail(path + "/count", "count " + std::to_string(a.count) + " is too large for an accessor without bufferView");
     } else {
         checkIndex(a.bufferView, m_.bufferViews, path + "/bufferView", "bufferView");
         const auto& bv = m_.bufferViews[size_t(a.bufferView)];
         size_t stride = bv.byteStride ? bv.byteStride : elem;
-        if (stride < elem) fail(path, "bufferView byteStride " + std::to_string(stride) + " is smaller than the element size " + std::to_string(elem));
+        if (stride < elem)
+            fail(path,
+                 "bufferView byteStride " + std::to_string(stride) + " is smaller than the element size " + std::to_string(elem));
         if (!fits(a.byteOffset, stride, a.count, elem, bv.byteLength))
-            fail(path, std::to_string(a.count) + " elements of " + std::to_string(elem) + " bytes (stride " + std::to_string(stride) +
-                           ", offset " + std::to_string(a.byteOffset) + ") exceed bufferView " + std::to_string(a.bufferView) + " (" +
-                           std::to_string(bv.byteLength) + " bytes)");
+            fail(path, std::to_string(a.count) + " elements of " + std::to_string(elem) + " bytes (stride " +
+                           std::to_string(stride) + ", offset " + std::to_string(a.byteOffset) + ") exceed bufferView " +
+                           std::to_string(a.bufferView) + " (" + std::to_string(bv.byteLength) + " bytes)");
     }
     if (!a.sparse.isSparse) return;
     const auto& s = a.sparse;
-    if (s.count < 1 || size_t(s.count) > a.count) fail(path + "/sparse/count", "sparse count " + std::to_string(s.count) + " is outside [1, count]");
+    if (s.count < 1 || size_t(s.count) > a.count)
+        fail(path + "/sparse/count", "sparse count " + std::to_string(s.count) + " is outside [1, count]");
     checkIndex(s.indices.bufferView, m_.bufferViews, path + "/sparse/indices/bufferView", "bufferView");
     checkIndex(s.values.bufferView, m_.bufferViews, path + "/sparse/values/bufferView", "bufferView");
     int isz = tinygltf::GetComponentSizeInBytes(uint32_t(s.indices.componentType));
-    if (s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+    if (s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
         s.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
         fail(path + "/sparse/indices/componentType", "sparse indices must be UNSIGNED_BYTE/SHORT/INT");
     if (s.indices.byteOffset < 0 || !fits(uint64_t(s.indices.byteOffset), uint64_t(isz), uint64_t(s.count), uint64_t(isz),
@@ -322,7 +357,8 @@ void Loader::validateNodes() {
         const auto& n = m_.nodes[i];
         std::string path = at("nodes", i);
         if (n.mesh != -1) checkIndex(n.mesh, m_.meshes, path + "/mesh", "mesh");
-        for (size_t c = 0; c < n.children.size(); ++c) checkIndex(n.children[c], m_.nodes, path + "/children/" + std::to_string(c), "node");
+        for (size_t c = 0; c < n.children.size(); ++c)
+            checkIndex(n.children[c], m_.nodes, path + "/children/" + std::to_string(c), "node");
         auto checkVec = [&](const std::vector<double>& v, size_t n, const char* key) {
             bool ok = v.empty() || v.size() == n;
             for (double d : v) ok = ok && std::isfinite(d);
@@ -393,7 +429,8 @@ std::vector<unsigned char> Loader::gather(int index) const {
             uint32_t target = 0;
             std::memcpy(&target, ib + k * isz, isz);  // little-endian: low bytes first
             if (target >= a.count)
-                fail(at("accessors", size_t(index)) + "/sparse/indices", "sparse index " + std::to_string(target) + " is out of range");
+                fail(at("accessors", size_t(index)) + "/sparse/indices",
+                     "sparse index " + std::to_string(target) + " is out of range");
             std::memcpy(out.data() + target * elem, vb + k * elem, elem);
         }
     }
@@ -431,16 +468,21 @@ glm::mat4 Loader::localMatrix(const tinygltf::Node& n) const {
         return m;
     }
     glm::mat4 t(1.0f), r(1.0f), s(1.0f);
-    if (n.translation.size() == 3) t[3] = glm::vec4(float(n.translation[0]), float(n.translation[1]), float(n.translation[2]), 1.0f);
+    if (n.translation.size() == 3)
+        t[3] = glm::vec4(float(n.translation[0]), float(n.translation[1]), float(n.translation[2]), 1.0f);
     if (n.rotation.size() == 4) {
         // Quaternion (x, y, z, w) to matrix, written out to avoid any doubt about glm's quat argument order.
-        double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] + n.rotation[3] * n.rotation[3]);
-        float x = float(n.rotation[0] / len), y = float(n.rotation[1] / len), z = float(n.rotation[2] / len), w = float(n.rotation[3] / len);
+        double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
+                               n.rotation[3] * n.rotation[3]);
+        float x = float(n.rotation[0] / len), y = float(n.rotation[1] / len), z = float(n.rotation[2] / len),
+              w = float(n.rotation[3] / len);
         r[0] = glm::vec4(1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y), 0);
         r[1] = glm::vec4(2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x), 0);
         r[2] = glm::vec4(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y), 0);
     }
-    if (n.scale.size() == 3) s = glm::mat4(glm::vec4(float(n.scale[0]), 0, 0, 0), glm::vec4(0, float(n.scale[1]), 0, 0), glm::vec4(0, 0, float(n.scale[2]), 0), glm::vec4(0, 0, 0, 1));
+    if (n.scale.size() == 3)
+        s = glm::mat4(glm::vec4(float(n.scale[0]), 0, 0, 0), glm::vec4(0, float(n.scale[1]), 0, 0),
+                      glm::vec4(0, 0, float(n.scale[2]), 0), glm::vec4(0, 0, 0, 1));
     return t * r * s;
 }
 
@@ -450,7 +492,10 @@ size_t Loader::emitPrimitive(Scene& scene, size_t mi, size_t pi, const glm::mat4
     std::string path = at("meshes", mi) + "/primitives/" + std::to_string(pi);
     int mode = p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode;
     auto posIt = p.attributes.find("POSITION");
-    if (mode < TINYGLTF_MODE_TRIANGLES || posIt == p.attributes.end()) return 0;  // points, lines, or nothing to place
+    if (mode < TINYGLTF_MODE_TRIANGLES || posIt == p.attributes.end()) {  // points, lines, or nothing to place
+        ++skipped_;
+        return 0;
+    }
     const std::vector<glm::vec3>& pos = positions(posIt->second);
 
     std::vector<uint32_t> seq;
@@ -507,7 +552,8 @@ Scene Loader::run(GltfStats* stats) {
             checkIndex(nodes[k], m_.nodes, path, "node");
             // Keeps traversal a forest walk: each node is visited (and instanced) once per root.
             if (parent_[size_t(nodes[k])] != -1)
-                fail(path, "node " + std::to_string(nodes[k]) + " is not a root node (its parent is node " + std::to_string(parent_[size_t(nodes[k])]) + ")");
+                fail(path, "node " + std::to_string(nodes[k]) + " is not a root node (its parent is node " +
+                               std::to_string(parent_[size_t(nodes[k])]) + ")");
             roots.push_back(nodes[k]);
         }
     } else {
@@ -536,9 +582,12 @@ Scene Loader::run(GltfStats* stats) {
         }
     }
     if (stats) *stats = counts;
-    if (scene.triangleCount() == 0)
-        fail("", counts.instanceTriangles ? "no triangles (all " + std::to_string(counts.instanceTriangles) + " are degenerate)"
-                                          : std::string("no triangles"));
+    if (scene.triangleCount() == 0) {
+        std::string why = counts.instanceTriangles ? " (all " + std::to_string(counts.instanceTriangles) + " are degenerate)"
+                          : skipped_ ? " (" + std::to_string(skipped_) + " point, line or POSITION-less primitives skipped)"
+                                     : std::string();
+        fail("", "no triangles" + why);
+    }
     return scene;
 }
 
@@ -555,7 +604,8 @@ Scene loadGltf(const std::string& file, GltfStats* stats) {
     bool magic = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     std::string ext = file.size() >= 4 ? file.substr(file.size() - 4) : "";
     for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    bool binary = magic || ext == ".glb";
+    if (ext == ".glb" && !magic) throw InputError(file, "", "not a GLB file (it does not start with \"glTF\")");
+    bool binary = magic;  // a .gltf that is really binary loads too
 
     std::string jsonText = binary ? glbJson(file, bytes) : std::string(bytes.begin(), bytes.end());
     Json doc;

@@ -11,7 +11,7 @@ namespace shadowlab {
 Scene makePlane(glm::vec2 size, int subdivisions, const Material& m);
 /// A UV sphere of `radius` at the origin with about `triangles` triangles.
 Scene makeSphere(float radius, int triangles, const Material& m);
-/// A torus around the Y axis with about `triangles` triangles.
+/// A torus around the Y axis with about `triangles` triangles (a ring torus: minorRadius < majorRadius).
 Scene makeTorus(float majorRadius, float minorRadius, int triangles, const Material& m);
 /// A closed cylinder along Y from y = 0 to `height` with about `triangles` triangles (caps included).
 Scene makeCylinder(float radius, float height, int triangles, const Material& m);

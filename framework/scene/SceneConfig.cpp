@@ -7,7 +7,7 @@
 //   KIND and its keys (lengths in scene units, metres by convention):
 //     plane     size [w, d] = [10, 10] (> 0), subdivisions = 1 (1..4096)      2·subdivisions² triangles
 //     sphere    radius = 1, triangles = 2000                                  UV sphere at the origin
-//     torus     major_radius = 1, minor_radius = 0.3, triangles = 2000        around the Y axis
+//     torus     major_radius = 1, minor_radius = 0.3 (< major), triangles = 2000  around the Y axis
 //     cylinder  radius = 0.5, height = 1, triangles = 500                     along Y from y = 0, capped
 //     fence     posts = 10, spacing = 0.5, height = 1.5, radius = 0.03, rails = 2, triangles_per_cylinder = 64
 //     soup      triangles = 1000, extent [4, 4, 4], triangle_size = 0.2, seed = 1
@@ -129,6 +129,8 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
     }
     if (kind == "torus") {
         float major = positive(node, "major_radius", 1.0), minor = positive(node, "minor_radius", 0.3);
+        // A tube reaching the axis (horn or spindle torus) is not a closed surface any more.
+        if (!(minor < major)) node.fail("minor_radius", "must be smaller than major_radius");
         int n = triangles(2000);
         return [=] { return makeTorus(major, minor, n, m); };
     }
@@ -144,7 +146,8 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         int rails = node.getInt("rails", 2, 0, 1000);
         int perCylinder = node.getInt("triangles_per_cylinder", 64, 1, 1'000'000);
         if (double(posts + rails) * perCylinder > kMaxTriangles)
-            node.fail("triangles_per_cylinder", "(posts + rails) × triangles_per_cylinder exceeds " + std::to_string(kMaxTriangles));
+            node.fail("triangles_per_cylinder",
+                      "(posts + rails) × triangles_per_cylinder exceeds " + std::to_string(kMaxTriangles));
         return [=] { return makeFence(posts, spacing, height, radius, rails, perCylinder, m); };
     }
     if (kind == "soup") {
@@ -165,7 +168,8 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         Scene object = inner();
         double total = double(object.triangleCount()) * count.x * count.y * count.z;
         if (total > kMaxTriangles)
-            node.fail("count", "the grid would have " + std::to_string(size_t(total)) + " triangles (limit " + std::to_string(kMaxTriangles) + ")");
+            node.fail("count", "the grid would have " + std::to_string(size_t(total)) + " triangles (limit " +
+                                   std::to_string(kMaxTriangles) + ")");
         return makeGrid(object, count, spacing);
     };
 }
@@ -175,7 +179,8 @@ Builder parseObject(JsonNode node, int depth) {
     bool isGltf = node.has("gltf"), isProcedural = node.has("procedural");
     if (isGltf && isProcedural) node.failHere("an object takes either \"gltf\" or \"procedural\", not both");
     if (!isGltf && !isProcedural)
-        node.failHere("an object needs \"gltf\" (a file) or \"procedural\" (plane, sphere, torus, cylinder, fence, soup or grid)");
+        node.failHere("an object needs \"gltf\" (a file) or \"procedural\" (plane, sphere, torus, cylinder, fence, "
+                      "soup or grid)");
 
     Builder build;
     std::string kind = isGltf ? "gltf" : node.getEnum("procedural", "", kKinds);
@@ -232,8 +237,14 @@ Scene buildScene(JsonNode sceneNode) {
     Scene scene;
     for (size_t i = 0; i < builders.size(); ++i) {
         Scene s = builders[i]();
-        if (i == 0) scene = std::move(s);
-        else scene.append(s, glm::mat4(1.0f));
+        if (i == 0) {
+            scene = std::move(s);
+            continue;
+        }
+        // Grow geometrically: Scene::append reserves exactly, which is quadratic over many objects.
+        size_t need = 3 * (scene.triangleCount() + s.triangleCount());
+        if (scene.positions.capacity() < need) scene.positions.reserve(std::max(need, 2 * scene.positions.capacity()));
+        scene.append(s, glm::mat4(1.0f));
     }
     scene.updateBounds();
     return scene;

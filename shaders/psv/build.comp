@@ -38,6 +38,9 @@ uint insertTriangle(uint t, out uint tested) {
 #if PSV_DEPTH_SKIP
     uint depthBits = floatBitsToUint(psvTriangleMinDepth(v0, v1, v2));
 #endif
+#if PSV_WEDGE
+    PsvWedgeTriangle wedgeTriangle = psvWedgeTriangle(v0, v1, v2);
+#endif
     uint node = 0u, slot = SLOT_POS; // the sentinel's `pos` holds the root
     while (true) {
         uint child = psvChild(node, slot); // a stale 0 only makes the CAS below fail
@@ -58,7 +61,10 @@ uint insertTriangle(uint t, out uint tested) {
                 if (c == 0) {
 #if PSV_WEDGE
                     // Non-negative floats order like their bit patterns: an integer max suffices.
-                    atomicMax(psvNodes[node].wedgeOrNeg, floatBitsToUint(psvWedge(plane, v0, v1, v2)));
+                    // A stale read only costs an exact wedge computed in vain.
+                    float current = uintBitsToFloat(psvNodes[node].wedgeOrNeg);
+                    if (psvWedgeBound(plane, wedgeTriangle) > current)
+                        atomicMax(psvNodes[node].wedgeOrNeg, floatBitsToUint(psvWedge(plane, wedgeTriangle)));
 #endif
                     slot = SLOT_INTER;
                 } else {
@@ -81,6 +87,9 @@ uint insertTriangle(uint t, out uint tested) {
     return PSV_C_BUILD_ERRORS; // not reached
 }
 
+#if PSV_C_INSERTED != 0 || PSV_C_CULLED_FACING != 1 || PSV_C_CULLED_EDGE_ON != 2 || PSV_C_CULLED_OCCLUDED != 3 || PSV_C_BUILD_ERRORS != 4
+#error "sOutcomes below is indexed by the outcome counters, which must be words 0..4"
+#endif
 shared uint sOutcomes[5]; // PSV_C_INSERTED .. PSV_C_BUILD_ERRORS
 shared uint sTestedMax;
 

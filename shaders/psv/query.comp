@@ -2,6 +2,7 @@
 // PSV query: Algorithm 2 of the paper, one invocation per pixel. It locates the G-buffer point in
 // the TOP tree with an explicit stack and writes its visibility: 1 lit, 0 shadowed, and with
 // PSV_TRANSPARENCY the product of (1 - opacity) of every frustum that contains it.
+#define PSV_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "psv/tree.glsl"

@@ -12,7 +12,12 @@ struct PsvNode {
     uint minDepth;    // capping: float bits of the smallest light depth in its subtree (depth skip)
 };
 
-layout(std430, binding = PSV_NODE_BINDING) coherent buffer PsvNodes { PsvNode psvNodes[]; };
+// The build reads child fields that other invocations are changing (coherent: no stale cached
+// copies; a stale value would only cost a failed compare-and-swap). The query only reads.
+#ifndef PSV_NODE_ACCESS
+#define PSV_NODE_ACCESS coherent
+#endif
+layout(std430, binding = PSV_NODE_BINDING) PSV_NODE_ACCESS buffer PsvNodes { PsvNode psvNodes[]; };
 layout(std430, binding = PSV_COUNTER_BINDING) coherent buffer PsvCounters { uint psvCounters[]; };
 
 uniform uint uTriangleCount;
@@ -79,11 +84,13 @@ bool psvLexLess(vec3 a, vec3 b) {
 vec4 psvShadowPlane(vec3 a, vec3 b, float flip) {
     bool swapped = psvLexLess(b, a);
     vec3 lo = swapped ? b : a, hi = swapped ? a : b;
-    vec3 n = psvDirectional() ? cross(hi - lo, uLightDirection) : cross(hi - lo, lo - uLightPosition);
-    float len = length(n);
+    // `precise`: no contraction into fma at one call site and not at another (this is inlined three
+    // times, and a shared edge can be (v0, v1) in one triangle and (v2, v0) in the other).
+    precise vec3 n = psvDirectional() ? cross(hi - lo, uLightDirection) : cross(hi - lo, lo - uLightPosition);
+    precise float len = length(n);
     if (!(len > 0.0)) return vec4(0.0);
     n /= len;
-    float w = psvDirectional() ? -dot(n, lo) : -dot(n, uLightPosition);
+    precise float w = psvDirectional() ? -dot(n, lo) : -dot(n, uLightPosition);
     vec4 p = vec4(n, w);
     // Negation is exact, so the two triangles of an edge still hold opposite copies of one plane.
     return (swapped ? -flip : flip) > 0.0 ? p : -p;
@@ -98,8 +105,8 @@ PsvFrustum psvFrustum(vec3 v0, vec3 v1, vec3 v2) {
     // Signed distance of the light to the triangle's plane (directional: cosine to the light).
     vec3 toLight = psvDirectional() ? -uLightDirection : uLightPosition - v0;
     float side = dot(n, toLight);
-    // Light (almost) in the triangle's plane: the frustum is empty, and the planes' orientation
-    // would rest on rounding. 1e-6 rad cannot hide a visible shadow.
+    // Light (almost) in the triangle's plane: the frustum is (nearly) empty, a sliver under 1e-6
+    // rad wide, and the planes' orientation would rest on rounding.
     if (!(abs(side) > 1e-6 * length(toLight))) { f.status = PSV_CASTER_EDGE_ON; return f; }
 #if PSV_FRONT_FACE_CULLING
     if (side > 0.0) { f.status = PSV_CASTER_FACING; return f; }
@@ -118,7 +125,12 @@ PsvFrustum psvFrustum(vec3 v0, vec3 v1, vec3 v2) {
 }
 
 // ---- Predicates ----------------------------------------------------------------------------------
-float psvSigned(vec4 plane, vec3 x) { return dot(plane.xyz, x) + plane.w; }
+// `precise`: the query evaluates a shared edge's plane P and its exact negation -P at the same
+// code site, so s(-P) is exactly -s(P), which keeps closed meshes watertight.
+float psvSigned(vec4 plane, vec3 x) {
+    precise float s = dot(plane.xyz, x) + plane.w;
+    return s;
+}
 
 // Where a triangle lies with respect to a plane: 1 strictly positive, -1 strictly negative, 0 it
 // touches or crosses it. The tolerance only ever moves triangles to the intersection child, which
@@ -194,19 +206,48 @@ bool psvInsideCone(vec3 u, vec3 a, vec3 b, vec3 c) {
     return sameSign && dot(u, a + b + c) > 0.0;
 }
 
+// What the wedge computations need of a triangle, computed once per insertion (not per node).
+struct PsvWedgeTriangle {
+    vec3 v0, v1, v2; // world positions (directional light)
+    vec3 a, b, c;    // unit directions from the light to the vertices (point light)
+    float arc;       // bound on the arc from a to any point of the triangle; 2 = unbounded
+};
+
+PsvWedgeTriangle psvWedgeTriangle(vec3 v0, vec3 v1, vec3 v2) {
+    PsvWedgeTriangle t;
+    t.v0 = v0; t.v1 = v1; t.v2 = v2;
+    t.a = normalize(v0 - uLightPosition);
+    t.b = normalize(v1 - uLightPosition);
+    t.c = normalize(v2 - uLightPosition);
+    // Seen from the light, every point u of a small triangle lies within the longer of the arcs
+    // a→b, a→c of vertex a (the distance to a point is convex within a hemisphere around it).
+    // Arcs below 0.5 rad are at most 1.011 times their chords; larger triangles get no bound.
+    float chord = max(length(t.b - t.a), length(t.c - t.a));
+    t.arc = chord < 0.5 ? 1.02 * chord : 2.0;
+    return t;
+}
+
 // The wedge value a triangle needs in a shadow-plane node (see the top of this section), with a
 // margin so rounding only widens it. Directional light: the shadow plane contains the light
 // direction, so the distance to the plane is constant along a shadow ray and the wedge is the
 // largest |distance| of the vertices (exact, the distance being linear over the triangle).
-float psvWedge(vec4 plane, vec3 v0, vec3 v1, vec3 v2) {
+float psvWedge(vec4 plane, PsvWedgeTriangle t) {
     if (psvDirectional())
-        return max(abs(psvSigned(plane, v0)), max(abs(psvSigned(plane, v1)), abs(psvSigned(plane, v2)))) + uTolerance;
+        return max(abs(psvSigned(plane, t.v0)), max(abs(psvSigned(plane, t.v1)), abs(psvSigned(plane, t.v2)))) + uTolerance;
     vec3 n = plane.xyz;
-    vec3 a = normalize(v0 - uLightPosition), b = normalize(v1 - uLightPosition), c = normalize(v2 - uLightPosition);
-    float m = max(abs(dot(n, a)), max(abs(dot(n, b)), abs(dot(n, c))));
-    m = max(m, max(psvArcMax(n, a, b), max(psvArcMax(n, b, c), psvArcMax(n, c, a))));
-    if (psvInsideCone(n, a, b, c) || psvInsideCone(-n, a, b, c)) m = 1.0;
+    float m = max(abs(dot(n, t.a)), max(abs(dot(n, t.b)), abs(dot(n, t.c))));
+    m = max(m, max(psvArcMax(n, t.a, t.b), max(psvArcMax(n, t.b, t.c), psvArcMax(n, t.c, t.a))));
+    if (psvInsideCone(n, t.a, t.b, t.c) || psvInsideCone(-n, t.a, t.b, t.c)) m = 1.0;
     return min(1.0, m * (1.0 + 1e-5) + 1e-6);
+}
+
+// A cheap bound above psvWedge(), so the build computes the exact wedge only where it can raise a
+// node's value: |sin| of the angle to the plane is 1-Lipschitz on the sphere, so
+// |n·u| <= |n·a| + arc(a, u) for every point u of the triangle.
+float psvWedgeBound(vec4 plane, PsvWedgeTriangle t) {
+    if (psvDirectional()) return psvWedge(plane, t); // exact and cheap already
+    float m = max(abs(dot(plane.xyz, t.a)), max(abs(dot(plane.xyz, t.b)), abs(dot(plane.xyz, t.c))));
+    return min(1.0, (m + t.arc) * (1.0 + 1e-5) + 2e-6);
 }
 
 // Whether a query point is inside a node's intersection wedge (same units as psvWedge).

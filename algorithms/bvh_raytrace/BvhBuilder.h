@@ -1,0 +1,32 @@
+#pragma once
+// CPU construction of the BVH that bvh_raytrace traverses on the GPU: binned SAH (Wald 2007) over
+// triangle centroids, flattened into the two-children-per-node layout of BvhGpuLayout.h.
+// GL-free, so the CPU tests can check it directly.
+#include "algorithms/bvh_raytrace/BvhGpuLayout.h"
+#include "framework/scene/Scene.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace shadowlab::bvh {
+
+struct BuildOptions {
+    int maxLeafSize = 4; ///< a leaf holds at most this many triangles (unless they cannot be split)
+    int bins = 32;       ///< SAH bins per axis
+    /// SAH cost of one node traversal relative to one ray–triangle test (Aila & Laine's GPU ratio
+    /// is near 1: a node fetch costs about what a triangle fetch does).
+    float traversalCost = 1.0f;
+};
+
+struct Bvh {
+    std::vector<NodeGpu> nodes;       ///< node 0 is the root
+    std::vector<uint32_t> triIndices; ///< leaf ranges index into this; values are scene triangle ids
+    int depth = 0;                    ///< most inner nodes on a root-to-leaf path (the stack a ray may need)
+    size_t leaves = 0;
+    double sahCost = 0;               ///< SAH cost of the tree (relative to one triangle test per ray)
+};
+
+/// Builds the BVH of every triangle of `scene`. Deterministic for a given scene and options.
+Bvh buildBvh(const Scene& scene, const BuildOptions& options = {});
+
+} // namespace shadowlab::bvh

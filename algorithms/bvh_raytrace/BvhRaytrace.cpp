@@ -1,0 +1,200 @@
+#include "algorithms/bvh_raytrace/BvhRaytrace.h"
+
+#include "algorithms/bvh_raytrace/BvhBuilder.h"
+#include "algorithms/bvh_raytrace/BvhGpuLayout.h"
+#include "framework/core/Error.h"
+#include "framework/render/LightUniforms.h"
+
+#include <array>
+#include <chrono>
+
+namespace shadowlab {
+
+namespace bvh {
+
+size_t maxStorageBlockBytes() {
+    GLint64 v = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
+    return size_t(v);
+}
+
+void checkStorageBlock(const char* what, size_t bytes, size_t limit) {
+    if (bytes <= limit) return;
+    auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20); };
+    throw RuntimeError(std::string("bvh_raytrace: ") + what + " need " + mib(bytes) +
+                       " MiB, more than GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + mib(limit) + " MiB) of this GL context");
+}
+
+} // namespace bvh
+
+namespace {
+
+const ParamSchema& bvhSchema() {
+    static const ParamSchema s = ParamSchema()
+        // A binned-SAH tree over n triangles is rarely deeper than ~2 log2(n) (≈ 45 for 2 M); 64 leaves
+        // headroom, and an overflow is reported, never hidden.
+        .integer("stack_size", 64, 1, 256, "nodes",
+                 "traversal stack; a ray that overflows it counts as blocked and is reported", ParamChange::Rebuild)
+        .integer("leaf_size", 4, 1, 16, "triangles", "most triangles per BVH leaf", ParamChange::Rebuild)
+        // Same key, default and unit as the reference's: the rays are the reference's rays.
+        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
+              "shadow ray origin offset along the surface normal, against self-intersection", ParamChange::Update);
+    return s;
+}
+
+using Clock = std::chrono::steady_clock;
+
+class BvhRaytrace final : public ShadowAlgorithm {
+public:
+    explicit BvhRaytrace(const ParamValues& p) : params_(p) { compile(); }
+
+    void setScene(const SceneGpu& scene) override {
+        scene_ = &scene;
+        nodes_ = GlBuffer(), indices_ = GlBuffer(); // free the old tree before building the new one
+        auto t0 = Clock::now();
+        bvh::BuildOptions opt;
+        opt.maxLeafSize = params_.getInt("leaf_size");
+        bvh::Bvh tree = bvh::buildBvh(scene.cpu(), opt);
+        buildMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        const size_t limit = bvh::maxStorageBlockBytes();
+        bvh::checkStorageBlock("the BVH nodes", tree.nodes.size() * sizeof(bvh::NodeGpu), limit);
+        bvh::checkStorageBlock("the triangle indices", tree.triIndices.size() * sizeof(uint32_t), limit);
+        bvh::checkStorageBlock("the scene positions", scene.positions().size(), limit);
+        nodes_ = GlBuffer::fromVector(tree.nodes, 0);
+        indices_ = GlBuffer::fromVector(tree.triIndices, 0);
+        counters_ = GlBuffer(bvh::kCounterBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+        nodeCount_ = tree.nodes.size();
+        depth_ = tree.depth;
+        leaves_ = tree.leaves;
+        sahCost_ = tree.sahCost;
+        countersRead_ = false;
+        counterValues_.fill(0);
+    }
+
+    void resize(glm::ivec2 resolution) override {
+        resolution_ = resolution;
+        nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+        overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+    }
+
+    void paramsChanged(const ParamValues& p, ParamChange change) override {
+        params_ = p;
+        if (change != ParamChange::Rebuild) return;
+        compile();
+        if (scene_) setScene(*scene_);
+    }
+
+    void computeVisibility(const FrameInputs& f) override {
+        if (!scene_) throw RuntimeError("bvh_raytrace: computeVisibility() before setScene()");
+        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
+        const std::vector<glm::vec3> points = f.light.samplePoints();
+        std::vector<glm::vec4> samples;
+        for (glm::vec3 s : points) samples.emplace_back(s, 1.0f);
+        if (samples.size() > sampleCapacity_) { // grows only: the light's sample count is fixed per run
+            samples_ = GlBuffer(samples.size() * sizeof(glm::vec4), nullptr, GL_DYNAMIC_STORAGE_BIT);
+            sampleCapacity_ = samples.size();
+        }
+        samples_.upload(samples.data(), samples.size() * sizeof(glm::vec4));
+
+        f.timer.begin("trace");
+        counters_.clearUint(0);
+        setLightUniforms(trace_, f.light);
+        const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
+        trace_.set("uRayOffset", float(params_.getFloat("ray_offset")) * radius);
+        trace_.set("uSampleCount", int(samples.size()));
+        scene_->bindStorage();
+        nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_NODE_BINDING);
+        indices_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_INDEX_BINDING);
+        samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
+        counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
+        glBindTextureUnit(0, f.gbuffer.position());
+        glBindTextureUnit(1, f.gbuffer.normal());
+        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(2, overflow_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        trace_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        f.timer.end();
+        countersRead_ = false;
+    }
+
+    std::vector<Counter> counters() const override {
+        const auto& c = readCounters();
+        auto wide = [&](int lo) { return double((uint64_t(c[size_t(lo) + 1]) << 32) | c[size_t(lo)]); };
+        const double rays = wide(BVH_C_RAYS_LO);
+        auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
+        return {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
+                {"nodes_visited_max", double(c[BVH_C_VISITED_MAX])},
+                {"triangles_tested_mean", perRay(wide(BVH_C_TRIS_LO))},
+                {"rays", rays},
+                {"traced_pixels", double(c[BVH_C_PIXELS])},
+                {"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
+                {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
+                {"bvh_nodes", double(nodeCount_)},
+                {"bvh_leaves", double(leaves_)},
+                {"bvh_depth", double(depth_)},
+                {"bvh_sah_cost", sahCost_},
+                {"bvh_build_ms", buildMs_},
+                {"node_bytes", double(nodes_.size())},
+                {"index_bytes", double(indices_.size())},
+                {"geometry_bytes", double(scene_ ? scene_->positions().size() : 0)}};
+    }
+
+    std::vector<DebugView> debugViews() const override {
+        return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
+    }
+
+    /// Nodes + triangle indices + the triangle positions the rays read. The positions are the
+    /// framework's shared scene buffer, counted here because a ray tracer needs them and line_space
+    /// does not: the paper's Table 1 compares sizes on that basis ("the BVH needs the triangle
+    /// information in addition"). Per-pixel debug images and the sample list are not counted.
+    size_t memoryBytes() const override {
+        return nodes_.size() + indices_.size() + (scene_ ? scene_->positions().size() : 0);
+    }
+
+    /// Pixels with a ray whose stack overflowed (written shadowed): 0 means the image is exact.
+    uint64_t overflowCount() const override { return readCounters()[BVH_C_OVERFLOW_PIXELS]; }
+
+private:
+    void compile() {
+        trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp",
+                                        {{"BVH_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}});
+    }
+
+    const std::array<uint32_t, BVH_COUNTER_WORDS>& readCounters() const {
+        if (!countersRead_ && counters_) {
+            counters_.download(counterValues_.data(), bvh::kCounterBytes);
+            countersRead_ = true;
+        }
+        return counterValues_;
+    }
+
+    ParamValues params_;
+    const SceneGpu* scene_ = nullptr;
+    glm::ivec2 resolution_{0, 0};
+    ShaderProgram trace_;
+    GlBuffer nodes_, indices_, samples_, counters_;
+    size_t sampleCapacity_ = 0;
+    GlTexture nodesVisited_, overflow_;
+    size_t nodeCount_ = 0, leaves_ = 0;
+    int depth_ = 0;
+    double sahCost_ = 0, buildMs_ = 0;
+    mutable std::array<uint32_t, BVH_COUNTER_WORDS> counterValues_{};
+    mutable bool countersRead_ = false;
+};
+
+} // namespace
+
+AlgorithmInfo bvhRaytraceInfo() {
+    AlgorithmInfo info;
+    info.name = "bvh_raytrace";
+    info.summary = "GLSL ray tracing of the reference's shadow rays through a binned-SAH BVH built on the CPU";
+    info.lights = {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area};
+    info.exact = true;
+    info.schema = &bvhSchema;
+    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<BvhRaytrace>(p); };
+    return info;
+}
+
+} // namespace shadowlab

@@ -1,0 +1,290 @@
+#include "algorithms/line_space/LineSpace.h"
+
+#include "algorithms/line_space/LineSpaceCache.h"
+#include "algorithms/line_space/NTree.h"
+#include "algorithms/line_space/SampleClassifier.h"
+#include "framework/core/Error.h"
+#include "framework/render/LightUniforms.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <optional>
+
+namespace shadowlab {
+namespace {
+
+const ParamSchema& lineSpaceSchema() {
+    static const ParamSchema s = ParamSchema()
+        // The paper uses N in 4..8 with d = 4 for N ≤ 5 and d = 3 above; (6, 3) is its mid-size set.
+        .integer("n", 6, 2, ls::kMaxN, "children per axis",
+                 "branching factor N of the N-tree: N³ children per subdivided node, 15 N⁴ shaft bits each",
+                 ParamChange::Rebuild)
+        .integer("d", 3, 1, ls::kMaxDepth, "levels",
+                 "depth d of the N-tree: levels 0..d-1 hold line spaces, level d (N^d cells per axis) is implicit",
+                 ParamChange::Rebuild)
+        .boolean("cache", true,
+                 "reuse the N-tree from the disk cache ($XDG_CACHE_HOME or ~/.cache /shadowlab/line_space), "
+                 "keyed by scene content, N and d",
+                 ParamChange::Rebuild)
+        // Off by default: it traces every sample again on the CPU, far slower than the GPU pass.
+        .boolean("classify", false,
+                 "also trace every sample exactly on the CPU (untimed) and report over-/under-occluded shares",
+                 ParamChange::Update)
+        // A GPU's limit is usually 128 MiB to 2 GiB; a smaller cap shows how a big line-space pool is
+        // split (and lets the tests exercise the split on small scenes).
+        .integer("max_block_mib", 0, 0, 1 << 16, "MiB",
+                 "cap on one SSBO (0 = GL_MAX_SHADER_STORAGE_BLOCK_SIZE); the line-space pool may span 4 of them",
+                 ParamChange::Rebuild)
+        // Same key, default and unit as the reference's: the rays are the reference's rays.
+        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
+              "shadow ray origin offset along the surface normal, against self-shadowing", ParamChange::Update);
+    return s;
+}
+
+size_t maxStorageBlockBytes() {
+    GLint64 v = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
+    return size_t(v);
+}
+
+class LineSpace final : public ShadowAlgorithm {
+public:
+    explicit LineSpace(const ParamValues& p) : params_(p) { compile(); }
+
+    void setScene(const SceneGpu& scene) override {
+        scene_ = &scene;
+        tracer_.reset();
+        nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(); // free the old pools first
+        for (GlBuffer& b : bitsBuf_) b = GlBuffer();
+        const int n = params_.getInt("n"), d = params_.getInt("d");
+        const size_t cap = size_t(params_.getInt("max_block_mib")) << 20;
+        const size_t limit = cap > 0 ? std::min(cap, maxStorageBlockBytes()) : maxStorageBlockBytes();
+        tree_ = obtainTree(scene.cpu(), n, d, limit);
+        poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
+                      tree_.bits.size() * sizeof(uint32_t)};
+        // Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
+        // up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a
+        // GPU with a larger limit is caught here.
+        nodesPerChunk_ = ls::nodesPerChunk(n, limit);
+        const size_t words = ls::wordsPerNode(n), chunks = (tree_.nodes.size() + nodesPerChunk_ - 1) / nodesPerChunk_;
+        auto mib = [](size_t b) {
+            char text[32];
+            std::snprintf(text, sizeof text, "%.1f", double(b) / double(1u << 20));
+            return std::string(text);
+        };
+        if (poolBytes_[0] > limit || poolBytes_[1] > limit || chunks > LS_BIT_CHUNKS)
+            throw RuntimeError("line_space: the pools of (N, d) = (" + std::to_string(n) + ", " + std::to_string(d) + ") need " +
+                               mib(poolBytes_[0]) + " + " + mib(poolBytes_[1]) + " + " + mib(poolBytes_[2]) +
+                               " MiB (node, tree, line space); one SSBO may hold " + mib(limit) +
+                               " MiB here (GL_MAX_SHADER_STORAGE_BLOCK_SIZE, or max_block_mib) and the line space may span " +
+                               std::to_string(LS_BIT_CHUNKS));
+        nodesBuf_ = GlBuffer::fromVector(tree_.nodes, 0);
+        treeBuf_ = GlBuffer::fromVector(tree_.tree, 0);
+        for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
+            // Unused chunks get a 4-byte buffer so every binding the shader declares is valid.
+            const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
+            const size_t last = std::min(tree_.bits.size(), (c + 1) * nodesPerChunk_ * words);
+            bitsBuf_[c] = GlBuffer((last - first) * sizeof(uint32_t), last > first ? tree_.bits.data() + first : nullptr, 0);
+        }
+        counters_ = GlBuffer(LS_COUNTER_WORDS * sizeof(uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        // The GPU holds the pools now; the CPU keeps only the node pool (start-node boxes for classify).
+        tree_.tree = {};
+        tree_.bits = {};
+        counterValues_.fill(0);
+        classes_.reset();
+    }
+
+    void resize(glm::ivec2 resolution) override {
+        resolution_ = resolution;
+        nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+    }
+
+    void paramsChanged(const ParamValues& p, ParamChange change) override {
+        params_ = p;
+        if (change != ParamChange::Rebuild) return;
+        compile();
+        if (scene_) setScene(*scene_);
+    }
+
+    void computeVisibility(const FrameInputs& f) override {
+        if (!scene_) throw RuntimeError("line_space: computeVisibility() before setScene()");
+        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
+        const bool classify = params_.getBool("classify");
+        const std::vector<glm::vec3> points = f.light.samplePoints();
+        std::vector<glm::vec4> samples;
+        for (glm::vec3 s : points) samples.emplace_back(s, 1.0f);
+        if (samples.size() * sizeof(glm::vec4) > samples_.size())
+            samples_ = GlBuffer(samples.size() * sizeof(glm::vec4), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        samples_.upload(samples.data(), samples.size() * sizeof(glm::vec4));
+        const size_t classifyBytes = size_t(resolution_.x) * size_t(resolution_.y) * ls::classifyStride(samples.size()) * 4;
+        if (classify && classifyBytes > classifyBuf_.size()) classifyBuf_ = GlBuffer(classifyBytes, nullptr, 0);
+        if (classify && !classifyProgram_)
+            classifyProgram_ = ShaderProgram::compute("line_space/trace.comp", defines(true));
+        const ShaderProgram& p = classify ? classifyProgram_ : trace_;
+
+        f.timer.begin("trace");
+        counters_.clearUint(0);
+        setLightUniforms(p, f.light);
+        p.set("uRayOffset", rayOffset());
+        p.set("uSampleCount", int(samples.size()));
+        p.set("uNodeCount", unsigned(tree_.nodes.size()));
+        p.set("uNodesPerChunk", unsigned(nodesPerChunk_));
+        nodesBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_NODE_BINDING);
+        treeBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_TREE_BINDING);
+        const GLuint bitBindings[LS_BIT_CHUNKS] = {LS_BITS_BINDING, LS_BITS_BINDING_1, LS_BITS_BINDING_2, LS_BITS_BINDING_3};
+        for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) bitsBuf_[c].bindBase(GL_SHADER_STORAGE_BUFFER, bitBindings[c]);
+        samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
+        counters_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_COUNTER_BINDING);
+        if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
+        glBindTextureUnit(0, f.gbuffer.position());
+        glBindTextureUnit(1, f.gbuffer.normal());
+        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        p.dispatch2D(resolution_.x, resolution_.y, 8, 8);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        f.timer.end();
+        countersRead_ = false;
+        classes_.reset();
+        if (classify) { // classified lazily in counters(), outside the timed stages
+            pendingG_ = f.cpuGBuffer();
+            pendingLight_ = f.light;
+        }
+    }
+
+    std::vector<Counter> counters() const override {
+        const auto& c = readCounters();
+        auto wide = [&](int lo) { return double((uint64_t(c[size_t(lo) + 1]) << 32) | c[size_t(lo)]); };
+        const double rays = wide(LS_C_RAYS_LO);
+        auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
+        std::vector<Counter> out = {{"nodes_visited_mean", perRay(wide(LS_C_VISITED_LO))},
+                                    {"nodes_visited_max", double(c[LS_C_VISITED_MAX])},
+                                    {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
+                                    {"cells_stepped_mean", perRay(wide(LS_C_CELLS_LO))},
+                                    {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
+                                    {"rays", rays},
+                                    {"traced_pixels", double(c[LS_C_PIXELS])},
+                                    {"subdivided_nodes", double(tree_.nodes.size())},
+                                    {"build_ms", tree_.buildMs},
+                                    {"cache_hit", cacheHit_ ? 1.0 : 0.0},
+                                    {"node_pool_bytes", double(poolBytes_[0])},
+                                    {"tree_pool_bytes", double(poolBytes_[1])},
+                                    {"line_space_pool_bytes", double(poolBytes_[2])}};
+        for (size_t l = 0; l < tree_.nodesPerLevel.size(); ++l)
+            out.push_back({"nodes_level_" + std::to_string(l), double(tree_.nodesPerLevel[l])});
+        if (params_.getBool("classify") && pendingG_.width > 0) {
+            const ls::SampleClasses& k = classify();
+            const double n = k.samples > 0 ? double(k.samples) : 1.0;
+            out.push_back({"classified_samples", double(k.samples)});
+            out.push_back({"exact_occluded_share", double(k.exactOccluded) / n});
+            out.push_back({"over_occluded_share", double(k.over) / n});
+            out.push_back({"under_occluded_share", double(k.under) / n});
+            out.push_back({"under_occluded_start_node_share", double(k.underInStart) / n});
+            out.push_back({"under_occluded_elsewhere", double(k.underElsewhere)});
+        }
+        return out;
+    }
+
+    std::vector<DebugView> debugViews() const override {
+        return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}};
+    }
+
+    /// The three pools (the paper's Table 1 size): no geometry is held at all. Not counted: the
+    /// sample list, the per-pixel heat map and the classify buffer (debug only).
+    size_t memoryBytes() const override { return poolBytes_[0] + poolBytes_[1] + poolBytes_[2]; }
+
+    /// Traversal stack overflows: one frame per level always suffices, so this is 0 unless the
+    /// pools are corrupt (an overflowing ray is counted occluded, never lit).
+    uint64_t overflowCount() const override { return readCounters()[LS_C_OVERFLOW]; }
+
+private:
+    ShaderDefines defines(bool classify) const {
+        return {{"LS_N", std::to_string(params_.getInt("n"))},
+                {"LS_DEPTH", std::to_string(params_.getInt("d"))},
+                {"LS_CLASSIFY", classify ? "1" : "0"}};
+    }
+
+    void compile() {
+        trace_ = ShaderProgram::compute("line_space/trace.comp", defines(false));
+        classifyProgram_ = ShaderProgram(); // compiled on first use
+    }
+
+    float rayOffset() const {
+        const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
+        return float(params_.getFloat("ray_offset")) * radius;
+    }
+
+    /// The tree from the disk cache when allowed and valid, else built (and cached).
+    ls::NTree obtainTree(const Scene& scene, int n, int d, size_t blockLimit) {
+        cacheHit_ = false;
+        const std::string dir = params_.getBool("cache") ? ls::cacheDirectory() : std::string();
+        std::string path, why;
+        const uint64_t hash = scene.contentHash();
+        if (!dir.empty()) {
+            path = ls::cacheFile(dir, hash, n, d);
+            if (std::optional<ls::NTree> t = ls::loadCache(path, hash, n, d, &why)) {
+                cacheHit_ = true;
+                return std::move(*t);
+            }
+            if (why.rfind("no cache file", 0) != 0)
+                std::fprintf(stderr, "line_space: ignoring cache file %s (%s); rebuilding\n", path.c_str(), why.c_str());
+        }
+        ls::NTree t = ls::buildNTree(scene, n, d, 0, blockLimit);
+        if (!dir.empty() && !ls::saveCache(path, hash, t, &why))
+            std::fprintf(stderr, "line_space: cannot write the cache (%s); continuing without it\n", why.c_str());
+        return t;
+    }
+
+    const ls::SampleClasses& classify() const {
+        if (!classes_) {
+            if (!tracer_) tracer_ = std::make_unique<EmbreeTracer>(scene_->cpu());
+            std::vector<uint32_t> perPixel = classifyBuf_.read<uint32_t>(
+                size_t(pendingG_.width) * size_t(pendingG_.height) * ls::classifyStride(pendingLight_.samplePoints().size()));
+            classes_ = ls::classifySamples(*tracer_, pendingG_, pendingLight_, rayOffset(), tree_.nodes, perPixel);
+        }
+        return *classes_;
+    }
+
+    const std::array<uint32_t, LS_COUNTER_WORDS>& readCounters() const {
+        if (!countersRead_ && counters_) {
+            counters_.download(counterValues_.data(), LS_COUNTER_WORDS * sizeof(uint32_t));
+            countersRead_ = true;
+        }
+        return counterValues_;
+    }
+
+    ParamValues params_;
+    const SceneGpu* scene_ = nullptr;
+    glm::ivec2 resolution_{0, 0};
+    ShaderProgram trace_, classifyProgram_;
+    ls::NTree tree_; ///< node pool and statistics (the tree and line-space pools live on the GPU only)
+    bool cacheHit_ = false;
+    std::array<size_t, 3> poolBytes_{}; ///< node, tree and line-space pools (a GlBuffer rounds empty ones up to 4 bytes)
+    GlBuffer nodesBuf_, treeBuf_, samples_, counters_, classifyBuf_;
+    std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
+    size_t nodesPerChunk_ = 1;
+    GlTexture nodesVisited_;
+    // classify: the frame to classify, the exact tracer (built on first use) and the result.
+    CpuGBuffer pendingG_;
+    Light pendingLight_;
+    mutable std::unique_ptr<EmbreeTracer> tracer_;
+    mutable std::optional<ls::SampleClasses> classes_;
+    mutable std::array<uint32_t, LS_COUNTER_WORDS> counterValues_{};
+    mutable bool countersRead_ = false;
+};
+
+} // namespace
+
+AlgorithmInfo lineSpaceInfo() {
+    AlgorithmInfo info;
+    info.name = "line_space";
+    info.summary = "approximate shadows from precomputed line-space visibility in an N-tree (no triangle tests)";
+    info.lights = {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area};
+    info.exact = false;
+    info.schema = &lineSpaceSchema;
+    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<LineSpace>(p); };
+    return info;
+}
+
+} // namespace shadowlab

@@ -1,0 +1,148 @@
+#include "algorithms/line_space/LineSpaceCache.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+namespace shadowlab::ls {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kMagic[8] = {'S', 'L', 'N', 'T', 'R', 'E', 'E', '\0'};
+
+/// Fixed-size file header, written as raw bytes (the cache is machine-local, like ~/.cache itself).
+struct Header {
+    char magic[8];
+    uint32_t version, n, d, reserved;
+    uint64_t sceneHash;
+    uint64_t nodeCount, treeWords, bitWords;
+    uint64_t nodesPerLevel[kMaxDepth];
+    float margin, pad;
+    double buildMs;
+    uint64_t payloadChecksum;
+    uint64_t headerChecksum; ///< of every byte above
+};
+
+/// FNV-1a over 64-bit words (8× faster than per byte on the ~100 MB pools; the tail per byte).
+uint64_t checksum(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    size_t i = 0;
+    for (; i + 8 <= bytes; i += 8) {
+        uint64_t w;
+        std::memcpy(&w, p + i, 8);
+        h = (h ^ w) * 1099511628211ull;
+    }
+    for (; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+uint64_t payloadChecksum(const NTree& t) {
+    uint64_t h = checksum(t.nodes.data(), t.nodes.size() * sizeof(NodeGpu));
+    h = checksum(t.tree.data(), t.tree.size() * sizeof(uint32_t), h);
+    return checksum(t.bits.data(), t.bits.size() * sizeof(uint32_t), h);
+}
+
+bool fail(std::string* why, const std::string& reason) {
+    if (why) *why = reason;
+    return false;
+}
+
+} // namespace
+
+std::string cacheDirectory() {
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/shadowlab/line_space";
+    if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/shadowlab/line_space";
+    return "";
+}
+
+std::string cacheFile(const std::string& dir, uint64_t sceneHash, int n, int d) {
+    char name[64];
+    std::snprintf(name, sizeof name, "%016llx_n%d_d%d_v%u.bin", (unsigned long long)sceneHash, n, d, kCacheVersion);
+    return dir + "/" + name;
+}
+
+bool saveCache(const std::string& path, uint64_t sceneHash, const NTree& t, std::string* why) {
+    Header h{};
+    std::memcpy(h.magic, kMagic, sizeof kMagic);
+    h.version = kCacheVersion;
+    h.n = uint32_t(t.n), h.d = uint32_t(t.d);
+    h.sceneHash = sceneHash;
+    h.nodeCount = t.nodes.size(), h.treeWords = t.tree.size(), h.bitWords = t.bits.size();
+    for (size_t l = 0; l < t.nodesPerLevel.size() && l < size_t(kMaxDepth); ++l) h.nodesPerLevel[l] = t.nodesPerLevel[l];
+    h.margin = t.margin;
+    h.buildMs = t.buildMs;
+    h.payloadChecksum = payloadChecksum(t);
+    h.headerChecksum = checksum(&h, offsetof(Header, headerChecksum));
+
+    std::error_code ec;
+    fs::create_directories(fs::path(path).parent_path(), ec);
+    // Written beside the target and renamed over it: a reader never sees half a file, and two
+    // processes building the same key at once each replace the file whole.
+    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) return fail(why, "cannot create " + tmp);
+        out.write(reinterpret_cast<const char*>(&h), sizeof h);
+        out.write(reinterpret_cast<const char*>(t.nodes.data()), std::streamsize(t.nodes.size() * sizeof(NodeGpu)));
+        out.write(reinterpret_cast<const char*>(t.tree.data()), std::streamsize(t.tree.size() * sizeof(uint32_t)));
+        out.write(reinterpret_cast<const char*>(t.bits.data()), std::streamsize(t.bits.size() * sizeof(uint32_t)));
+        if (!out) {
+            fs::remove(tmp, ec);
+            return fail(why, "cannot write " + tmp);
+        }
+    }
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        return fail(why, "cannot rename " + tmp + " to " + path);
+    }
+    return true;
+}
+
+std::optional<NTree> loadCache(const std::string& path, uint64_t sceneHash, int n, int d, std::string* why) {
+    auto bad = [why](const std::string& reason) {
+        fail(why, reason);
+        return std::optional<NTree>{};
+    };
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return bad("no cache file " + path);
+    Header h{};
+    if (!in.read(reinterpret_cast<char*>(&h), sizeof h)) return bad("truncated header");
+    if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return bad("not an N-tree cache file");
+    if (h.headerChecksum != checksum(&h, offsetof(Header, headerChecksum))) return bad("header checksum mismatch");
+    if (h.version != kCacheVersion) return bad("cache version " + std::to_string(h.version));
+    if (h.sceneHash != sceneHash || h.n != uint32_t(n) || h.d != uint32_t(d))
+        return bad("the file is for another scene or (N, d)");
+    if (h.bitWords != h.nodeCount * wordsPerNode(n) || h.treeWords % size_t(n * n * n) != 0)
+        return bad("inconsistent pool sizes");
+    const uint64_t expected = sizeof h + h.nodeCount * sizeof(NodeGpu) + (h.treeWords + h.bitWords) * sizeof(uint32_t);
+    std::error_code ec;
+    if (fs::file_size(path, ec) != expected) return bad("file size differs from its header (truncated?)");
+
+    NTree t;
+    t.n = n, t.d = d;
+    t.margin = h.margin;
+    t.buildMs = h.buildMs;
+    t.nodesPerLevel.assign(h.nodesPerLevel, h.nodesPerLevel + d);
+    t.nodes.resize(h.nodeCount);
+    t.tree.resize(h.treeWords);
+    t.bits.resize(h.bitWords);
+    in.read(reinterpret_cast<char*>(t.nodes.data()), std::streamsize(t.nodes.size() * sizeof(NodeGpu)));
+    in.read(reinterpret_cast<char*>(t.tree.data()), std::streamsize(t.tree.size() * sizeof(uint32_t)));
+    in.read(reinterpret_cast<char*>(t.bits.data()), std::streamsize(t.bits.size() * sizeof(uint32_t)));
+    if (!in) return bad("truncated pools");
+    if (payloadChecksum(t) != h.payloadChecksum) return bad("pool checksum mismatch (corrupt file)");
+    // Child references must stay inside the pools: a shader must never read out of bounds.
+    for (const NodeGpu& node : t.nodes)
+        if (node.children != LS_NO_CHILDREN && node.children + uint64_t(n * n * n) > t.tree.size())
+            return bad("children group out of range");
+    for (uint32_t c : t.tree)
+        if (c != LS_EMPTY && c >= t.nodes.size()) return bad("child index out of range");
+    return t;
+}
+
+} // namespace shadowlab::ls

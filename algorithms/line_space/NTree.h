@@ -1,0 +1,85 @@
+#pragma once
+// The N-tree with a line space per subdivided node (Keul et al. 2016, 2017), built on the CPU and
+// held in the paper's three pools, laid out exactly as the GPU reads them
+// (shaders/line_space/layout.glsl). GL-free, so the CPU tests check it directly.
+//
+//   * The root is the scene's bounding box (padded, see NTree::margin). A node of level l < d that
+//     holds geometry is subdivided into N × N × N equal children; level d holds only leaves, which
+//     are never stored: the line space of their parent (level d - 1) summarises them.
+//   * A child holds geometry when a triangle touches it (exact triangle–box test, on the child's
+//     box widened by `margin`).
+//   * Line space of a node: one bit per pair of sub-faces on two different faces, set when the shaft
+//     between them touches a non-empty child (exact shaft–box test against the widened child box).
+//     Set bits are therefore conservative: a segment between the two sub-faces that touches geometry
+//     inside the node always finds its bit set (see Geometry.h).
+#include "algorithms/line_space/Geometry.h"
+#include "framework/scene/Scene.h"
+#include "shaders/line_space/layout.glsl"
+
+#include <cstddef>
+#include <cstdint>
+#include <cstddef>
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+namespace shadowlab::ls {
+
+/// Node pool entry, std430 (LsNode in shaders/line_space/trace.comp).
+struct NodeGpu {
+    float lo[3];
+    uint32_t children; ///< offset of its children group in the tree pool, or LS_NO_CHILDREN
+    float size[3];     ///< world units per axis
+    uint32_t level;    ///< 0 = root
+};
+static_assert(sizeof(NodeGpu) == LS_NODE_BYTES, "LsNode is 32 bytes in std430");
+
+constexpr int kMaxN = 8;     ///< N² sub-faces per face must fit one 64-bit mask in the build
+constexpr int kMaxDepth = 5; ///< d: N^d leaf cells per axis
+
+constexpr size_t wordsPerNode(int n) { return size_t(LS_WORDS_PER_NODE(n)); }
+static_assert(wordsPerNode(4) == 120 && wordsPerNode(8) == 1920, "15 N^4 bits, packed in 32-bit words");
+
+/// Bit of the shaft between sub-face `subA` of face `fa` and `subB` of face `fb` (fa != fb, any order).
+inline uint32_t shaftBit(int n, int fa, int subA, int fb, int subB) {
+    if (fa > fb) std::swap(fa, fb), std::swap(subA, subB);
+    const uint32_t n2 = uint32_t(n * n);
+    return uint32_t(LS_PAIR_INDEX(fa, fb)) * n2 * n2 + uint32_t(subA) * n2 + uint32_t(subB);
+}
+
+struct NTree {
+    int n = 0, d = 0;
+    float margin = 0;             ///< world units: boxes are widened by this in every overlap test
+    std::vector<NodeGpu> nodes;   ///< node pool, breadth first (node 0 is the root, if any geometry)
+    std::vector<uint32_t> tree;   ///< tree pool: N³ entries per children group: node index or LS_EMPTY
+    std::vector<uint32_t> bits;   ///< line-space pool: wordsPerNode(n) words per node
+    std::vector<uint64_t> nodesPerLevel; ///< subdivided nodes per level 0 .. d-1
+    double buildMs = 0;           ///< CPU time of the build (kept when loaded from the disk cache)
+
+    bool bit(size_t node, uint32_t b) const { return (bits[node * wordsPerNode(n) + (b >> 5)] >> (b & 31)) & 1u; }
+    size_t poolBytes() const {
+        return nodes.size() * sizeof(NodeGpu) + tree.size() * sizeof(uint32_t) + bits.size() * sizeof(uint32_t);
+    }
+};
+
+/// Builds the N-tree of `scene` with branching factor n (2..kMaxN) and depth d (1..kMaxDepth), on
+/// `threads` threads (0 = all). Deterministic: the pools do not depend on the thread count.
+/// Throws RuntimeError as soon as the node or tree pool would exceed `maxBlockBytes` (the GPU's
+/// SSBO limit) or the line-space pool LS_BIT_CHUNKS blocks of that size: a level's node count is
+/// known before its line spaces are computed, so an impossible parameter set fails in seconds
+/// instead of after the whole build.
+NTree buildNTree(const Scene& scene, int n, int d, int threads = 0, size_t maxBlockBytes = SIZE_MAX);
+
+/// Nodes per line-space pool chunk for SSBOs of at most `maxBlockBytes`.
+inline size_t nodesPerChunk(int n, size_t maxBlockBytes) {
+    return std::max<size_t>(1, maxBlockBytes / (wordsPerNode(n) * sizeof(uint32_t)));
+}
+
+/// The root box the build uses for `scene` (bounds padded so no axis is flat and geometry on the
+/// bounds lies strictly inside), and the overlap margin; exposed for the tests.
+void rootBox(const Scene& scene, glm::vec3& lo, glm::vec3& size, float& margin);
+
+/// The sub-face box (flat along the face's axis) of face f, sub-face (i, j), of node box lo + [0, size].
+DBox subFaceBox(glm::dvec3 lo, glm::dvec3 size, int n, int f, int i, int j);
+
+} // namespace shadowlab::ls

@@ -1,0 +1,192 @@
+// Level-by-level construction of the N-tree and its line spaces (see NTree.h). Every node of a level
+// is independent, so a level is processed in parallel and then appended in node order: the pools
+// are breadth first and identical for any thread count.
+#include "algorithms/line_space/NTree.h"
+
+#include "algorithms/line_space/ShaftFill.h"
+#include "framework/core/Error.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+
+namespace shadowlab::ls {
+namespace {
+
+/// A node of the level being built, with the triangles that touch it.
+struct Pending {
+    glm::vec3 lo, size;
+    std::vector<uint32_t> tris;
+};
+
+struct NodeResult {
+    std::vector<uint8_t> occupied;              ///< N³, child order (z × N + y) × N + x
+    std::vector<std::vector<uint32_t>> childTris; ///< per child, only above the last level
+    std::vector<uint32_t> words;                ///< the node's line space
+};
+
+/// Child cell coordinate k along an axis: the same float expression the shader's DDA evaluates.
+float cellLo(float lo, float cell, int k) { return lo + float(k) * cell; }
+
+glm::dvec3 toD(glm::vec3 v) { return glm::dvec3(v); }
+
+class Builder {
+public:
+    Builder(const Scene& scene, int n, float margin) : scene_(scene), n_(n), margin_(margin) {}
+
+    /// Which children of `node` the triangles touch (and, if `lists`, which triangles touch each).
+    void occupancy(const Pending& node, bool lists, NodeResult& r) const {
+        const int n = n_, n3 = n * n * n;
+        const glm::vec3 cell = node.size / float(n);
+        r.occupied.assign(size_t(n3), 0);
+        if (lists) r.childTris.assign(size_t(n3), {});
+        const double m = margin_;
+        for (uint32_t t : node.tris) {
+            const glm::dvec3 a = toD(scene_.positions[3 * size_t(t)]), b = toD(scene_.positions[3 * size_t(t) + 1]),
+                             c = toD(scene_.positions[3 * size_t(t) + 2]);
+            glm::ivec3 i0, i1;
+            for (int k = 0; k < 3; ++k) {
+                double lo = std::min({a[k], b[k], c[k]}) - m, hi = std::max({a[k], b[k], c[k]}) + m;
+                i0[k] = std::clamp(int(std::floor((lo - node.lo[k]) / cell[k])), 0, n - 1);
+                i1[k] = std::clamp(int(std::floor((hi - node.lo[k]) / cell[k])), 0, n - 1);
+            }
+            // A triangle whose widened bounding box lies in one cell touches that cell: no test needed.
+            const bool single = i0 == i1;
+            for (int z = i0.z; z <= i1.z; ++z)
+                for (int y = i0.y; y <= i1.y; ++y)
+                    for (int x = i0.x; x <= i1.x; ++x) {
+                        const int ci = (z * n + y) * n + x;
+                        if (!single) {
+                            const glm::vec3 clo(cellLo(node.lo.x, cell.x, x), cellLo(node.lo.y, cell.y, y),
+                                                cellLo(node.lo.z, cell.z, z));
+                            const DBox box{toD(clo) - m, toD(clo + cell) + m};
+                            if (!triangleOverlapsBox(a, b, c, box)) continue;
+                        }
+                        r.occupied[size_t(ci)] = 1;
+                        if (lists) r.childTris[size_t(ci)].push_back(t);
+                    }
+        }
+    }
+
+private:
+    const Scene& scene_;
+    int n_;
+    float margin_;
+};
+
+/// Runs job(i) for i in [0, count) on `threads` threads (dynamic scheduling: node costs vary a lot).
+template <class Job>
+void parallelFor(size_t count, int threads, Job job) {
+    std::atomic<size_t> next{0};
+    auto worker = [&] {
+        for (size_t i = next.fetch_add(1); i < count; i = next.fetch_add(1)) job(i);
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads && size_t(t) < count; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+}
+
+} // namespace
+
+void rootBox(const Scene& scene, glm::vec3& lo, glm::vec3& size, float& margin) {
+    glm::vec3 bmin = scene.bounds.empty() ? glm::vec3(-1.0f) : scene.bounds.min;
+    glm::vec3 bmax = scene.bounds.empty() ? glm::vec3(1.0f) : scene.bounds.max;
+    const float extent = std::max({bmax.x - bmin.x, bmax.y - bmin.y, bmax.z - bmin.z, 1e-6f});
+    // A flat scene (a lone plane) would give zero-thickness cells; 1e-3 of the extent avoids it.
+    for (int k = 0; k < 3; ++k) {
+        const float grow = std::max(0.0f, 1e-3f * extent - (bmax[k] - bmin[k])) * 0.5f;
+        bmin[k] -= grow, bmax[k] += grow;
+    }
+    // The margin covers float rounding of the shader's ray–box and sub-face arithmetic (~1e-6 of
+    // the extent); the padding keeps geometry on the bounds strictly inside the root.
+    margin = 1e-5f * extent;
+    const float pad = 1e-4f * extent;
+    lo = bmin - pad;
+    size = (bmax - bmin) + 2.0f * pad;
+}
+
+DBox subFaceBox(glm::dvec3 lo, glm::dvec3 size, int n, int f, int i, int j) {
+    const int a = f >> 1, u = (a + 1) % 3, v = (a + 2) % 3;
+    DBox b;
+    b.lo[a] = b.hi[a] = lo[a] + double(f & 1) * size[a];
+    const double cu = size[u] / n, cv = size[v] / n;
+    b.lo[u] = lo[u] + i * cu, b.hi[u] = lo[u] + (i + 1) * cu;
+    b.lo[v] = lo[v] + j * cv, b.hi[v] = lo[v] + (j + 1) * cv;
+    return b;
+}
+
+NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockBytes) {
+    const auto t0 = std::chrono::steady_clock::now();
+    NTree t;
+    t.n = n, t.d = d;
+    t.nodesPerLevel.assign(size_t(d), 0);
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    glm::vec3 lo, size;
+    rootBox(scene, lo, size, t.margin);
+    Builder builder(scene, n, t.margin);
+
+    std::vector<Pending> level;
+    if (scene.triangleCount() > 0) {
+        Pending root{lo, size, {}};
+        root.tris.resize(scene.triangleCount());
+        for (uint32_t i = 0; i < uint32_t(root.tris.size()); ++i) root.tris[i] = i;
+        t.nodes.push_back({{lo.x, lo.y, lo.z}, LS_NO_CHILDREN, {size.x, size.y, size.z}, 0});
+        level.push_back(std::move(root));
+    }
+    const size_t words = wordsPerNode(n);
+    const int n3 = n * n * n;
+    auto check = [&](const char* pool, size_t bytes, size_t limit) {
+        if (bytes <= limit) return;
+        auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20); };
+        throw RuntimeError("line_space: the " + std::string(pool) + " pool of (N, d) = (" + std::to_string(n) + ", " +
+                           std::to_string(d) + ") needs at least " + mib(bytes) + " MiB, more than the " + mib(limit) +
+                           " MiB it may take here (GL shader storage blocks); use a smaller N or d");
+    };
+    for (int l = 0; l < d && !level.empty(); ++l) {
+        const size_t base = t.nodes.size() - level.size(); // this level's nodes are the last ones added
+        const size_t perChunk = nodesPerChunk(n, maxBlockBytes);
+        const size_t bitLimit = maxBlockBytes == SIZE_MAX ? SIZE_MAX : perChunk * LS_BIT_CHUNKS * words * sizeof(uint32_t);
+        check("line-space", t.nodes.size() * words * sizeof(uint32_t), bitLimit);
+        check("node", t.nodes.size() * sizeof(NodeGpu), maxBlockBytes);
+        check("tree", (t.tree.size() + (l + 1 < d ? level.size() * size_t(n3) : 0)) * sizeof(uint32_t), maxBlockBytes);
+        const bool last = l == d - 1;
+        t.nodesPerLevel[size_t(l)] = level.size();
+        std::vector<NodeResult> results(level.size());
+        parallelFor(level.size(), threads, [&](size_t i) {
+            builder.occupancy(level[i], !last, results[i]);
+            level[i].tris = {}; // the children's lists replace it
+            results[i].words.assign(words, 0u);
+            fillLineSpace(n, level[i].lo, level[i].size, results[i].occupied, t.margin, results[i].words.data());
+        });
+        t.bits.resize(t.nodes.size() * words);
+        std::vector<Pending> next;
+        for (size_t i = 0; i < level.size(); ++i) {
+            NodeResult& r = results[i];
+            std::copy(r.words.begin(), r.words.end(), t.bits.begin() + std::ptrdiff_t((base + i) * words));
+            if (last) continue; // children are leaves: nothing stored below
+            t.nodes[base + i].children = uint32_t(t.tree.size());
+            const glm::vec3 cell = level[i].size / float(n);
+            for (int c = 0; c < n3; ++c) {
+                if (!r.occupied[size_t(c)]) {
+                    t.tree.push_back(LS_EMPTY);
+                    continue;
+                }
+                const int x = c % n, y = (c / n) % n, z = c / (n * n);
+                const glm::vec3 clo(cellLo(level[i].lo.x, cell.x, x), cellLo(level[i].lo.y, cell.y, y),
+                                    cellLo(level[i].lo.z, cell.z, z));
+                t.tree.push_back(uint32_t(t.nodes.size()));
+                t.nodes.push_back({{clo.x, clo.y, clo.z}, LS_NO_CHILDREN, {cell.x, cell.y, cell.z}, uint32_t(l + 1)});
+                next.push_back({clo, cell, std::move(r.childTris[size_t(c)])});
+            }
+        }
+        level = std::move(next);
+    }
+    t.buildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return t;
+}
+
+} // namespace shadowlab::ls

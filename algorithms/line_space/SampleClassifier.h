@@ -1,0 +1,39 @@
+#pragma once
+// Where line_space's binary answer per shadow sample differs from the scene's: each sample the GPU
+// traced is traced again exactly on the CPU (Embree, the reference's rays) and classified.
+//   over-occluded:  the line space said blocked, the segment is free (a non-empty shaft it passed);
+//   under-occluded: the line space said free, the segment is blocked. The method is conservative
+//                   everywhere except in the node the ray starts in (skipped, paper 4.1), so each
+//                   under-occluded sample is traced once more from where it leaves that node: a hit
+//                   there would be a miss outside the start node, which must never happen.
+// Used by the `classify` parameter (counters, untimed) and the tests.
+#include "algorithms/line_space/NTree.h"
+#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/render/GBuffer.h"
+#include "framework/view/Light.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace shadowlab::ls {
+
+struct SampleClasses {
+    uint64_t samples = 0;        ///< rays classified: lit pixels × light samples
+    uint64_t exactOccluded = 0;  ///< blocked in the scene
+    uint64_t lineSpaceOccluded = 0;
+    uint64_t over = 0;           ///< line space blocked, scene free
+    uint64_t under = 0;          ///< line space free, scene blocked ...
+    uint64_t underInStart = 0;   ///< ... by geometry inside the skipped start node
+    uint64_t underElsewhere = 0; ///< ... by geometry outside it (0 for a conservative line space)
+};
+
+/// Words per pixel of the shader's classify buffer: the start node (LS_EMPTY = none), then one
+/// occlusion bit per sample.
+inline size_t classifyStride(size_t samples) { return 1 + (samples + 31) / 32; }
+
+/// Classifies every sample of every lit pixel of `g`; `perPixel` is the shader's classify buffer,
+/// `nodes` the node pool (for the start nodes' boxes). `threads` = 0 uses every hardware thread.
+SampleClasses classifySamples(const EmbreeTracer& tracer, const CpuGBuffer& g, const Light& light, float rayOffset,
+                              const std::vector<NodeGpu>& nodes, const std::vector<uint32_t>& perPixel, int threads = 0);
+
+} // namespace shadowlab::ls

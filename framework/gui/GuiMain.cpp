@@ -1,0 +1,30 @@
+// shadowlab-gui: the interactive viewer (GLFW window + Dear ImGui) over the same framework as `shadowlab`.
+#include "framework/core/Error.h"
+#include "framework/gui/GuiApp.h"
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+using namespace shadowlab;
+
+int main(int argc, char** argv) {
+    try {
+        GuiOptions opts = parseGuiOptions(std::vector<std::string>(argv + 1, argv + argc));
+        if (opts.help) {
+            std::fputs(kGuiUsage, stdout);
+            return 0;
+        }
+        if (opts.version) {
+            std::puts("shadowlab-gui 0.1");
+            return 0;
+        }
+        return runGui(opts);
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "shadowlab-gui: error: %s\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "shadowlab-gui: failed: %s\n", e.what());
+        return 1;
+    }
+}

@@ -1,0 +1,131 @@
+#include "framework/gui/GuiOptions.h"
+
+#include "framework/core/Error.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace shadowlab {
+
+const char* const kGuiUsage = R"(shadowlab-gui: interactive viewer of the shadow algorithms (GLFW + Dear ImGui).
+
+Usage:
+  shadowlab-gui [CONFIG.json] [options]
+      Opens the config's scene, light, camera path and algorithms (a built-in scene without one).
+
+Automation (tests, docs; each acts through the same code as the widgets):
+  --algorithm ID            start with this config entry id or registered algorithm
+  --set KEY=VALUE           set a parameter of that algorithm (repeatable)
+  --view MODE               shaded | visibility | heat | difference
+  --reference               trace the CPU reference after the first frame (for the difference view)
+  --play                    play the fly-through;  --frame N  start at frame N
+  --frames N                exit after N rendered frames (default: run until the window closes)
+  --screenshot FILE.png     write the whole window after the last frame
+  --record-keyframes "x,y,z,tx,ty,tz;..."   record these camera poses, as the Add keyframe button
+  --record-step S           path seconds between recorded keyframes
+  --save-config FILE.json   save the recorded path and current settings as an experiment config
+  --report FILE.json        log every rendered frame (camera, light, stage times)
+  --size WxH                window size (default 1280x800);  --render-scale S  (0.125-1)
+  --resize WxH              resize the window after the first frame
+
+Exit codes: 0 success, 2 bad input (one line), 1 runtime failure. F1 in the window lists the keys.
+)";
+
+namespace {
+
+InputError usage(const std::string& cause) { return InputError("command line", "", cause + " (see --help)"); }
+
+double number(const std::string& opt, const std::string& text) {
+    char* end = nullptr;
+    double v = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end || !std::isfinite(v)) throw usage(opt + " expects a number, got \"" + text + "\"");
+    return v;
+}
+
+int integer(const std::string& opt, const std::string& text, int minValue) {
+    double v = number(opt, text);
+    if (v != std::floor(v) || v < minValue || v > 1e9)
+        throw usage(opt + " expects an integer >= " + std::to_string(minValue) + ", got \"" + text + "\"");
+    return int(v);
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, sep))
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+
+std::vector<std::pair<glm::vec3, glm::vec3>> parseKeyframes(const std::string& text) {
+    std::vector<std::pair<glm::vec3, glm::vec3>> out;
+    for (const std::string& key : split(text, ';')) {
+        std::vector<std::string> f = split(key, ',');
+        if (f.size() != 6) throw usage("--record-keyframes: \"" + key + "\" needs 6 numbers x,y,z,tx,ty,tz");
+        float v[6];
+        for (int i = 0; i < 6; ++i) v[i] = float(number("--record-keyframes", f[size_t(i)]));
+        glm::vec3 position(v[0], v[1], v[2]), target(v[3], v[4], v[5]);
+        if (position == target) throw usage("--record-keyframes: \"" + key + "\" looks at its own position");
+        out.push_back({position, target});
+    }
+    if (out.empty()) throw usage("--record-keyframes needs at least one keyframe");
+    return out;
+}
+
+glm::ivec2 size(const std::string& opt, const std::string& text) {
+    std::vector<std::string> wh = split(text, 'x');
+    if (wh.size() != 2) throw usage(opt + " expects WxH, got \"" + text + "\"");
+    return {integer(opt, wh[0], 64), integer(opt, wh[1], 64)};
+}
+
+} // namespace
+
+GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
+    GuiOptions o;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&]() -> const std::string& {
+            if (i + 1 >= args.size()) throw usage(a + " needs a value");
+            return args[++i];
+        };
+        if (a == "--help" || a == "-h") o.help = true;
+        else if (a == "--version") o.version = true;
+        else if (a == "--algorithm") o.algorithm = value();
+        else if (a == "--set") {
+            const std::string& kv = value();
+            size_t eq = kv.find('=');
+            if (eq == std::string::npos || eq == 0) throw usage("--set expects KEY=VALUE, got \"" + kv + "\"");
+            o.sets.push_back({kv.substr(0, eq), kv.substr(eq + 1)});
+        } else if (a == "--view") {
+            o.view = value();
+            if (o.view != "shaded" && o.view != "visibility" && o.view != "heat" && o.view != "difference")
+                throw usage("--view expects shaded, visibility, heat or difference, got \"" + o.view + "\"");
+        } else if (a == "--reference") o.reference = true;
+        else if (a == "--play") o.play = true;
+        else if (a == "--frame") o.startFrame = integer(a, value(), 0);
+        else if (a == "--frames") o.frames = integer(a, value(), 1);
+        else if (a == "--screenshot") o.screenshot = value();
+        else if (a == "--record-keyframes") o.recordKeyframes = parseKeyframes(value());
+        else if (a == "--record-step") {
+            o.recordStep = float(number(a, value()));
+            if (!(o.recordStep > 0)) throw usage("--record-step must be positive");
+        } else if (a == "--save-config") o.saveConfig = value();
+        else if (a == "--report") o.report = value();
+        else if (a == "--size") o.windowSize = size(a, value());
+        else if (a == "--resize") o.resizeTo = size(a, value()); else if (a == "--render-scale") {
+            o.renderScale = float(number(a, value()));
+            if (o.renderScale < kRenderScaleMin || o.renderScale > kRenderScaleMax)
+                throw usage("--render-scale must be in [" + std::to_string(kRenderScaleMin) + ", " +
+                            std::to_string(kRenderScaleMax) + "]");
+        } else if (!a.empty() && a[0] == '-') throw usage("unknown option " + a);
+        else if (o.config.empty()) o.config = a;
+        else throw usage("unexpected argument " + a);
+    }
+    if (!o.screenshot.empty() && o.frames == 0) throw usage("--screenshot needs --frames N (it is taken after the last frame)");
+    if (!o.saveConfig.empty() && o.recordKeyframes.empty()) throw usage("--save-config needs --record-keyframes");
+    return o;
+}
+
+} // namespace shadowlab

@@ -1,0 +1,142 @@
+#include "framework/gui/Viewer.h"
+
+#include "framework/core/Error.h"
+
+#include <chrono>
+
+namespace shadowlab {
+
+Viewer::Viewer(ExperimentConfig config, Json source) : config_(std::move(config)), source_(std::move(source)) {
+    camera = config_.camera;
+    light = config_.light;
+    sceneGpu_ = std::make_unique<SceneGpu>(*config_.scene);
+
+    choices_ = algorithmChoices(config_);
+    applyPlayback();
+    instantiate();
+}
+
+Viewer::~Viewer() = default;
+
+void Viewer::setCameraPath(Path path) {
+    config_.cameraPath = std::move(path);
+    playback.frame = 0;
+    applyPlayback();
+}
+
+std::vector<AlgorithmChoice> algorithmChoices(const ExperimentConfig& config) {
+    std::vector<AlgorithmChoice> choices;
+    // Config entries keep their ids and tuned params; the reference is listed like any entry.
+    for (const AlgorithmEntry& e : config.algorithms) choices.push_back({e.id, true, e.info, e.params});
+    if (config.reference)
+        choices.push_back({config.referenceEntry.id, true, config.referenceEntry.info, config.referenceEntry.params});
+    for (const AlgorithmInfo& a : algorithmRegistry()) choices.push_back({a.name, false, &a, ParamValues(a.schema())});
+    return choices;
+}
+
+int findChoice(const std::vector<AlgorithmChoice>& choices, const std::string& idOrName) {
+    for (bool fromConfig : {true, false})
+        for (size_t i = 0; i < choices.size(); ++i)
+            if (choices[i].fromConfig == fromConfig && choices[i].label == idOrName) return int(i);
+    return -1;
+}
+
+void Viewer::selectAlgorithm(int index) {
+    if (index < 0 || size_t(index) >= choices_.size()) throw InputError("", "", "no algorithm choice " + std::to_string(index));
+    if (index == active_ && algorithm_) return;
+    active_ = index;
+    instantiate();
+}
+
+std::string Viewer::unsupportedReason() const {
+    const AlgorithmInfo& info = *active().info;
+    if (info.supports(light.type)) return "";
+    return info.name + " does not support " + std::string(toString(light.type)) + " lights";
+}
+
+void Viewer::instantiate() {
+    const AlgorithmChoice& c = active();
+    // Drop the old instance first: two sets of shadow maps or trees need not fit at once.
+    algorithm_.reset();
+    algorithm_ = c.info->create(c.params);
+    algorithm_->setScene(*sceneGpu_);
+    if (resolution_.x > 0) algorithm_->resize(resolution_);
+}
+
+void Viewer::applyPlayback() {
+    if (playback.followCamera && !config_.cameraPath.empty()) {
+        Camera c = config_.cameraAt(playback.frame);
+        camera.position = c.position;
+        camera.target = c.target;
+    }
+    if (playback.followLight && !config_.lightPath.empty()) {
+        Light l = config_.lightAt(playback.frame);
+        light.position = l.position;
+        light.target = l.target;
+    }
+}
+
+void Viewer::stepPlayback() {
+    if (!playback.playing) return;
+    if (playback.frame + 1 < config_.frames) ++playback.frame;
+    else if (playback.loop) playback.frame = 0;
+    else playback.playing = false;
+}
+
+void Viewer::setResolution(glm::ivec2 res) {
+    if (res == resolution_ || res.x <= 0 || res.y <= 0) return;
+    resolution_ = res;
+    gbuffer_ = std::make_unique<GBuffer>(res);
+    shading_ = std::make_unique<ShadingPass>(res);
+    visibility_ = makeTexture2D(GL_R32F, res.x, res.y);
+    cpuG_.reset();
+    if (algorithm_) algorithm_->resize(res);
+}
+
+const CpuGBuffer& Viewer::cpuGBuffer() {
+    if (!cpuG_) cpuG_ = gbuffer_->readBack();
+    return *cpuG_;
+}
+
+void Viewer::runOn(ShadowAlgorithm& algorithm, GLuint visibility, StageTimer& timer) {
+    auto getCpuG = [this]() -> const CpuGBuffer& { return cpuGBuffer(); };
+    algorithm.computeVisibility({*gbuffer_, getCpuG, camera, light, playback.frame, visibility, timer});
+}
+
+void Viewer::renderFrame() {
+    if (resolution_.x <= 0) return;
+    gbuffer_->render(*sceneGpu_, camera);
+    cpuG_.reset();
+    lastStages_.clear();
+    if (unsupportedReason().empty()) {
+        // Same bracketing as the runner: glFinish on both sides so the wall time is the algorithm's.
+        glFinish();
+        auto t = std::chrono::steady_clock::now();
+        runOn(*algorithm_, visibility_.id(), timer_);
+        glFinish();
+        lastWallMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+        lastStages_ = timer_.collect();
+    } else {
+        // Shown unshadowed rather than with stale visibility; the panel says why.
+        const float one = 1.0f;
+        glClearTexImage(visibility_.id(), 0, GL_RED, GL_FLOAT, &one);
+        lastWallMs_ = 0;
+    }
+    shading_->run(*gbuffer_, visibility_.id(), light);
+    ++renderedFrames_;
+}
+
+void applyParamChange(Viewer& viewer, const std::string& key, const ParamValue& value) {
+    AlgorithmChoice& choice = viewer.choices_[size_t(viewer.active_)];
+    const ParamSpec* spec = choice.info->schema().find(key);
+    ParamValues next = choice.params;
+    next.set(key, value); // throws InputError on an unknown key or an invalid value; nothing changed yet
+    choice.params = next;
+    viewer.algorithm_->paramsChanged(choice.params, spec->change);
+    if (spec->change == ParamChange::Rebuild) {
+        viewer.algorithm_->setScene(*viewer.sceneGpu_);
+        if (viewer.resolution_.x > 0) viewer.algorithm_->resize(viewer.resolution_);
+    }
+}
+
+} // namespace shadowlab

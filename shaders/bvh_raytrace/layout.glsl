@@ -1,0 +1,34 @@
+// bvh_raytrace GPU layout constants, shared by GLSL (#include "bvh_raytrace/layout.glsl") and C++
+// (algorithms/bvh_raytrace/BvhGpuLayout.h includes this very file). #defines and comments only,
+// so it is valid in both languages and the numbers exist once.
+
+// SSBO binding points (0..2 are the scene buffers of shaders/common/scene.glsl: the triangles are
+// read from there, so the BVH adds only nodes and a triangle permutation).
+#define BVH_NODE_BINDING 3
+#define BVH_INDEX_BINDING 4
+#define BVH_SAMPLE_BINDING 5
+#define BVH_COUNTER_BINDING 6
+
+// A node stores the bounds of both children (Aila & Laine 2009), so one 64-byte fetch decides
+// which children a ray enters. countK > 0: child K is a leaf of countK triangles starting at
+// index childK of the index buffer; countK == 0: child K is inner node childK. An absent child
+// (a tree of fewer than two leaves) has an inverted box that no ray enters.
+#define BVH_NODE_BYTES 64
+
+// Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words (the shader
+// carries into HI when LO wraps).
+#define BVH_COUNTER_WORDS 12
+#define BVH_C_RAYS_LO 0           // shadow rays traced (lit pixels × samples)
+#define BVH_C_RAYS_HI 1
+#define BVH_C_VISITED_LO 2        // inner nodes fetched, summed over rays
+#define BVH_C_VISITED_HI 3
+#define BVH_C_VISITED_MAX 4       // most nodes one ray fetched
+#define BVH_C_TRIS_LO 5           // ray–triangle tests, summed over rays
+#define BVH_C_TRIS_HI 6
+#define BVH_C_OVERFLOW_RAYS 7     // rays whose traversal stack overflowed (counted as blocked)
+#define BVH_C_OVERFLOW_PIXELS 8   // pixels with at least one such ray (written shadowed)
+#define BVH_C_PIXELS 9            // pixels that traced rays (covered, facing and reached by the light)
+// Words 10..11 are reserved.
+
+// Child reference of an absent child (only the root of a tree of fewer than two leaves has one).
+#define BVH_ABSENT 0xFFFFFFFFu

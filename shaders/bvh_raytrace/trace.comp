@@ -1,0 +1,209 @@
+#version 450
+// bvh_raytrace: one invocation per pixel traces the reference's shadow rays (EmbreeTracer.h: origin
+// p + n * offset, unit direction to each light sample, tfar = distance - offset) through a BVH built
+// on the CPU, with a fixed stack and any-hit early exit. Visibility = fraction of unblocked samples.
+#include "common/light.glsl"
+#include "common/scene.glsl"
+#include "bvh_raytrace/layout.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+
+struct BvhNode { // 64 bytes, mirrored by bvh::NodeGpu (algorithms/bvh_raytrace/BvhGpuLayout.h)
+    vec3 lo0; uint child0;
+    vec3 hi0; uint child1;
+    vec3 lo1; uint count0;
+    vec3 hi1; uint count1;
+};
+layout(std430, binding = BVH_NODE_BINDING) readonly buffer BvhNodes { BvhNode bvhNodes[]; };
+layout(std430, binding = BVH_INDEX_BINDING) readonly buffer BvhIndices { uint bvhIndices[]; };
+layout(std430, binding = BVH_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
+layout(std430, binding = BVH_COUNTER_BINDING) buffer BvhCounters { uint bvhCounters[]; };
+
+layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
+layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
+layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
+layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map: nodes per pixel
+layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where a ray's stack overflowed
+uniform float uRayOffset; // world units, the reference's
+uniform int uSampleCount; // entries of lightSamples (1 for point and spot lights)
+
+const float kInf = uintBitsToFloat(0x7F800000u);
+
+struct Ray {
+    vec3 o, d, invD;
+    float tfar;
+    int kx, ky, kz; // watertight test: kz = dominant axis of d
+    vec3 shear;
+};
+
+Ray makeRay(vec3 o, vec3 d, float tfar) {
+    Ray r;
+    r.o = o, r.d = d, r.tfar = tfar;
+    // A zero component would give 0 * inf = NaN in the slab test; 1e-30 keeps the slab infinite.
+    vec3 safe = mix(d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(d, vec3(0.0))), lessThan(abs(d), vec3(1e-30)));
+    r.invD = 1.0 / safe;
+    vec3 a = abs(d);
+    r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+    r.kx = (r.kz + 1) % 3;
+    r.ky = (r.kx + 1) % 3;
+    if (d[r.kz] < 0.0) { int t = r.kx; r.kx = r.ky; r.ky = t; } // keep the winding
+    r.shear = vec3(d[r.kx] / d[r.kz], d[r.ky] / d[r.kz], 1.0 / d[r.kz]);
+    return r;
+}
+
+// Woop, Benthin & Wald 2013: watertight, like Embree's robust mode the reference uses, so a ray
+// through a shared edge hits one of the two triangles and never slips between them.
+bool hitTriangle(Ray r, uint tri) {
+    vec3 A = sceneVertex(tri, 0u) - r.o, B = sceneVertex(tri, 1u) - r.o, C = sceneVertex(tri, 2u) - r.o;
+    float Ax = A[r.kx] - r.shear.x * A[r.kz], Ay = A[r.ky] - r.shear.y * A[r.kz];
+    float Bx = B[r.kx] - r.shear.x * B[r.kz], By = B[r.ky] - r.shear.y * B[r.kz];
+    float Cx = C[r.kx] - r.shear.x * C[r.kz], Cy = C[r.ky] - r.shear.y * C[r.kz];
+    float U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
+    if (U == 0.0 || V == 0.0 || W == 0.0) { // on an edge in float: decide it in double
+        U = float(double(Cx) * double(By) - double(Cy) * double(Bx));
+        V = float(double(Ax) * double(Cy) - double(Ay) * double(Cx));
+        W = float(double(Bx) * double(Ay) - double(By) * double(Ax));
+    }
+    if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
+    float det = U + V + W;
+    if (det == 0.0) return false;
+    float T = U * (r.shear.z * A[r.kz]) + V * (r.shear.z * B[r.kz]) + W * (r.shear.z * C[r.kz]);
+    // t = T / det must lie in (0, tfar]
+    return det > 0.0 ? (T > 0.0 && T <= r.tfar * det) : (T < 0.0 && T >= r.tfar * det);
+}
+
+// Slab test on [0, tfar]; tnear is where the ray enters (for near-first ordering). The far end
+// is widened by a few ulps (Ize 2013) so rounding never drops a box the ray grazes.
+bool hitBox(vec3 lo, vec3 hi, Ray r, out float tnear) {
+    vec3 t0 = (lo - r.o) * r.invD, t1 = (hi - r.o) * r.invD;
+    vec3 tmin = min(t0, t1), tmax = max(t0, t1);
+    tnear = max(max(tmin.x, tmin.y), max(tmin.z, 0.0));
+    float tfar = min(min(tmax.x, tmax.y), min(tmax.z, r.tfar)) * 1.0000004;
+    return tnear <= tfar;
+}
+
+struct Trace {
+    bool occluded, overflow;
+    uint visited, tested;
+};
+
+bool hitLeaf(Ray r, uint first, uint count, inout uint tested) {
+    for (uint i = 0u; i < count; ++i) {
+        ++tested;
+        if (hitTriangle(r, bvhIndices[first + i])) return true;
+    }
+    return false;
+}
+
+Trace trace(Ray r) {
+    Trace res = Trace(false, false, 0u, 0u);
+    uint stack[BVH_STACK_SIZE];
+    int sp = 0;
+    uint node = 0u;
+    while (true) {
+        ++res.visited;
+        BvhNode n = bvhNodes[node];
+        float tn0, tn1;
+        bool h0 = n.child0 != BVH_ABSENT && hitBox(n.lo0, n.hi0, r, tn0);
+        bool h1 = n.child1 != BVH_ABSENT && hitBox(n.lo1, n.hi1, r, tn1);
+        // Any hit ends the ray: leaves are tested as soon as their box is entered.
+        if (h0 && n.count0 > 0u) {
+            if (hitLeaf(r, n.child0, n.count0, res.tested)) { res.occluded = true; break; }
+            h0 = false;
+        }
+        if (h1 && n.count1 > 0u) {
+            if (hitLeaf(r, n.child1, n.count1, res.tested)) { res.occluded = true; break; }
+            h1 = false;
+        }
+        if (h0 && h1) {
+            bool first0 = tn0 <= tn1;
+            // A full stack would drop a subtree that may hold the occluder: stop and report.
+            if (sp == BVH_STACK_SIZE) { res.overflow = true; break; }
+            stack[sp++] = first0 ? n.child1 : n.child0;
+            node = first0 ? n.child0 : n.child1;
+        } else if (h0) {
+            node = n.child0;
+        } else if (h1) {
+            node = n.child1;
+        } else {
+            if (sp == 0) break;
+            node = stack[--sp];
+        }
+    }
+    return res;
+}
+
+bool illuminated(vec3 p) {
+    if (uLightType == LIGHT_SPOT) return dot(normalize(p - uLightPosition), uLightDirection) > uLightCosCone;
+    if (uLightType == LIGHT_AREA) return dot(p - uLightPosition, uLightDirection) > 0.0;
+    return true;
+}
+
+shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels;
+
+void addWide(int lo, uint value) { // 64-bit counter split over words lo, lo + 1
+    uint old = atomicAdd(bvhCounters[lo], value);
+    if (old + value < old) atomicAdd(bvhCounters[lo + 1], 1u);
+}
+
+void main() {
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = 0u;
+    barrier();
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (all(lessThan(px, imageSize(uVisibility)))) {
+        vec4 pos = texelFetch(uPosition, px, 0);
+        float visibility = 1.0; // background: nothing to shadow (the reference's convention)
+        uint visited = 0u, overflowRays = 0u;
+        if (pos.w >= 0.5) {
+            vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
+            visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
+            if (illuminated(p) && dot(n, toLight(p)) > 0.0) {
+                vec3 o = p + n * uRayOffset; // the same (unnormalised) normal as the reference
+                bool directional = uLightType == LIGHT_DIRECTIONAL;
+                int count = directional ? 1 : uSampleCount;
+                float unblocked = 0.0;
+                uint tested = 0u, maxVisited = 0u;
+                for (int s = 0; s < count; ++s) {
+                    Ray r;
+                    if (directional) {
+                        r = makeRay(o, -uLightDirection, kInf);
+                    } else {
+                        vec3 d = lightSamples[s].xyz - o;
+                        float dist = length(d);
+                        if (!(dist > 0.0)) { unblocked += 1.0; continue; } // origin on the sample
+                        r = makeRay(o, d / dist, max(0.0, dist - uRayOffset));
+                    }
+                    Trace t = trace(r);
+                    visited += t.visited;
+                    tested += t.tested;
+                    maxVisited = max(maxVisited, t.visited);
+                    if (t.overflow) ++overflowRays;
+                    else if (!t.occluded) unblocked += 1.0;
+                }
+                // An overflowed ray counts as blocked, and its pixel is written fully shadowed, so a
+                // stack too small shows as dark pixels and in overflowCount(), never as light.
+                visibility = overflowRays > 0u ? 0.0 : unblocked / float(count);
+                atomicAdd(sPixels, 1u);
+                atomicAdd(sRays, uint(count));
+                atomicAdd(sVisited, visited);
+                atomicMax(sVisitedMax, maxVisited);
+                atomicAdd(sTested, tested);
+                if (overflowRays > 0u) { atomicAdd(sOverflowRays, overflowRays); atomicAdd(sOverflowPixels, 1u); }
+            }
+        }
+        imageStore(uVisibility, px, vec4(visibility));
+        imageStore(uNodesVisited, px, vec4(float(visited)));
+        imageStore(uOverflow, px, vec4(overflowRays > 0u ? 1.0 : 0.0));
+    }
+    barrier();
+    if (gl_LocalInvocationIndex == 0u && sPixels != 0u) {
+        atomicAdd(bvhCounters[BVH_C_PIXELS], sPixels);
+        addWide(BVH_C_RAYS_LO, sRays);
+        addWide(BVH_C_VISITED_LO, sVisited);
+        atomicMax(bvhCounters[BVH_C_VISITED_MAX], sVisitedMax);
+        addWide(BVH_C_TRIS_LO, sTested);
+        if (sOverflowRays != 0u) {
+            atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], sOverflowRays);
+            atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], sOverflowPixels);
+        }
+    }
+}

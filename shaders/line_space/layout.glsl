@@ -1,0 +1,52 @@
+// line_space GPU layout constants, shared by GLSL (#include "line_space/layout.glsl") and C++
+// (algorithms/line_space/LineSpaceLayout.h includes this very file). #defines and comments only,
+// so it is valid in both languages and the numbers exist once.
+
+// SSBO binding points (0..2 are the scene buffers, which line_space never reads: the paper's
+// point is that the shadow rays need no geometry).
+#define LS_NODE_BINDING 3       // node pool: one LsNode per subdivided node, breadth-first, root = 0
+#define LS_TREE_BINDING 4       // tree pool: children groups of N³ entries, one per node above the last level
+#define LS_BITS_BINDING 5       // line-space pool, chunk 0: LS_WORDS_PER_NODE(N) words per node, node order
+#define LS_SAMPLE_BINDING 6     // light sample points (vec4)
+#define LS_COUNTER_BINDING 7    // per-frame counters
+#define LS_CLASSIFY_BINDING 8   // with classify: per pixel, start node + one occlusion bit per sample
+// The line-space pool is the one that outgrows a shader storage block (128 MiB here): (8, 3) on a
+// 2 M-triangle scene needs ~220 MB. It is split at node boundaries into up to LS_BIT_CHUNKS blocks
+// of uNodesPerChunk nodes each, bound at LS_BITS_BINDING and LS_BITS_BINDING_1..3.
+#define LS_BIT_CHUNKS 4
+#define LS_BITS_BINDING_1 9
+#define LS_BITS_BINDING_2 10
+#define LS_BITS_BINDING_3 11
+
+// Node pool entry: vec3 lo; uint children; vec3 size; uint level (32 bytes, std430).
+#define LS_NODE_BYTES 32
+// `children` of a node on the last subdivided level (its children are leaves, never stored).
+#define LS_NO_CHILDREN 0xFFFFFFFFu
+// Tree pool entry of an empty child (every non-empty child above the last level is subdivided).
+#define LS_EMPTY 0xFFFFFFFFu
+
+// Sub-faces: face f = 2 × axis + side (side 0 = the min plane); the face's sub-face (i, j) along
+// axes u = (axis + 1) % 3, v = (axis + 2) % 3 has index j × N + i. A shaft joins sub-faces on two
+// different faces fa < fb; its bit is
+//   LS_PAIR_INDEX(fa, fb) × N⁴ + subA × N² + subB
+// so a node holds exactly the 15 N⁴ bits of the paper (the symmetric half, no same-face pairs).
+#define LS_PAIR_INDEX(fa, fb) ((fa) * (11 - (fa)) / 2 + (fb) - (fa) - 1)
+#define LS_BITS_PER_NODE(n) (15 * (n) * (n) * (n) * (n))
+#define LS_WORDS_PER_NODE(n) ((LS_BITS_PER_NODE(n) + 31) / 32)
+
+// Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words.
+#define LS_COUNTER_WORDS 14
+#define LS_C_RAYS_LO 0          // shadow rays (lit pixels × samples)
+#define LS_C_RAYS_HI 1
+#define LS_C_VISITED_LO 2       // nodes entered, summed over rays
+#define LS_C_VISITED_HI 3
+#define LS_C_VISITED_MAX 4      // most nodes one ray entered
+#define LS_C_SHAFTS_LO 5        // line-space bits read, summed over rays
+#define LS_C_SHAFTS_HI 6
+#define LS_C_OCCLUDED_LO 7      // rays the line space declared occluded
+#define LS_C_OCCLUDED_HI 8
+#define LS_C_PIXELS 9           // pixels that traced rays
+#define LS_C_OVERFLOW 10        // traversal stack overflows (cannot happen: one frame per level)
+#define LS_C_CELLS_LO 11        // child cells the DDA stepped through (empty ones included), summed over rays
+#define LS_C_CELLS_HI 12
+// Word 13 is reserved.

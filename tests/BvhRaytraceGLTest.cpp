@@ -1,0 +1,211 @@
+// bvh_raytrace on OSMesa: the same shadow rays as the Embree reference, so hard shadows must agree
+// on all but a handful of pixels (≤ 0.1 % of lit pixels) and soft shadows sample for sample; a tiny
+// stack must be reported and never light a pixel; the counters describe the traversal.
+#include "algorithms/bvh_raytrace/BvhRaytrace.h"
+#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/metrics/Accuracy.h"
+#include "framework/scene/Procedural.h"
+#include "tests/TestSupport.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cstdio>
+#include <map>
+
+namespace shadowlab {
+namespace {
+
+glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
+glm::mat4 rotate(float deg, glm::vec3 axis) { return glm::rotate(glm::mat4(1.0f), glm::radians(deg), axis); }
+
+struct Shot {
+    Scene scene;
+    Camera camera;
+    Light light;
+};
+
+Camera lookAt(glm::vec3 from, glm::vec3 to) {
+    Camera c;
+    c.position = from, c.target = to;
+    c.fovYDeg = 55.0f, c.nearPlane = 0.02f, c.farPlane = 50.0f;
+    return c;
+}
+
+// The smoke scene's objects: a sphere, a tilted torus and a thin fence on a ground plane.
+Scene objects() {
+    Scene s = makePlane({8, 8}, 4, Material{});
+    s.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
+    s.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
+    s.append(makeFence(6, 0.35f, 1.0f, 0.03f, 2, 32, Material{}), translate({0, 0, -1.2f}));
+    return s;
+}
+
+Shot pointShot() {
+    Shot s{objects(), lookAt({0, 3.0f, 5.0f}, {0, 0.4f, 0}), Light{}};
+    s.light.type = LightType::Point;
+    s.light.position = {2.0f, 4.0f, 1.5f};
+    return s;
+}
+
+Shot spotShot() {
+    Shot s = pointShot();
+    s.light.type = LightType::Spot;
+    s.light.position = {-1.5f, 3.5f, 2.0f};
+    s.light.target = {0, 0, 0};
+    s.light.coneDeg = 35.0f;
+    return s;
+}
+
+Shot directionalShot() {
+    Shot s = pointShot();
+    s.light.type = LightType::Directional;
+    s.light.position = {3.0f, 4.0f, 2.0f};
+    s.light.target = {0, 0, 0};
+    return s;
+}
+
+Shot areaShot(int samples, const char* pattern) {
+    Shot s = pointShot();
+    s.light.type = LightType::Area;
+    s.light.position = {1.5f, 3.0f, 1.5f};
+    s.light.target = {0, 0, 0};
+    s.light.size = {1.2f, 1.2f};
+    s.light.samples = samples;
+    s.light.pattern = pattern;
+    return s;
+}
+
+// A single triangle over the ground: the root holds a leaf and an absent child.
+Shot singleTriangle() {
+    Shot s = pointShot();
+    s.scene = Scene{};
+    s.scene.addTriangles({{-3, 0, -3}, {3, 0, 3}, {3, 0, -3}, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3},
+                          {-0.5f, 1, -0.5f}, {0.5f, 1, 0.5f}, {0.5f, 1, -0.5f}},
+                         Material{});
+    s.camera = lookAt({0, 4, 3}, {0, 0, 0});
+    s.light.position = {0.3f, 3.0f, 0.2f};
+    return s;
+}
+
+constexpr int kRes = 96; // small: GLSL runs on the CPU here
+
+struct Outcome {
+    std::vector<float> visibility, reference, overflowMask;
+    std::vector<uint8_t> lit;
+    std::map<std::string, double> counters;
+    uint64_t overflow = 0;
+    size_t memory = 0;
+    Accuracy accuracy;
+};
+
+class BvhRaytraceGLTest : public test::GLTest {
+protected:
+    Outcome run(const Shot& s, const std::map<std::string, ParamValue>& overrides = {}) {
+        const AlgorithmInfo info = bvhRaytraceInfo();
+        ParamValues params(info.schema());
+        for (const auto& [k, v] : overrides) params.set(k, v);
+        SceneGpu gpu(s.scene);
+        GBuffer gbuffer({kRes, kRes});
+        gbuffer.render(gpu, s.camera);
+        std::unique_ptr<ShadowAlgorithm> algo = info.create(params);
+        algo->setScene(gpu);
+        algo->resize({kRes, kRes});
+        GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
+        StageTimer timer;
+        CpuGBuffer cpu = gbuffer.readBack();
+        algo->computeVisibility({gbuffer, [&]() -> const CpuGBuffer& { return cpu; }, s.camera, s.light, 0, visibility.id(), timer});
+        timer.collect();
+        Outcome o;
+        o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
+        for (const Counter& c : algo->counters()) o.counters[c.name] = c.value;
+        o.overflow = algo->overflowCount();
+        o.memory = algo->memoryBytes();
+        for (const DebugView& v : algo->debugViews())
+            if (v.name == "stack_overflow") o.overflowMask = readTextureR32F(v.texture, kRes, kRes);
+        o.lit = litMask(cpu, s.light);
+        EmbreeTracer tracer(s.scene);
+        tracer.traceVisibility(cpu, s.light, float(params.getFloat("ray_offset")) * s.scene.bounds.radius(), 0, o.reference);
+        o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
+        return o;
+    }
+};
+
+struct AccuracyCase {
+    const char* name;
+    Shot (*make)();
+    double maxMismatch; ///< share of lit pixels whose binary visibility differs from the reference
+    double maxRmse;     ///< RMS visibility difference over lit pixels
+};
+
+// The bound for hard shadows is 0.1 % of lit pixels (≈ 5 of the ~5000 lit pixels at 96²):
+// the rays are the reference's, and the watertight test matches Embree's robust mode, so only a
+// ray grazing an edge within float rounding of the two tracers may differ. Soft shadows use the
+// same samples, so the RMSE stays at that level too.
+const AccuracyCase kAccuracy[] = {
+    {"point", pointShot, 1e-3, 0.03},
+    {"spot", spotShot, 1e-3, 0.03},
+    {"directional", directionalShot, 1e-3, 0.03},
+    {"area_16_stratified", [] { return areaShot(16, "stratified"); }, 1e-3, 0.01},
+    {"area_9_grid", [] { return areaShot(9, "grid"); }, 1e-3, 0.01},
+    {"single_triangle", singleTriangle, 1e-3, 0.03},
+};
+
+class BvhRaytraceAccuracyGLTest : public BvhRaytraceGLTest, public ::testing::WithParamInterface<AccuracyCase> {};
+
+TEST_P(BvhRaytraceAccuracyGLTest, MatchesReference) {
+    const AccuracyCase& c = GetParam();
+    Outcome o = run(c.make());
+    std::printf("[bvh_raytrace] %-20s lit %5zu mismatch %.4f%% rmse %.5f nodes/ray %.1f (max %.0f) tris/ray %.1f bvh %0.f nodes "
+                "depth %.0f\n",
+                c.name, o.accuracy.litPixels, 100 * o.accuracy.mismatchRatio, o.accuracy.rmse, o.counters["nodes_visited_mean"],
+                o.counters["nodes_visited_max"], o.counters["triangles_tested_mean"], o.counters["bvh_nodes"],
+                o.counters["bvh_depth"]);
+    EXPECT_GT(o.accuracy.litPixels, size_t(kRes * kRes / 8)) << "the view should show lit surfaces";
+    EXPECT_LE(o.accuracy.mismatchRatio, c.maxMismatch);
+    EXPECT_LE(o.accuracy.rmse, c.maxRmse);
+    EXPECT_EQ(o.overflow, 0u);
+    size_t shadowed = 0;
+    for (size_t i = 0; i < o.lit.size(); ++i) shadowed += o.lit[i] && o.reference[i] < 0.5f;
+    EXPECT_GT(shadowed, size_t(50)) << "the scene should cast shadows onto lit pixels";
+    EXPECT_GT(o.counters["nodes_visited_mean"], 0.0);
+    EXPECT_EQ(o.counters["traced_pixels"], double(o.accuracy.litPixels));
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, BvhRaytraceAccuracyGLTest, ::testing::ValuesIn(kAccuracy),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST_F(BvhRaytraceGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
+    Outcome o = run(areaShot(4, "grid"), {{"stack_size", 1}});
+    const double pixels = o.counters["stack_overflow_pixels"];
+    std::printf("[bvh_raytrace] stack_size 1: %.0f pixels, %.0f rays overflowed\n", pixels, o.counters["stack_overflow_rays"]);
+    ASSERT_GT(pixels, 0.0);
+    EXPECT_EQ(o.overflow, uint64_t(pixels));
+    size_t marked = 0;
+    for (size_t i = 0; i < o.visibility.size(); ++i) {
+        if (o.overflowMask[i] > 0.5f) {
+            ++marked;
+            EXPECT_EQ(o.visibility[i], 0.0f) << "pixel " << i << " overflowed but is not written shadowed";
+        }
+        // Where no ray overflowed the answer is still the reference's; nowhere is a pixel lighter.
+        if (o.lit[i]) EXPECT_LE(o.visibility[i], o.reference[i] + 1e-6f) << "pixel " << i << " lit by overflow";
+    }
+    EXPECT_EQ(double(marked), pixels);
+}
+
+TEST_F(BvhRaytraceGLTest, CountersAndMemoryDescribeTheTree) {
+    Shot s = pointShot();
+    Outcome o = run(s);
+    const double n = double(s.scene.triangleCount());
+    // Leaves of at most 4 triangles: at least n / 4 leaves, one fewer inner node than leaves.
+    EXPECT_GE(o.counters["bvh_leaves"], n / 4);
+    EXPECT_EQ(o.counters["bvh_nodes"], o.counters["bvh_leaves"] - 1);
+    EXPECT_EQ(o.memory, size_t(o.counters["bvh_nodes"]) * 64 + size_t(n) * 4 + size_t(n) * 36);
+    // Any-hit early exit and the SAH keep a ray far below the tree size.
+    EXPECT_LT(o.counters["nodes_visited_mean"], 0.05 * o.counters["bvh_nodes"]);
+    EXPECT_GE(o.counters["nodes_visited_max"], o.counters["nodes_visited_mean"]);
+    EXPECT_LE(o.counters["nodes_visited_max"], o.counters["bvh_nodes"]);
+    EXPECT_EQ(o.counters["rays"], double(o.accuracy.litPixels)); // one ray per lit pixel for a point light
+}
+
+} // namespace
+} // namespace shadowlab

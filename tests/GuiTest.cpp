@@ -1,0 +1,212 @@
+// shadowlab-gui driven without a person: launched under Xvfb (GLX on llvmpipe) with its automation
+// options, which act through the same functions as the widgets (selectAlgorithm, applyParamChange,
+// the path recorder, the config writer). CPU tier: it needs no GL context of its own.
+#include "framework/experiment/Config.h"
+#include "tests/TestSupport.h"
+
+#include <stb_image.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+#ifdef SHADOWLAB_GUI_BINARY
+const std::string kGui = SHADOWLAB_GUI_BINARY;
+#else
+const std::string kGui;
+#endif
+
+const std::string kSmoke = std::string(SHADOWLAB_SOURCE_DIR) + "/configs/smoke.json";
+constexpr int kPanelWidth = 380; ///< GuiState::panelWidth: the panel is x < 380 at the default 1280×800
+
+/// Skips the test (with why) where the GUI cannot be launched; returns the command prefix otherwise.
+std::string guiCommand() {
+    if (kGui.empty()) return "";
+    std::string out;
+    if (test::runCommand("command -v xvfb-run", out) != 0) return "";
+    // A private X server per run (-a picks a free display); Mesa's software GLX renders on the CPU.
+    return "LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s \"-screen 0 1280x800x24\" " + kGui;
+}
+
+/// Runs the GUI under Xvfb. ctest -j may start two `xvfb-run -a` at once, and both can pick the same
+/// free display number; the loser reports that Xvfb failed to start, so try again.
+int runGui(const std::string& command, std::string& out) {
+    int rc = 0;
+    for (int attempt = 0; attempt < 3; ++attempt) {
+        rc = test::runCommand(command, out);
+        if (out.find("Xvfb failed to start") == std::string::npos) break;
+    }
+    return rc;
+}
+
+#define REQUIRE_GUI(cmd)                                                                                  \
+    std::string cmd = guiCommand();                                                                       \
+    if (kGui.empty()) GTEST_SKIP() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)"; \
+    if (cmd.empty()) GTEST_SKIP() << "xvfb-run is missing (Debian package xvfb)";
+
+Json readJson(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return Json::parse(ss.str());
+}
+
+glm::vec3 vec3(const Json& j) { return {j[0].get<float>(), j[1].get<float>(), j[2].get<float>()}; }
+
+struct Rgb {
+    int r, g, b;
+    int max() const { return std::max({r, g, b}); }
+};
+
+class Png {
+public:
+    explicit Png(const std::string& path) { data_ = stbi_load(path.c_str(), &w_, &h_, &n_, 3); }
+    ~Png() { if (data_) stbi_image_free(data_); }
+    bool ok() const { return data_ != nullptr; }
+    int width() const { return w_; }
+    int height() const { return h_; }
+    Rgb at(int x, int y) const {
+        const unsigned char* p = data_ + (size_t(y) * size_t(w_) + size_t(x)) * 3;
+        return {p[0], p[1], p[2]};
+    }
+
+private:
+    unsigned char* data_ = nullptr;
+    int w_ = 0, h_ = 0, n_ = 0;
+};
+
+// Thresholds of the screenshot checks, measured on llvmpipe (Mesa 22.3) at 1280×800 after 6 frames
+// of smoke.json with psv (path frame 1): the panel is ~55 % dark window background and ~35 % blue
+// headers, frames and slider grabs, with ~1,400 distinct colours from anti-aliased text; the ground
+// is ~200 grey where lit and ~94 where shadowed (ambient 0.15), ~55 % and ~2.7 % of the scene region.
+constexpr size_t kMinPanelColours = 50;     ///< text anti-aliasing alone gives hundreds
+constexpr double kMinPanelBlue = 0.10;      ///< ImGui's dark style: headers, frames and slider grabs
+constexpr double kMinPanelDark = 0.20;      ///< ImGui's dark window background
+constexpr double kMinLitGround = 0.20;      ///< bright neutral grey pixels of the scene region
+constexpr double kMinShadowedGround = 0.01; ///< dark neutral grey: the sphere's and torus' shadows (~7,000 px)
+
+TEST(GuiTest, SwitchesAlgorithmSetsParameterPlaysAndShowsShadows) {
+    REQUIRE_GUI(gui);
+    std::string dir = test::makeTempDir("gui");
+    std::string shot = dir + "/gui.png", report = dir + "/report.json";
+    // The app opens on the config's first entry (shadow_map); switch to the registered psv, change
+    // a Rebuild and an Update parameter through applyParamChange (the widgets' path), and play 6
+    // frames of the fly-through (smoke.json has 4 path frames: the playback loops).
+    std::string out;
+    int rc = runGui(gui + " " + kSmoke + " --algorithm psv --set stack_size=64 --set ray_offset=0.0002 --play" +
+                        " --frames 6 --screenshot " + shot + " --report " + report,
+                    out);
+    ASSERT_EQ(rc, 0) << out;
+
+    Json r = readJson(report);
+    EXPECT_EQ(r["algorithm"], "psv");
+    EXPECT_EQ(r["params"]["stack_size"], 64);
+    EXPECT_DOUBLE_EQ(r["params"]["ray_offset"].get<double>(), 0.0002);
+    for (const Json& f : r["frames"]) EXPECT_EQ(f["algorithm"], "psv");
+    ASSERT_EQ(r["frames"].size(), 6u);
+    // Playback advanced through the path: frames 0..3, then wrapped.
+    std::vector<int> pathFrames;
+    for (const Json& f : r["frames"]) pathFrames.push_back(f["path_frame"].get<int>());
+    EXPECT_EQ(pathFrames, (std::vector<int>{0, 1, 2, 3, 0, 1}));
+    EXPECT_NE(vec3(r["frames"][0]["camera"]["position"]), vec3(r["frames"][1]["camera"]["position"]));
+
+    Png png(shot);
+    ASSERT_TRUE(png.ok()) << shot;
+    ASSERT_EQ(png.width(), 1280);
+    ASSERT_EQ(png.height(), 800);
+
+    std::set<int> colours;
+    size_t blue = 0, dark = 0, panel = 0;
+    for (int y = 0; y < png.height(); ++y)
+        for (int x = 0; x < kPanelWidth; ++x, ++panel) {
+            Rgb c = png.at(x, y);
+            colours.insert((c.r << 16) | (c.g << 8) | c.b);
+            if (c.b > c.r + 40 && c.b > 60) ++blue;
+            if (c.max() < 40) ++dark;
+        }
+    EXPECT_GE(colours.size(), kMinPanelColours);
+    EXPECT_GE(double(blue) / double(panel), kMinPanelBlue);
+    EXPECT_GE(double(dark) / double(panel), kMinPanelDark);
+
+    size_t lit = 0, shadowed = 0, scene = 0;
+    for (int y = 0; y < png.height(); ++y)
+        for (int x = kPanelWidth + 8; x < png.width(); ++x, ++scene) {
+            Rgb c = png.at(x, y);
+            // The ground and fence are neutral grey; the sky is blue, the sphere red, the torus blue.
+            bool neutral = std::abs(c.r - c.g) < 12 && std::abs(c.g - c.b) < 25;
+            if (!neutral) continue;
+            if (c.max() >= 170) ++lit;
+            else if (c.max() >= 60 && c.max() < 130) ++shadowed;
+        }
+    EXPECT_GE(double(lit) / double(scene), kMinLitGround) << lit << " lit of " << scene;
+    EXPECT_GE(double(shadowed) / double(scene), kMinShadowedGround) << shadowed << " shadowed of " << scene;
+}
+
+TEST(GuiTest, RecordedPathRunsUnchangedAndReproducesTheCamera) {
+    REQUIRE_GUI(gui);
+    std::string dir = test::makeTempDir("guipath");
+    std::string saved = dir + "/recorded.json", report = dir + "/report.json";
+    const std::vector<std::pair<glm::vec3, glm::vec3>> keys = {
+        {{0, 3, 5}, {0, 0.4f, 0}}, {{3, 2.5f, 3.5f}, {0, 0.4f, 0}}, {{-2, 2, 4}, {0, 0.5f, 0}}};
+    std::string text;
+    for (const auto& [p, t] : keys) {
+        std::ostringstream os;
+        os << p.x << "," << p.y << "," << p.z << "," << t.x << "," << t.y << "," << t.z << ";";
+        text += os.str();
+    }
+    // Record the keyframes as the button does, save, then play the recording and log every camera.
+    std::string out;
+    int rc = runGui(gui + " " + kSmoke + " --set bias_slope=2.5 --record-keyframes \"" + text +
+                        "\" --record-step 0.5 --save-config " + saved + " --play --frames 5 --report " + report,
+                    out);
+    ASSERT_EQ(rc, 0) << out;
+    ASSERT_TRUE(fs::exists(saved)) << out;
+
+    // The saved file is an ordinary experiment: `shadowlab run` accepts it unchanged.
+    std::string results = dir + "/results";
+    rc = test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + saved + " --no-progress --out " + results, out);
+    ASSERT_EQ(rc, 0) << out;
+    Json resolved = readJson(results + "/config.resolved.json");
+    const Json& kf = resolved["camera"]["path"]["keyframes"];
+    ASSERT_EQ(kf.size(), keys.size());
+    for (size_t i = 0; i < keys.size(); ++i) {
+        EXPECT_DOUBLE_EQ(kf[i]["time"].get<double>(), 0.5 * double(i));
+        EXPECT_EQ(vec3(kf[i]["position"]), keys[i].first) << "keyframe " << i;
+        EXPECT_EQ(vec3(kf[i]["target"]), keys[i].second) << "keyframe " << i;
+    }
+    EXPECT_EQ(resolved["algorithms"][0]["params"]["bias_slope"], 2.5);
+
+    // The app played the recorded path exactly as the runner samples it (Path::at at frameTime).
+    ExperimentConfig cfg = loadConfig(saved, false);
+    Json r = readJson(report);
+    ASSERT_EQ(r["frames"].size(), 5u);
+    for (const Json& f : r["frames"]) {
+        int frame = f["path_frame"].get<int>();
+        Camera expected = cfg.cameraAt(frame);
+        glm::vec3 p = vec3(f["camera"]["position"]), t = vec3(f["camera"]["target"]);
+        // Same float arithmetic on both sides; 1e-5 only absorbs the JSON round trip of floats.
+        EXPECT_LT(glm::length(p - expected.position), 1e-5f) << "frame " << frame;
+        EXPECT_LT(glm::length(t - expected.target), 1e-5f) << "frame " << frame;
+    }
+}
+
+TEST(GuiTest, BadInputIsOneLineAndExitCode2) {
+    if (kGui.empty()) GTEST_SKIP() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    // Checked before any window opens, so no X server is needed.
+    for (const std::string args : {" --set no_such_key=1", " --algorithm no_such_algorithm", " --set resolution=1",
+                                   " --frames x", " /nonexistent/config.json"}) {
+        std::string out;
+        EXPECT_EQ(test::runCommand(kGui + " " + (args[1] == '/' ? "" : kSmoke) + args, out), 2) << args << "\n" << out;
+        std::string trimmed = out.substr(0, out.find_last_not_of('\n') + 1);
+        EXPECT_EQ(trimmed.find('\n'), std::string::npos) << out;
+    }
+}
+
+} // namespace
+} // namespace shadowlab

@@ -1,0 +1,284 @@
+// line_space on OSMesa, against the Embree reference with the same samples: every sample is also
+// traced exactly (the `classify` parameter) to show where the method errs: towards shadow
+// (non-empty shafts a ray passes) everywhere, towards light only inside the node the ray starts in.
+// Also: soft shadows hide the approximation better than hard ones (the paper's Figure 7), a larger
+// N errs less, and the disk cache returns the same image (and rebuilds a corrupt file).
+#include "algorithms/line_space/LineSpace.h"
+#include "algorithms/line_space/LineSpaceCache.h"
+#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/metrics/Accuracy.h"
+#include "framework/scene/Procedural.h"
+#include "tests/TestSupport.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+namespace shadowlab {
+namespace {
+
+glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
+glm::mat4 rotate(float deg, glm::vec3 axis) { return glm::rotate(glm::mat4(1.0f), glm::radians(deg), axis); }
+
+struct Shot {
+    Scene scene;
+    Camera camera;
+    Light light;
+};
+
+// The smoke scene's objects (≈ 3,800 triangles): a sphere, a tilted torus, a thin fence on a plane.
+Shot pointShot() {
+    Shot s;
+    s.scene = makePlane({8, 8}, 4, Material{});
+    s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
+    s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
+    s.scene.append(makeFence(6, 0.35f, 1.0f, 0.03f, 2, 32, Material{}), translate({0, 0, -1.2f}));
+    s.scene.updateBounds();
+    s.camera.position = {0, 3.0f, 5.0f}, s.camera.target = {0, 0.4f, 0};
+    s.camera.fovYDeg = 55.0f, s.camera.nearPlane = 0.02f, s.camera.farPlane = 50.0f;
+    s.light.type = LightType::Point;
+    s.light.position = {2.0f, 4.0f, 1.5f};
+    return s;
+}
+
+Shot areaShot(int samples = 16) {
+    Shot s = pointShot();
+    s.light.type = LightType::Area;
+    s.light.position = {1.5f, 3.0f, 1.5f};
+    s.light.target = {0, 0, 0};
+    s.light.size = {1.5f, 1.5f};
+    s.light.samples = samples;
+    return s;
+}
+
+// Pebbles smaller than a last-level node scattered on the ground under an area light: a ray from the
+// ground beside a pebble meets it inside the node it starts in, which the line space skips.
+Shot pebbleShot() {
+    Shot s = areaShot(16);
+    s.scene = makePlane({8, 8}, 4, Material{});
+    for (int i = 0; i < 7; ++i)
+        for (int j = 0; j < 5; ++j)
+            s.scene.append(makeSphere(0.025f, 60, Material{}), translate({-1.5f + 0.45f * float(i), 0.024f, -1.0f + 0.5f * float(j)}));
+    s.scene.append(makeSphere(0.5f, 600, Material{}), translate({0.5f, 1.5f, -0.5f})); // lifts the root box
+    s.scene.updateBounds();
+    s.camera.position = {0, 2.0f, 2.5f}, s.camera.target = {0, 0, -0.2f};
+    s.light.position = {1.0f, 1.2f, 1.5f};
+    return s;
+}
+
+Shot spotShot() {
+    Shot s = pointShot();
+    s.light.type = LightType::Spot;
+    s.light.position = {-1.5f, 3.5f, 2.0f};
+    s.light.coneDeg = 35.0f;
+    return s;
+}
+
+Shot directionalShot() {
+    Shot s = pointShot();
+    s.light.type = LightType::Directional;
+    s.light.position = {3.0f, 4.0f, 2.0f};
+    return s;
+}
+
+constexpr int kRes = 64; // small: GLSL runs on the CPU here
+
+struct Outcome {
+    std::vector<float> visibility, reference;
+    std::vector<uint8_t> lit;
+    std::map<std::string, double> counters;
+    uint64_t overflow = 0;
+    size_t memory = 0;
+    Accuracy accuracy;
+};
+
+class LineSpaceGLTest : public test::GLTest {
+protected:
+    // Every build of this test binary goes to a private cache directory (a stale cache of an
+    // earlier build could otherwise hide a change of the builder).
+    void SetUp() override {
+        test::GLTest::SetUp();
+        const char* xdg = std::getenv("XDG_CACHE_HOME");
+        savedXdg_ = xdg ? std::optional<std::string>(xdg) : std::nullopt;
+        static const std::string dir = test::makeTempDir("lsgl");
+        setenv("XDG_CACHE_HOME", dir.c_str(), 1);
+    }
+    void TearDown() override {
+        if (savedXdg_) setenv("XDG_CACHE_HOME", savedXdg_->c_str(), 1);
+        else unsetenv("XDG_CACHE_HOME");
+        test::GLTest::TearDown();
+    }
+
+    Outcome run(const Shot& s, const std::map<std::string, ParamValue>& overrides = {}) {
+        const AlgorithmInfo info = lineSpaceInfo();
+        ParamValues params(info.schema());
+        params.set("classify", true);
+        for (const auto& [k, v] : overrides) params.set(k, v);
+        SceneGpu gpu(s.scene);
+        GBuffer gbuffer({kRes, kRes});
+        gbuffer.render(gpu, s.camera);
+        std::unique_ptr<ShadowAlgorithm> algo = info.create(params);
+        algo->setScene(gpu);
+        algo->resize({kRes, kRes});
+        GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
+        StageTimer timer;
+        CpuGBuffer cpu = gbuffer.readBack();
+        algo->computeVisibility({gbuffer, [&]() -> const CpuGBuffer& { return cpu; }, s.camera, s.light, 0, visibility.id(), timer});
+        timer.collect();
+        Outcome o;
+        o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
+        for (const Counter& c : algo->counters()) o.counters[c.name] = c.value;
+        o.overflow = algo->overflowCount();
+        o.memory = algo->memoryBytes();
+        o.lit = litMask(cpu, s.light);
+        EmbreeTracer tracer(s.scene);
+        tracer.traceVisibility(cpu, s.light, float(params.getFloat("ray_offset")) * s.scene.bounds.radius(), 0, o.reference);
+        o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
+        return o;
+    }
+
+    std::optional<std::string> savedXdg_;
+};
+
+void print(const char* name, const Outcome& o) {
+    std::printf("[line_space] %-22s mismatch %6.3f%% rmse %.4f | samples over %.4f under %.4f (start node %.4f, "
+                "elsewhere %.0f) | nodes/ray %.1f shafts/ray %.1f | %0.f nodes, %.2f MB, build %.0f ms\n",
+                name, 100 * o.accuracy.mismatchRatio, o.accuracy.rmse, o.counters.at("over_occluded_share"),
+                o.counters.at("under_occluded_share"), o.counters.at("under_occluded_start_node_share"),
+                o.counters.at("under_occluded_elsewhere"), o.counters.at("nodes_visited_mean"),
+                o.counters.at("shafts_tested_mean"), o.counters.at("subdivided_nodes"), double(o.memory) / 1e6,
+                o.counters.at("build_ms"));
+}
+
+struct ErrCase {
+    const char* name;
+    Shot (*make)();
+    std::map<std::string, ParamValue> params;
+};
+
+const ErrCase kErrCases[] = {
+    {"point_6_3", pointShot, {}},
+    {"point_4_3", pointShot, {{"n", 4}}},
+    {"point_8_2", pointShot, {{"n", 8}, {"d", 2}}},
+    {"point_3_4", pointShot, {{"n", 3}, {"d", 4}}},
+    {"spot_6_3", spotShot, {}},
+    {"directional_6_3", directionalShot, {}},
+    {"area16_6_3", [] { return areaShot(16); }, {}},
+    {"pebbles_6_3", pebbleShot, {}},
+};
+
+class LineSpaceErrGLTest : public LineSpaceGLTest, public ::testing::WithParamInterface<ErrCase> {};
+
+// The paper's claim made testable: away from the node a ray starts in, the line space only errs
+// towards shadow (a blocker is never missed); inside it, it errs towards light.
+TEST_P(LineSpaceErrGLTest, ErrsTowardsShadowAwayFromTheStartNode) {
+    const ErrCase& c = GetParam();
+    Outcome o = run(c.make(), c.params);
+    print(c.name, o);
+    EXPECT_EQ(o.counters["under_occluded_elsewhere"], 0.0) << "a blocker outside the start node was missed";
+    EXPECT_GT(o.counters["classified_samples"], 0.0);
+    EXPECT_EQ(o.counters["classified_samples"], o.counters["rays"]);
+    EXPECT_GT(o.counters["over_occluded_share"], 0.0) << "the shafts are approximate: some free rays are blocked";
+    EXPECT_EQ(o.overflow, 0u);
+    EXPECT_LE(o.counters["shafts_tested_mean"], o.counters["nodes_visited_mean"]);
+    // The binary image follows the samples: where the reference is lit, line space may be dark,
+    // and the opposite needs a blocker in the start node. Both stay a minority of lit pixels.
+    EXPECT_LT(o.accuracy.mismatchRatio, 0.25);
+}
+
+// Small blockers inside the start node are missed: the one way the method errs towards light.
+TEST_F(LineSpaceGLTest, BlockersInsideTheStartNodeAreMissed) {
+    Outcome o = run(pebbleShot());
+    print("pebbles (start node)", o);
+    EXPECT_GT(o.counters["under_occluded_start_node_share"], 0.0);
+    EXPECT_EQ(o.counters["under_occluded_start_node_share"], o.counters["under_occluded_share"]);
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, LineSpaceErrGLTest, ::testing::ValuesIn(kErrCases),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// Figure 7 of the paper: one shadow ray shows the approximation (a coarse silhouette); averaging an
+// area light's samples hides most of it.
+TEST_F(LineSpaceGLTest, SoftShadowsHideTheApproximation) {
+    Shot hard = areaShot(1), soft = areaShot(25);
+    hard.light.type = LightType::Point; // the area light's centre
+    const std::map<std::string, ParamValue> p = {{"n", 5}, {"d", 3}};
+    Outcome h = run(hard, p), s = run(soft, p);
+    print("hard (point) 5_3", h);
+    print("soft (25 samples) 5_3", s);
+    // The binary mismatch barely moves (most of it is self-shadowing of lit object sides, where
+    // every sample of a pixel is blocked), but the visibility error drops.
+    EXPECT_LT(s.accuracy.rmse, h.accuracy.rmse);
+}
+
+// A larger N gives slimmer shafts and smaller leaves: fewer free rays are declared blocked.
+TEST_F(LineSpaceGLTest, LargerBranchingFactorOverOccludesLess) {
+    Shot s = areaShot(16);
+    Outcome coarse = run(s, {{"n", 3}, {"d", 3}}), fine = run(s, {{"n", 6}, {"d", 3}});
+    print("area16_3_3", coarse);
+    print("area16_6_3", fine);
+    EXPECT_LT(fine.counters["over_occluded_share"], coarse.counters["over_occluded_share"]);
+    EXPECT_LT(fine.accuracy.rmse, coarse.accuracy.rmse);
+    EXPECT_GT(fine.memory, coarse.memory);
+}
+
+TEST_F(LineSpaceGLTest, MemoryIsThePools) {
+    Shot s = pointShot();
+    Outcome o = run(s, {{"n", 4}, {"d", 3}});
+    const double nodes = o.counters["subdivided_nodes"];
+    EXPECT_EQ(o.counters["nodes_level_0"], 1.0);
+    EXPECT_EQ(o.counters["nodes_level_0"] + o.counters["nodes_level_1"] + o.counters["nodes_level_2"], nodes);
+    EXPECT_EQ(o.counters["node_pool_bytes"], 32 * nodes);
+    EXPECT_EQ(o.counters["line_space_pool_bytes"], 4 * 120 * nodes); // 15 · 4⁴ bits = 120 words per node
+    // Children groups (4³ entries) for the nodes above the last level only.
+    EXPECT_EQ(o.counters["tree_pool_bytes"], 4 * 64 * (o.counters["nodes_level_0"] + o.counters["nodes_level_1"]));
+    EXPECT_EQ(double(o.memory), o.counters["node_pool_bytes"] + o.counters["tree_pool_bytes"] + o.counters["line_space_pool_bytes"]);
+}
+
+// The line-space pool is split over several SSBOs when it outgrows one: same image; beyond the
+// 4 blocks the shader binds, an error naming the pools (never a wrong image).
+TEST_F(LineSpaceGLTest, LineSpacePoolSplitsOverStorageBlocks) {
+    Shot s = pointShot();
+    Outcome whole = run(s, {{"classify", false}}); // (6, 3): ~6 MB of line space
+    Outcome split = run(s, {{"classify", false}, {"max_block_mib", 2}});
+    EXPECT_GT(split.counters["line_space_pool_bytes"], 2.0 * (2 << 20)) << "the pool must need three blocks";
+    EXPECT_EQ(split.visibility, whole.visibility);
+    EXPECT_EQ(split.memory, whole.memory);
+    try {
+        run(s, {{"classify", false}, {"max_block_mib", 1}});
+        ADD_FAILURE() << "a pool beyond 4 blocks of 1 MiB must be refused";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("MiB"), std::string::npos) << e.what();
+        std::printf("[line_space] max_block_mib 1: %s\n", e.what());
+    }
+}
+
+TEST_F(LineSpaceGLTest, DiskCacheGivesTheSameImageAndRebuildsCorruptFiles) {
+    Shot s = pointShot();
+    const std::map<std::string, ParamValue> p = {{"n", 3}, {"d", 3}, {"classify", false}};
+    const std::string file = ls::cacheFile(ls::cacheDirectory(), s.scene.contentHash(), 3, 3);
+    std::filesystem::remove(file);
+    Outcome built = run(s, p);
+    EXPECT_EQ(built.counters["cache_hit"], 0.0);
+    ASSERT_TRUE(std::filesystem::exists(file));
+    Outcome cached = run(s, p);
+    EXPECT_EQ(cached.counters["cache_hit"], 1.0);
+    EXPECT_EQ(cached.visibility, built.visibility);
+    EXPECT_EQ(cached.counters["build_ms"], built.counters["build_ms"]) << "the cache keeps the original build time";
+    {
+        std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(std::streamoff(std::filesystem::file_size(file) / 2));
+        f.put('\x7f').put('\x01');
+    }
+    Outcome rebuilt = run(s, p);
+    EXPECT_EQ(rebuilt.counters["cache_hit"], 0.0) << "a corrupt file must not be used";
+    EXPECT_EQ(rebuilt.visibility, built.visibility);
+    EXPECT_EQ(run(s, p).counters["cache_hit"], 1.0) << "the rebuilt tree replaced the corrupt file";
+}
+
+} // namespace
+} // namespace shadowlab
