@@ -346,20 +346,5 @@ TEST_F(LineSpaceCacheTest, DirectoryFollowsXdgThenHome) {
 }
 
 // Build times of the Table 1 parameter sets on the 2CylinderEngine (run by hand).
-TEST(LineSpaceTest, DISABLED_BuildTimesOnTheEngine) {
-    Scene engine = loadGltf(test::kEngineGlb);
-    Scene s = makePlane({6, 6}, 8, Material{});
-    glm::vec3 e = engine.bounds.extent();
-    float k = 2.5f / std::max({e.x, e.y, e.z});
-    glm::vec3 anchor(engine.bounds.center().x, engine.bounds.min.y, engine.bounds.center().z);
-    s.append(engine, glm::scale(glm::mat4(1.0f), glm::vec3(k)) * glm::translate(glm::mat4(1.0f), -anchor));
-    s.updateBounds();
-    for (auto [n, d] : {std::pair{4, 4}, {5, 4}, {6, 3}, {7, 3}, {8, 3}}) {
-        ls::NTree t = ls::buildNTree(s, n, d);
-        std::printf("(%d,%d): %zu tris, %zu nodes, %.1f MB, %.0f ms\n", n, d, s.triangleCount(), t.nodes.size(),
-                    double(t.poolBytes()) / 1e6, t.buildMs);
-    }
-}
-
 } // namespace
 } // namespace shadowlab

@@ -99,11 +99,13 @@ Json ExperimentResults::summary() const {
         j["algorithm"] = a.algorithm;
         j["params"] = a.params;
         j["preprocess_ms"] = a.preprocessMs;
-        // time_ms: GPU time where the stage has it (timer queries), else CPU time; "total" is the
-        // wall-clock time of the whole visibility computation, GPU finished.
+        // time_ms: GPU time where the stage has it (timer queries) and they can be trusted
+        // (stage_time_source "gpu"), else the stage's CPU/wall time; "total" is the wall-clock time
+        // of the whole visibility computation, GPU finished.
+        const bool gpuTimes = meta.value("stage_time_source", std::string("gpu")) == "gpu";
         Json time = Json::object(), cpuTime = Json::object();
         for (const auto& name : order) {
-            bool useGpu = name != "total" && gpu.count(name) && gpu[name].size() == cpu[name].size();
+            bool useGpu = gpuTimes && name != "total" && gpu.count(name) && gpu[name].size() == cpu[name].size();
             time[name] = computeStats(useGpu ? gpu[name] : cpu[name]).toJson();
             cpuTime[name] = computeStats(cpu[name]).toJson();
         }
@@ -141,7 +143,10 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
        << ", triangles: " << s["triangles"] << "\n";
     os << "- wall time: " << std::setprecision(1) << s.value("wall_time_s", 0.0) << " s\n\n";
 
-    os << "## Time per frame (ms; GPU timer queries where the stage runs on the GPU, CPU time otherwise)\n\n";
+    if (s.value("stage_time_source", std::string("gpu")) == "gpu")
+        os << "## Time per frame (ms; GPU timer queries where the stage runs on the GPU, CPU time otherwise)\n\n";
+    else
+        os << "## Time per frame (ms; wall clock of each stage run to completion: this renderer's timer queries are unreliable)\n\n";
     os << "| id | algorithm | stage | mean | min | max | median |\n|---|---|---|---:|---:|---:|---:|\n";
     for (const auto& a : algorithms) {
         const Json& j = s["algorithms"][a.id];

@@ -95,6 +95,8 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     GBuffer gbuffer(res);
     ShadingPass shading(res);
     StageTimer timer;
+    const bool softwareGl = isSoftwareRenderer(glRendererString());
+    timer.setSynchronous(softwareGl);
 
     // The reference runs first each frame: every other algorithm is compared with its visibility.
     std::vector<const AlgorithmEntry*> entries;
@@ -121,6 +123,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"renderer", glRendererString()},
                     {"gl_version", glVersionString()},
                     {"backend", backend},
+                    // Where time_ms comes from (see isSoftwareRenderer()): "gpu" = timer queries,
+                    // "wall" = the wall clock of each stage run synchronously.
+                    {"stage_time_source", softwareGl ? "wall" : "gpu"},
                     {"subgroup_size", querySubgroupSize()},
                     {"resolution", {res.x, res.y}},
                     {"frames", cfg.frames},

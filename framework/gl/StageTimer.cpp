@@ -4,6 +4,12 @@
 
 namespace shadowlab {
 
+bool isSoftwareRenderer(const std::string& renderer) {
+    for (const char* name : {"llvmpipe", "softpipe", "swrast", "SwiftShader"})
+        if (renderer.find(name) != std::string::npos) return true;
+    return false;
+}
+
 StageTimer::StageTimer() = default;
 
 void StageTimer::begin(const std::string& name, bool gpu) {
@@ -27,6 +33,7 @@ void StageTimer::begin(const std::string& name, bool gpu) {
 void StageTimer::end() {
     if (!open_) throw RuntimeError("StageTimer: end() without begin()");
     auto& p = stages_.back();
+    if (synchronous_) glFinish();
     p.time.cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
     if (p.query) glEndQuery(GL_TIME_ELAPSED);
     open_ = false;
