@@ -1,5 +1,8 @@
 // The command line as a user meets it: exit codes, one-line errors, and malformed scene files.
+#include "framework/core/JsonNode.h"
 #include "tests/TestSupport.h"
+
+#include <algorithm>
 
 #include <filesystem>
 #include <fstream>
@@ -23,10 +26,31 @@ TEST(CliTest, UnknownCommandIsBadInput) {
     EXPECT_EQ(test::runCommand(bin() + " frobnicate", out), 2);
 }
 
-TEST(CliTest, ShippedConfigsValidate) {
-    for (const char* cfg : {"smoke.json", "demo.json"}) {
+TEST(CliTest, EveryShippedConfigValidates) {
+    size_t n = 0;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(std::string(SHADOWLAB_SOURCE_DIR) + "/configs")) {
+        if (e.path().extension() != ".json") continue;
         std::string out;
-        EXPECT_EQ(test::runCommand(bin() + " validate " + std::string(SHADOWLAB_SOURCE_DIR) + "/configs/" + cfg, out), 0) << out;
+        EXPECT_EQ(test::runCommand(bin() + " validate " + e.path().string(), out), 0) << out;
+        ++n;
+    }
+    EXPECT_GE(n, 2u);
+}
+
+TEST(CliTest, SetOverridesAValueAndIsValidatedLikeTheFile) {
+    const std::string smoke = std::string(SHADOWLAB_SOURCE_DIR) + "/configs/smoke.json";
+    std::string out;
+    // (…) 2>/dev/null: only the resolved config (stdout) is read back.
+    ASSERT_EQ(test::runCommand("(" + bin() + " validate " + smoke + " --set resolution=[32,48] --set algorithms.0.params.pcf=0" +
+                                   " --set light.type=directional 2>/dev/null)", out), 0) << out;
+    Json resolved = Json::parse(out);
+    EXPECT_EQ(resolved["resolution"], Json::array({32, 48}));
+    EXPECT_EQ(resolved["algorithms"][0]["params"]["pcf"], 0);
+    EXPECT_EQ(resolved["light"]["type"], "directional");
+    // A typo or a bad index is bad input: exit code 2 and one line naming the path.
+    for (const char* bad : {"algorithms.0.params.pfc=1", "algorithms.99.params.pcf=1", "resolution", "frames.x=1"}) {
+        EXPECT_EQ(test::runCommand(bin() + " validate " + smoke + " --set " + bad, out), 2) << bad;
+        EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
     }
 }
 

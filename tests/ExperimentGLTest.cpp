@@ -19,7 +19,8 @@ std::string slurp(const std::string& path) {
     return ss.str();
 }
 
-/// Config files are named relative to the source tree (configs/… or tests/data/…).
+/// Config files are named relative to the source tree (configs/… or tests/data/…), optionally
+/// followed by `--set` overrides (e.g. the demo at a test-sized resolution).
 std::string configPath(const std::string& name) { return std::string(SHADOWLAB_SOURCE_DIR) + "/" + name; }
 
 /// Runs `shadowlab run CONFIG --out DIR` once per config for the whole test binary.
@@ -44,6 +45,10 @@ struct AccuracyCase {
     const char* id;
     double maxMismatchPerFrame; ///< share of lit pixels
 };
+// The README's demo (the engine on a plane, its fly-through and light path) at 128², 4 frames
+// spread over the path: the same scene and views as the main job, at a test's cost.
+constexpr const char* kDemoSmall = "configs/demo.json --set resolution=[128,128] --set frames=4 --set warmup_frames=1"
+                                   " --set output.images_at_frames=[3]";
 const AccuracyCase kAccuracy[] = {
     // The reference compared with itself must agree exactly.
     {"configs/smoke.json", "reference", 0.0},
@@ -53,13 +58,16 @@ const AccuracyCase kAccuracy[] = {
     {"configs/smoke.json", "shadow_map", 0.01},
     {"tests/data/lights_spot.json", "shadow_map", 0.01},
     {"tests/data/lights_directional.json", "shadow_map", 0.01},
+    {kDemoSmall, "sm_2k", 0.01},
     // psv is exact up to float rounding in the plane tests of grazing pixels: the bound of
     // 0.1 % of lit pixels (measured: 0 on every smoke frame).
     {"configs/smoke.json", "psv", 0.001},
+    {kDemoSmall, "psv", 0.001},
     // bvh_raytrace traces the reference's own rays (same origin offset, watertight triangle test like
     // Embree's robust mode): the bound of 0.1 % of lit pixels, for hard and soft shadows
     // (measured: 0 on every frame of both configs).
     {"configs/smoke.json", "bvh_raytrace", 0.001},
+    {kDemoSmall, "bvh_raytrace", 0.001},
     {"configs/line_space/soft_smoke.json", "bvh_raytrace", 0.001},
     // line_space is approximate by design: a ray crossing a non-empty shaft counts as blocked even
     // when it passes beside the geometry (paper Fig. 5), so shadows grow by up to a leaf cell and lit
@@ -70,6 +78,8 @@ const AccuracyCase kAccuracy[] = {
     {"configs/smoke.json", "line_space", 0.20},
     {"configs/line_space/soft_smoke.json", "line_space", 0.20},
 };
+
+void PrintTo(const AccuracyCase& c, std::ostream* os) { *os << c.config << " / " << c.id << " ≤ " << c.maxMismatchPerFrame; }
 
 class ExperimentGLTest : public ::testing::TestWithParam<AccuracyCase> {};
 
@@ -88,7 +98,11 @@ TEST_P(ExperimentGLTest, AgreesWithReferenceOnEveryFrame) {
 
 INSTANTIATE_TEST_SUITE_P(Table, ExperimentGLTest, ::testing::ValuesIn(kAccuracy),
                          [](const auto& info) {
-                             std::string n = std::string(info.param.config) + "_" + info.param.id;
+                             // "configs/demo.json --set …" → configs_demo_json_reduced_<id>
+                             std::string config = info.param.config;
+                             const size_t space = config.find(' ');
+                             if (space != std::string::npos) config = config.substr(0, space) + "_reduced";
+                             std::string n = config + "_" + info.param.id;
                              for (char& ch : n)
                                  if (!isalnum(static_cast<unsigned char>(ch))) ch = '_';
                              return n;

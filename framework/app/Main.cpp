@@ -18,11 +18,14 @@ namespace {
 const char* kUsage = R"(shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.
 
 Usage:
-  shadowlab run CONFIG.json [--out DIR] [--force] [--no-progress]
+  shadowlab run CONFIG.json [--out DIR] [--force] [--no-progress] [--set PATH=VALUE]...
       Runs the experiment and writes DIR (default: the config's output.dir): config.resolved.json,
       frames.csv, summary.json, report.md, images/ and plots. An existing DIR is kept unless --force;
       it is replaced only once the new run has completed.
-  shadowlab validate CONFIG.json
+      --set overrides one config value before validation, by dotted path (array elements by
+      index), VALUE as JSON or a plain string: --set resolution=[128,128] --set frames=3
+      --set algorithms.0.params.pcf=0 --set light.type=directional
+  shadowlab validate CONFIG.json [--set PATH=VALUE]...
       Checks the config (and loads its scene) without rendering; prints the resolved config.
   shadowlab list [--json]
       Lists the registered algorithms and their parameters.
@@ -67,6 +70,7 @@ void printList(bool json) {
 
 int run(const std::vector<std::string>& args) {
     std::string config;
+    std::vector<std::string> overrides;
     RunOptions opt;
     for (size_t i = 1; i < args.size(); ++i) {
         const std::string& a = args[i];
@@ -77,6 +81,9 @@ int run(const std::vector<std::string>& args) {
             opt.force = true;
         } else if (a == "--no-progress") {
             opt.progress = false;
+        } else if (a == "--set") {
+            if (++i >= args.size()) usageError("--set needs PATH=VALUE");
+            overrides.push_back(args[i]);
         } else if (!a.empty() && a[0] == '-') {
             usageError("unknown option " + a);
         } else if (config.empty()) {
@@ -86,7 +93,7 @@ int run(const std::vector<std::string>& args) {
         }
     }
     if (config.empty()) usageError("run needs a config file");
-    ExperimentConfig cfg = loadConfig(config);
+    ExperimentConfig cfg = loadConfig(config, true, overrides);
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
     std::fprintf(stderr, "shadowlab: %s, %zu triangles, %d×%d, %d frames on %s (%s)\n", cfg.name.c_str(),
@@ -123,8 +130,13 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "validate") {
-            if (args.size() != 2) usageError("validate needs exactly one config file");
-            ExperimentConfig cfg = loadConfig(args[1]);
+            std::vector<std::string> overrides;
+            for (size_t i = 2; i < args.size(); ++i) {
+                if (args[i] != "--set" || ++i >= args.size()) usageError("validate takes one config file and --set PATH=VALUE");
+                overrides.push_back(args[i]);
+            }
+            if (args.size() < 2) usageError("validate needs a config file");
+            ExperimentConfig cfg = loadConfig(args[1], true, overrides);
             std::cout << cfg.resolved.dump(2) << "\n";
             std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", args[1].c_str(), cfg.scene->triangleCount(),
                          cfg.algorithms.size(), cfg.reference ? " + reference" : "");

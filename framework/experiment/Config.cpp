@@ -143,8 +143,42 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     return c;
 }
 
-ExperimentConfig loadConfig(const std::string& file, bool loadScene) {
+void applyOverride(Json& config, const std::string& assignment) {
+    const size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0)
+        throw InputError("--set", assignment, "expected PATH=VALUE, e.g. resolution=[64,64] or algorithms.0.params.pcf=0");
+    const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+    Json value = Json::parse(text, nullptr, false);
+    if (value.is_discarded()) value = text; // not JSON: a plain string (e.g. light.type=directional)
+    Json* node = &config;
+    std::string walked;
+    size_t start = 0;
+    while (true) {
+        const size_t dot = path.find('.', start);
+        const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+        walked += (walked.empty() ? "" : ".") + key;
+        if (key.empty()) throw InputError("--set", path, "empty path component");
+        Json* next = nullptr;
+        if (node->is_array()) {
+            const bool numeric = key.find_first_not_of("0123456789") == std::string::npos;
+            if (!numeric || std::stoul(key) >= node->size())
+                throw InputError("--set", walked, "no element " + key + " in an array of " + std::to_string(node->size()));
+            next = &(*node)[std::stoul(key)];
+        } else if (node->is_object() || node->is_null()) {
+            next = &(*node)[key];
+        } else {
+            throw InputError("--set", walked, "cannot descend into a " + std::string(node->type_name()));
+        }
+        node = next;
+        if (dot == std::string::npos) break;
+        start = dot + 1;
+    }
+    *node = value;
+}
+
+ExperimentConfig loadConfig(const std::string& file, bool loadScene, const std::vector<std::string>& overrides) {
     Json j = JsonNode::parseFile(file);
+    for (const auto& o : overrides) applyOverride(j, o);
     return parseConfig(j, file, loadScene);
 }
 

@@ -49,7 +49,13 @@ struct ExperimentConfig {
 };
 
 /// Reads and validates a config file (and loads its scene unless `loadScene` is false).
-ExperimentConfig loadConfig(const std::string& file, bool loadScene = true);
+/// `overrides` are "dotted.path=VALUE" assignments applied before validation (applyOverride).
+ExperimentConfig loadConfig(const std::string& file, bool loadScene = true,
+                            const std::vector<std::string>& overrides = {});
+/// Applies one command-line override "a.b.2.c=VALUE" to a config: object keys by name (created when
+/// missing), array elements by index; VALUE is JSON (`[64,64]`, `3`, `true`, `"x"`) or else a plain
+/// string. The result is validated like the file itself, so a typo still fails loudly.
+void applyOverride(Json& config, const std::string& assignment);
 /// Same, from JSON already in memory; `file` names it in errors and anchors relative paths.
 ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loadScene = true);
 
