@@ -7,7 +7,7 @@ PACKAGES=(
   build-essential cmake pkg-config git
   libglm-dev nlohmann-json3-dev libtinygltf-dev libembree-dev libstb-dev libgtest-dev
   libosmesa6-dev libegl-dev libopengl-dev libgl-dev libglfw3-dev libimgui-dev
-  assimp-testmodels python3 python3-matplotlib xvfb xauth
+  assimp-testmodels python3 python3-matplotlib xvfb xauth fonts-dejavu-core
 )
 
 missing=()
