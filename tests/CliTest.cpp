@@ -54,6 +54,25 @@ TEST(CliTest, SetOverridesAValueAndIsValidatedLikeTheFile) {
     }
 }
 
+#ifdef SHADOWLAB_EGL_BINARY
+// shadowlab-egl is the runner for GPU servers; Mesa's EGL (surfaceless llvmpipe) runs it here, so
+// its context, function loading and outputs are tested even without a GPU.
+TEST(CliTest, EglRunnerRunsTheSmokeConfig) {
+    const std::string dir = test::makeTempDir("egl") + "/out";
+    std::string out;
+    ASSERT_EQ(test::runCommand(std::string(SHADOWLAB_EGL_BINARY) + " run " + std::string(SHADOWLAB_SOURCE_DIR) +
+                                   "/configs/smoke.json --no-progress --out " + dir +
+                                   " --set resolution=[64,64] --set frames=2 --set output.images_at_frames=[1]",
+                               out), 0) << out;
+    std::ifstream in(dir + "/summary.json");
+    Json s = Json::parse(in);
+    EXPECT_EQ(s["backend"], "EGL");
+    for (const auto& [id, a] : s["algorithms"].items())
+        if (a["algorithm"] == "psv" || a["algorithm"] == "bvh_raytrace")
+            EXPECT_LE(a["accuracy"]["mismatch_ratio_max"].get<double>(), 0.001) << id; // exact, as on OSMesa
+}
+#endif
+
 // Every malformed glTF of Debian's assimp-testmodels: a one-line error naming the file, exit code 2.
 const char* kMalformed[] = {
     "IndexOutOfRange/IndexOutOfRange.gltf",
