@@ -3,6 +3,7 @@
 #include "algorithms/bvh_raytrace/BvhRaytrace.h"
 #include "algorithms/line_space/LineSpace.h"
 #include "algorithms/psv/Psv.h"
+#include "algorithms/ptsv/Ptsv.h"
 #include "algorithms/reference/Reference.h"
 #include "algorithms/shadow_map/ShadowMap.h"
 
@@ -17,6 +18,7 @@ const std::vector<AlgorithmInfo>& algorithmRegistry() {
         psvInfo(),
         bvhRaytraceInfo(),
         lineSpaceInfo(),
+        ptsvInfo(),
     };
     return registry;
 }

@@ -1,0 +1,438 @@
+#include "algorithms/ptsv/Ptsv.h"
+
+#include "algorithms/ptsv/PtsvLayout.h"
+#include "framework/core/Error.h"
+#include "framework/render/LightUniforms.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <functional>
+
+namespace shadowlab {
+namespace {
+
+const ParamSchema& ptsvSchema() {
+    static const ParamSchema s = ParamSchema()
+        .choice("bounds", "explicit", {"explicit", "implicit"},
+                "node bounds: the tight box of its samples (paper 2.1) or the cluster frustum its key implies",
+                ParamChange::Rebuild)
+        .boolean("culling_planes", true,
+                 "the three additional culling planes through the light and each vertex (paper 2, Figure 4)",
+                 ParamChange::Rebuild)
+        .boolean("two_pass", true,
+                 "two-pass traversal (paper 2.2): pass one stops at split_level and queues jobs, pass two finishes them",
+                 ParamChange::Rebuild)
+        .integer("split_level", 0, 0, PTSV_MAX_LEVELS, "tree depth",
+                 "depth L where pass one queues its jobs (root 0, clusters = levels); 0 = levels - 1",
+                 ParamChange::Update)
+        .integer("tile_size", 8, 2, 16, "px", "cluster tile width and height (paper: 8)", ParamChange::Rebuild)
+        // 22 bits keep the full tree's explicit bounds under 100 MiB (the paper's 1024² needs 24:
+        // there slices become 4× deeper than wide).
+        .integer("max_key_bits", 22, 10, PTSV_MAX_KEY_BITS, "bits",
+                 "cluster key length cap: beyond it depth slices are merged in pairs (bounds memory 24 B × 2^bits)",
+                 ParamChange::Rebuild)
+        // Off by default: it is exact only for closed, consistently wound meshes (as in psv).
+        .boolean("front_face_culling", false,
+                 "only triangles facing away from the light cast; exact for closed meshes only",
+                 ParamChange::Rebuild)
+        // 0 by default: the samples already sit ray_offset in front of their own triangle (the
+        // reference's convention), and any bias lights receivers just behind a caster (measured on
+        // the demo: 1e-6 adds 8 lit pixels to its 60 frames).
+        .real("plane_bias", 0.0, 0.0, 1e-3, "× scene radius",
+              "triangle plane moved away from the light when front faces cast (paper 2), against self-shadowing",
+              ParamChange::Update)
+        // Same key, default and unit as the reference's: the samples are the reference's ray origins.
+        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
+              "sample offset along the surface normal, against self-shadowing", ParamChange::Update)
+        .integer("job_capacity", 1 << 20, 1, 1 << 24, "jobs",
+                 "two-pass job list; jobs that find it full are finished by pass one (counted in overflow)",
+                 ParamChange::Rebuild)
+        .integer("jobs_per_workgroup", 1, 1, 64, "jobs",
+                 "consecutive jobs one traversal workgroup runs in turn (the paper's persistent threads run "
+                 "until the queue is empty; bounded here by llvmpipe's per-invocation loop cap)",
+                 ParamChange::Rebuild)
+        .choice("vote", "auto", {"auto", "ballot", "shared"},
+                "how a node's 32 children are tested together: ballot (ARB_shader_ballot: one subgroup, each "
+                "invocation testing 32 / width children, no barrier), shared (32 invocations, shared memory and a "
+                "barrier per node), auto (ballot where the driver has it)",
+                ParamChange::Rebuild)
+        .choice("leaf_samples", "tile", {"tile", "cluster"},
+                "samples tested at a leaf: the whole tile (paper) or only the cluster's (its key compared first)",
+                ParamChange::Rebuild)
+        .boolean("job_iterations", false,
+                 "record every job's traversal iterations and report the mean of the 1024 largest (Figure 7)",
+                 ParamChange::Rebuild)
+        .boolean("heat_map", false, "count test-and-set operations per pixel (debug view, costs one atomic per test)",
+                 ParamChange::Rebuild);
+    return s;
+}
+
+constexpr GLuint kSetupGroup = 64;   ///< local_size_x of setup.comp and reduce.comp
+constexpr GLuint kMaxGroups = 65535; ///< GL's minimum max work group count per dimension
+
+/// Vote paths (PTSV_BALLOT in traverse.comp), reported as the `vote_path` counter.
+enum Vote { kVoteShared = 0, kVoteBallot = 1 };
+
+class Ptsv final : public ShadowAlgorithm {
+public:
+    explicit Ptsv(const ParamValues& p) : params_(p) {
+        subgroupSize_ = querySubgroupSize();
+        compile();
+    }
+
+    void setScene(const SceneGpu& scene) override {
+        scene_ = &scene;
+        const size_t n = scene.triangleCount();
+        if (n * PTSV_PLANES_PER_TRIANGLE * 16 > maxBlockBytes())
+            throw RuntimeError("ptsv: " + std::to_string(n) + " triangles exceed the largest storage block");
+        planes_ = GlBuffer(std::max<size_t>(n, 1) * PTSV_PLANES_PER_TRIANGLE * 16, nullptr, 0);
+        counters_ = GlBuffer(PTSV_COUNTER_WORDS * sizeof(uint32_t), nullptr, 0);
+        counters_.clearUint(0);
+        countersRead_ = false;
+        layoutKey_ = {}; // the per-job iteration record is sized by the triangle count
+    }
+
+    void resize(glm::ivec2 resolution) override {
+        resolution_ = resolution;
+        layoutKey_ = {}; // per-sample buffers follow in ensureLayout(), which also needs the camera
+        heat_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+    }
+
+    void paramsChanged(const ParamValues& p, ParamChange change) override {
+        params_ = p;
+        if (change != ParamChange::Rebuild) return;
+        compile();
+        layoutKey_ = {};
+    }
+
+    void computeVisibility(const FrameInputs& f) override {
+        if (!scene_) throw RuntimeError("ptsv: computeVisibility() before setScene()");
+        if (f.light.type != LightType::Point && f.light.type != LightType::Directional)
+            throw RuntimeError(std::string("ptsv supports point and directional lights, not ") + toString(f.light.type));
+        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
+        ensureLayout(f.camera);
+        setUniforms(f.camera, f.light);
+        bindAll();
+
+        f.timer.begin("hierarchy");
+        counters_.clearUint(0);
+        if (params_.getBool("job_iterations")) jobIterations_.clearUint(0);
+        glClearNamedBufferSubData(masks_.id(), GL_R32UI, 0, GLsizeiptr(layout_.maskWords * 4), GL_RED_INTEGER,
+                                  GL_UNSIGNED_INT, nullptr);
+        glBindTextureUnit(0, f.gbuffer.position());
+        glBindTextureUnit(1, f.gbuffer.normal());
+        hierarchy_.use();
+        glDispatchCompute(GLuint(layout_.tilesX), GLuint(layout_.tilesY), 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        for (int d = layout_.levels - 1; d >= 1; --d) {
+            const size_t count = layout_.nodesAt(d);
+            reduce_.set("uDepth", d);
+            reduce_.set("uNodeCount", unsigned(count));
+            dispatchLinear(reduce_, count);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        f.timer.end();
+
+        f.timer.begin("setup");
+        const size_t n = scene_->triangleCount();
+        if (n > 0) {
+            setup_.set("uTriangleCount", unsigned(n));
+            dispatchLinear(setup_, n);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        f.timer.end();
+
+        f.timer.begin("traverse");
+        if (n > 0) {
+            // One workgroup per batch of triangles, as a 2D grid past 65535.
+            const size_t perGroup = size_t(params_.getInt("jobs_per_workgroup"));
+            const size_t groups = (n + perGroup - 1) / perGroup;
+            const GLuint gx = GLuint(std::min<size_t>(groups, kMaxGroups)), gy = GLuint((groups + gx - 1) / gx);
+            pass1_.use();
+            glDispatchCompute(gx, gy, 1);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            if (params_.getBool("two_pass")) {
+                jobArgs_.use();
+                glDispatchCompute(1, 1, 1);
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+                glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, counters_.id());
+                pass2_.use();
+                glDispatchComputeIndirect(GLintptr(PTSV_C_DISPATCH * sizeof(uint32_t)));
+                glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            }
+        }
+        f.timer.end();
+
+        f.timer.begin("resolve");
+        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(1, heat_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        resolve_.use();
+        glDispatchCompute(GLuint(layout_.tilesX), GLuint(layout_.tilesY), 1);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        f.timer.end();
+        countersRead_ = false;
+    }
+
+    std::vector<Counter> counters() const override {
+        const auto& c = readCounters();
+        auto wide = [&](int lo, int hi) { return double((uint64_t(c[size_t(hi)]) << 32) | c[size_t(lo)]); };
+        const double jobs1 = c[PTSV_C_JOBS_1];
+        const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(params_.getInt("job_capacity")));
+        std::vector<Counter> out = {{"test_and_set", wide(PTSV_C_TESTS_LO, PTSV_C_TESTS_HI)},
+                {"node_tests", wide(PTSV_C_NODE_TESTS_LO, PTSV_C_NODE_TESTS_HI)},
+                {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
+                {"iterations_mean_pass1", jobs1 > 0 ? c[PTSV_C_ITER_SUM_1] / jobs1 : 0.0},
+                {"iterations_max_pass2", double(c[PTSV_C_ITER_MAX_2])},
+                {"iterations_mean_pass2", pushed > 0 ? c[PTSV_C_ITER_SUM_2] / pushed : 0.0},
+                {"jobs", params_.getBool("two_pass") ? pushed : 0.0},
+                {"job_overflow", double(c[PTSV_C_JOB_OVERFLOW])},
+                {"truncated_jobs", double(c[PTSV_C_TRUNCATED])},
+                {"accepted_nodes", double(c[PTSV_C_ACCEPTED])},
+                {"leaf_visits", double(c[PTSV_C_LEAF_VISITS])},
+                {"clusters", double(c[PTSV_C_CLUSTERS])},
+                {"receivers", double(c[PTSV_C_RECEIVERS])},
+                {"shadowed", double(c[PTSV_C_SHADOWED])},
+                {"casters", jobs1},
+                {"culled_front_facing", double(c[PTSV_C_CULLED_FACING])},
+                {"culled_edge_on", double(c[PTSV_C_CULLED_EDGE_ON])},
+                {"tree_levels", double(layout_.levels)},
+                {"key_bits", double(layout_.keyBits)},
+                {"slices_merged", double(layout_.merged)},
+                {"split_depth", params_.getBool("two_pass") ? double(splitDepth()) : 0.0},
+                {"vote_path", double(vote_)},
+                {"traversal_lanes", double(lanes_)},
+                {"subgroup_size", double(subgroupSize_)}};
+        if (params_.getBool("job_iterations")) {
+            // Figure 7: the jobs that keep a multiprocessor busy longest, against the average.
+            const size_t n = scene_ ? scene_->triangleCount() : 0;
+            std::vector<uint32_t> it = jobIterations_.read<uint32_t>(n + size_t(pushed));
+            auto top = [](std::vector<uint32_t> v) {
+                const size_t k = std::min<size_t>(1024, v.size());
+                std::partial_sort(v.begin(), v.begin() + ptrdiff_t(k), v.end(), std::greater<>());
+                double sum = 0;
+                for (size_t i = 0; i < k; ++i) sum += v[i];
+                return k ? sum / double(k) : 0.0;
+            };
+            std::vector<uint32_t> pass1(it.begin(), it.begin() + ptrdiff_t(n)), pass2(it.begin() + ptrdiff_t(n), it.end());
+            out.push_back({"iterations_top1024_mean_pass1", top(pass1)});
+            out.push_back({"iterations_top1024_mean_pass2", top(pass2)});
+        }
+        return out;
+    }
+
+    std::vector<DebugView> debugViews() const override {
+        if (!params_.getBool("heat_map")) return {};
+        return {{"tests_per_pixel", heat_.id(), 0.0f, "test-and-set"}};
+    }
+
+    /// Child masks, bounds, per-sample buffers, triangle planes, job list and counters (not the
+    /// heat-map image, a debug aid).
+    size_t memoryBytes() const override {
+        size_t bytes = 0;
+        for (const GlBuffer* b : {&masks_, &bounds_, &samples_, &keys_, &shadow_, &heatCounts_, &planes_, &jobs_, &counters_,
+                                  &jobIterations_})
+            bytes += b->size();
+        return bytes;
+    }
+
+    /// Jobs that found the job list full (finished by pass one instead, so the image stays exact: the
+    /// count says the list was too small for the two-pass balance), plus jobs the driver's loop cap
+    /// cut short (their shadows may be missing: must stay 0).
+    uint64_t overflowCount() const override {
+        const auto& c = readCounters();
+        return uint64_t(c[PTSV_C_JOB_OVERFLOW]) + c[PTSV_C_TRUNCATED];
+    }
+
+private:
+    static size_t maxBlockBytes() {
+        GLint64 v = 0;
+        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
+        return size_t(v);
+    }
+
+    int splitDepth() const {
+        const int l = params_.getInt("split_level");
+        return l == 0 ? std::max(1, layout_.levels - 1) : std::min(l, layout_.levels);
+    }
+
+    void compile() {
+        // The ballot path needs the workgroup to be one subgroup: widths dividing 32 give
+        // 32 / width children per invocation; wider subgroups run 32 invocations in one.
+        const bool ballotUsable = subgroupSize_ >= 32 || (subgroupSize_ > 0 && 32 % subgroupSize_ == 0);
+        const std::string vote = params_.getEnum("vote");
+        if (vote == "ballot" && !ballotUsable)
+            throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width dividing 32 or "
+                               "above it (this context: " + std::to_string(subgroupSize_) + ")");
+        vote_ = vote != "shared" && ballotUsable ? kVoteBallot : kVoteShared;
+        lanes_ = vote_ == kVoteBallot ? std::min(subgroupSize_, 32) : 32;
+        auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
+        ShaderDefines defines = {{"PTSV_TILE", std::to_string(params_.getInt("tile_size"))},
+                                 {"PTSV_EXPLICIT_BOUNDS", flag(params_.getEnum("bounds") == "explicit")},
+                                 {"PTSV_CULLING_PLANES", flag(params_.getBool("culling_planes"))},
+                                 {"PTSV_TWO_PASS", flag(params_.getBool("two_pass"))},
+                                 {"PTSV_FRONT_FACE_CULLING", flag(params_.getBool("front_face_culling"))},
+                                 {"PTSV_LEAF_CLUSTER_ONLY", flag(params_.getEnum("leaf_samples") == "cluster")},
+                                 {"PTSV_HEAT_MAP", flag(params_.getBool("heat_map"))},
+                                 {"PTSV_JOB_ITERATIONS", flag(params_.getBool("job_iterations"))},
+                                 {"PTSV_BALLOT", flag(vote_ == kVoteBallot)},
+                                 {"PTSV_LANES", std::to_string(lanes_)},
+                                 {"PTSV_JOBS_PER_GROUP", std::to_string(params_.getInt("jobs_per_workgroup"))}};
+        hierarchy_ = ShaderProgram::compute("ptsv/hierarchy.comp", defines);
+        reduce_ = ShaderProgram::compute("ptsv/reduce.comp", defines);
+        setup_ = ShaderProgram::compute("ptsv/setup.comp", defines);
+        resolve_ = ShaderProgram::compute("ptsv/resolve.comp", defines);
+        ShaderDefines d1 = defines, d2 = defines;
+        d1.push_back({"PTSV_PASS", "1"});
+        d2.push_back({"PTSV_PASS", "2"});
+        pass1_ = ShaderProgram::compute("ptsv/traverse.comp", d1);
+        pass2_ = ShaderProgram::compute("ptsv/traverse.comp", d2);
+        jobArgs_ = ShaderProgram::compute("ptsv/jobs.comp", defines);
+    }
+
+    /// The hierarchy's shape follows the resolution and the camera's field of view and near/far:
+    /// (re)allocated when one of them changes.
+    void ensureLayout(const Camera& camera) {
+        const std::array<float, 6> key = {float(resolution_.x), float(resolution_.y), camera.fovYDeg, camera.nearPlane,
+                                          camera.farPlane, float(params_.getInt("tile_size"))};
+        if (key == layoutKey_ && masks_) return;
+        layoutKey_ = key;
+        const int tile = params_.getInt("tile_size");
+        layout_ = ptsv::makeKeyLayout(resolution_, tile, camera.fovYDeg, camera.nearPlane, camera.farPlane,
+                                      params_.getInt("max_key_bits"));
+        const bool explicitBounds = params_.getEnum("bounds") == "explicit";
+        const size_t boundsBytes = explicitBounds ? layout_.boundsNodes * 6 * sizeof(float) : 4;
+        if (boundsBytes > maxBlockBytes())
+            throw RuntimeError("ptsv: explicit bounds of a full tree with " + std::to_string(layout_.keyBits) +
+                               "-bit keys need " + std::to_string(boundsBytes >> 20) +
+                               " MiB, over this context's storage block limit: use bounds = implicit, a larger "
+                               "tile_size, a lower resolution or a smaller far/near ratio");
+        const size_t slots = size_t(layout_.tilesX) * size_t(layout_.tilesY) * size_t(tile) * size_t(tile);
+        masks_ = GlBuffer(layout_.maskWords * 4, nullptr, 0);
+        bounds_ = GlBuffer(boundsBytes, nullptr, 0);
+        samples_ = GlBuffer(slots * 16, nullptr, 0);
+        keys_ = GlBuffer(slots * 4, nullptr, 0);
+        shadow_ = GlBuffer(slots * 4, nullptr, 0);
+        heatCounts_ = GlBuffer(params_.getBool("heat_map") ? slots * 4 : 4, nullptr, 0);
+        jobs_ = GlBuffer(params_.getBool("two_pass") ? size_t(params_.getInt("job_capacity")) * 8 : 8, nullptr, 0);
+        const size_t jobSlots = scene_->triangleCount() + (params_.getBool("two_pass") ? size_t(params_.getInt("job_capacity")) : 0);
+        // Zero-filled: a culled triangle (no workgroup writes its slot) counts 0 iterations.
+        jobIterations_ = GlBuffer(params_.getBool("job_iterations") ? std::max<size_t>(jobSlots, 1) * 4 : 4, nullptr, 0);
+        warnedSplit_ = false;
+    }
+
+    void setUniforms(const Camera& camera, const Light& light) {
+        const Bounds& b = scene_->bounds();
+        const float radius = b.empty() ? 1.0f : b.radius();
+        const glm::vec3 center = b.empty() ? glm::vec3(0.0f) : b.center();
+        // Rounding of a plane evaluation grows with the coordinates' magnitude (and the light's:
+        // edge planes pass through it); 4e-6 of it is far above float error (psv uses the same) and
+        // only sends nodes that close to a plane one level further down.
+        float magnitude = glm::length(center) + radius + glm::length(camera.position);
+        if (light.type == LightType::Point) magnitude = std::max(magnitude, glm::length(light.position));
+        const float tolerance = 4e-6f * magnitude;
+        const float rayOffset = float(params_.getFloat("ray_offset")) * radius;
+        const float aspect = float(resolution_.x) / float(resolution_.y);
+        const float tanHalf = std::tan(glm::radians(camera.fovYDeg) * 0.5f);
+        const glm::mat4 view = camera.view();
+        const int split = splitDepth();
+        if (params_.getBool("two_pass") && params_.getInt("split_level") > layout_.levels && !warnedSplit_) {
+            std::fprintf(stderr, "ptsv: split_level %d is below the %d-level tree: using %d\n",
+                         params_.getInt("split_level"), layout_.levels, split);
+            warnedSplit_ = true;
+        }
+        for (const ShaderProgram* p : {&hierarchy_, &reduce_, &setup_, &pass1_, &pass2_, &jobArgs_, &resolve_}) {
+            setLightUniforms(*p, light);
+            p->set("uResolution", resolution_);
+            p->set("uTile", layout_.tile);
+            p->set("uTilesX", layout_.tilesX);
+            p->set("uSlices", layout_.slices);
+            p->set("uSliceLog", layout_.sliceLog);
+            p->set("uKeyBits", layout_.keyBits);
+            p->set("uLevels", layout_.levels);
+            glProgramUniform1uiv(p->id(), p->location("uKeyBit"), 32, layout_.keyBit.data());
+            glProgramUniform1uiv(p->id(), p->location("uMaskOffset"), GLsizei(layout_.maskOffset.size()),
+                                 layout_.maskOffset.data());
+            glProgramUniform1uiv(p->id(), p->location("uNodeOffset"), GLsizei(layout_.nodeOffset.size()),
+                                 layout_.nodeOffset.data());
+            p->set("uView", view);
+            p->set("uNear", camera.nearPlane);
+            p->set("uTanHalf", glm::vec2(tanHalf * aspect, tanHalf));
+        }
+        hierarchy_.set("uRayOffset", rayOffset);
+        setup_.set("uPlaneBias", float(params_.getFloat("plane_bias")) * radius);
+        for (const ShaderProgram* p : {&pass1_, &pass2_, &jobArgs_}) {
+            p->set("uTriangleCount", unsigned(scene_->triangleCount()));
+            p->set("uSplitDepth", split);
+            p->set("uJobCapacity", unsigned(params_.getInt("job_capacity")));
+            p->set("uTolerance", tolerance);
+            // q lies within |n| ray_offset of the G-buffer point that chose its implicit node, and
+            // the 16-bit normal's length is within 1e-3 of 1.
+            p->set("uImplicitPad", rayOffset * 1.01f);
+            p->set("uInvView", glm::inverse(view));
+        }
+    }
+
+    void bindAll() const {
+        scene_->bindStorage();
+        masks_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_MASK_BINDING);
+        bounds_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_AABB_BINDING);
+        samples_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_SAMPLE_BINDING);
+        keys_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_KEY_BINDING);
+        shadow_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_SHADOW_BINDING);
+        planes_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_PLANE_BINDING);
+        jobs_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_JOB_BINDING);
+        counters_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_COUNTER_BINDING);
+        jobIterations_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_JOB_ITER_BINDING);
+        heatCounts_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_HEAT_BINDING);
+    }
+
+    /// One invocation per item, as a 2D grid when the count needs more than 65535 groups of 64.
+    static void dispatchLinear(const ShaderProgram& p, size_t count) {
+        const GLuint groups = GLuint((count + kSetupGroup - 1) / kSetupGroup);
+        const GLuint gx = std::min(groups, kMaxGroups), gy = (groups + gx - 1) / gx;
+        p.set("uInvocationsPerRow", unsigned(gx * kSetupGroup));
+        p.use();
+        glDispatchCompute(gx, gy, 1);
+    }
+
+    const std::array<uint32_t, PTSV_COUNTER_WORDS>& readCounters() const {
+        if (!countersRead_ && counters_) {
+            counters_.download(counterValues_.data(), PTSV_COUNTER_WORDS * sizeof(uint32_t));
+            countersRead_ = true;
+        }
+        return counterValues_;
+    }
+
+    ParamValues params_;
+    const SceneGpu* scene_ = nullptr;
+    glm::ivec2 resolution_{0, 0};
+    int subgroupSize_ = 0;
+    Vote vote_ = kVoteShared;
+    int lanes_ = 32; ///< invocations per traversal workgroup
+    ptsv::KeyLayout layout_;
+    std::array<float, 6> layoutKey_{};
+    bool warnedSplit_ = false;
+    ShaderProgram hierarchy_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
+    GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, counters_, jobIterations_;
+    GlTexture heat_;
+    mutable std::array<uint32_t, PTSV_COUNTER_WORDS> counterValues_{};
+    mutable bool countersRead_ = false;
+};
+
+} // namespace
+
+AlgorithmInfo ptsvInfo() {
+    AlgorithmInfo info;
+    info.name = "ptsv";
+    info.summary = "per-triangle shadow volumes through a per-frame view-sample cluster hierarchy (compute)";
+    info.lights = {LightType::Point, LightType::Directional};
+    info.exact = true;
+    info.schema = &ptsvSchema;
+    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<Ptsv>(p); };
+    return info;
+}
+
+} // namespace shadowlab

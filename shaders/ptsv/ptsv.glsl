@@ -1,0 +1,112 @@
+// The view-sample cluster hierarchy of Sintorn et al. 2014: buffers, cluster keys, node bounds and
+// the shadow-volume predicates shared by every ptsv stage.
+// Needs common/scene.glsl and common/light.glsl included before it.
+#include "ptsv/layout.glsl"
+
+layout(std430, binding = PTSV_MASK_BINDING) coherent buffer PtsvMasks { uint ptsvMasks[]; };
+layout(std430, binding = PTSV_AABB_BINDING) buffer PtsvBounds { float ptsvBounds[]; };
+layout(std430, binding = PTSV_SAMPLE_BINDING) buffer PtsvSamples { vec4 ptsvSamples[]; };
+layout(std430, binding = PTSV_KEY_BINDING) buffer PtsvKeys { uint ptsvKeys[]; };
+layout(std430, binding = PTSV_SHADOW_BINDING) buffer PtsvShadow { uint ptsvShadow[]; };
+layout(std430, binding = PTSV_PLANE_BINDING) buffer PtsvPlanes { vec4 ptsvPlanes[]; };
+layout(std430, binding = PTSV_JOB_BINDING) buffer PtsvJobs { uvec2 ptsvJobs[]; };
+layout(std430, binding = PTSV_COUNTER_BINDING) coherent buffer PtsvCounters { uint ptsvCounters[]; };
+layout(std430, binding = PTSV_HEAT_BINDING) buffer PtsvHeat { uint ptsvHeat[]; };
+layout(std430, binding = PTSV_JOB_ITER_BINDING) buffer PtsvJobIterations { uint ptsvJobIterations[]; };
+
+// Hierarchy shape (algorithms/ptsv/PtsvLayout.h computes it on the host).
+uniform ivec2 uResolution;
+uniform int uTile;
+uniform int uTilesX;
+uniform int uSlices;
+uniform float uSliceLog;
+uniform int uKeyBits;
+uniform int uLevels;
+uniform uint uKeyBit[32];
+uniform uint uMaskOffset[PTSV_MAX_LEVELS + 1];
+uniform uint uNodeOffset[PTSV_MAX_LEVELS + 2];
+// Camera: view matrix, near plane, tan of the half field of view in x and y.
+uniform mat4 uView;
+uniform float uNear;
+uniform vec2 uTanHalf;
+
+bool ptsvDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
+
+// ---- Cluster keys ------------------------------------------------------------------------------
+// The loops run to the constant PTSV_MAX_KEY_BITS so the compiler can unroll them: llvmpipe counts
+// every iteration of a non-unrolled loop against its per-invocation cap (see traverse.comp).
+uint ptsvKey(uvec3 c) {
+    uint k = 0u;
+    for (int i = 0; i < PTSV_MAX_KEY_BITS; ++i) {
+        uint e = uKeyBit[i];
+        if (i < uKeyBits) k |= ((c[e & 3u] >> (e >> 2)) & 1u) << uint(i);
+    }
+    return k;
+}
+
+// Cluster-coordinate range [lo, hi) of node `id` at `depth` (its key prefix; the low bits are free).
+void ptsvNodeRange(uint id, int depth, out uvec3 lo, out uvec3 hi) {
+    lo = uvec3(0u);
+    uvec3 freeBits = uvec3(0u);
+    int low = 5 * (uLevels - depth);
+    for (int i = 0; i < PTSV_MAX_KEY_BITS; ++i) {
+        uint e = uKeyBit[i];
+        if (i >= uKeyBits) continue;
+        if (i < low) freeBits[e & 3u] += 1u; // Morton: a coordinate's free bits are its lowest
+        else lo[e & 3u] |= ((id >> uint(i - low)) & 1u) << (e >> 2);
+    }
+    hi = lo + (uvec3(1u) << freeBits);
+}
+
+int ptsvSlice(float viewDepth) {
+    float z = floor(log(viewDepth / uNear) / uSliceLog);
+    return int(clamp(z, 0.0, float(uSlices - 1)));
+}
+
+uint ptsvTileSamples() { return uint(uTile * uTile); }
+
+// ---- Shadow volume predicates --------------------------------------------------------------------
+// `precise`: a shared edge's plane P and its exact negation -P are evaluated at the same code site,
+// so s(-P) is exactly -s(P): a point on a closed mesh's edge is inside one of the two volumes.
+float ptsvSigned(vec4 plane, vec3 x) {
+    precise float s = dot(plane.xyz, x) + plane.w;
+    return s;
+}
+
+vec4 ptsvPlane(uint triangle, uint i) { return ptsvPlanes[PTSV_PLANES_PER_TRIANGLE * triangle + i]; }
+uint ptsvStatus(uint triangle) { return floatBitsToUint(ptsvPlane(triangle, 7u).x); }
+
+// The exact per-sample test (the test of test-and-set): inside the three edge planes (closed) and
+// strictly behind the (biased) triangle plane, i.e. the segment from q to the light crosses it.
+bool ptsvInVolume(vec4 e0, vec4 e1, vec4 e2, vec4 cap, vec3 q) {
+    return ptsvSigned(e0, q) <= 0.0 && ptsvSigned(e1, q) <= 0.0 && ptsvSigned(e2, q) <= 0.0 && ptsvSigned(cap, q) < 0.0;
+}
+
+// Smallest and largest value of a plane over a world-space box (the n- and p-vertices).
+vec2 ptsvBoxRange(vec4 plane, vec3 bmin, vec3 bmax) {
+    vec3 nv = mix(bmax, bmin, greaterThanEqual(plane.xyz, vec3(0.0)));
+    vec3 pv = mix(bmin, bmax, greaterThanEqual(plane.xyz, vec3(0.0)));
+    return vec2(dot(plane.xyz, nv), dot(plane.xyz, pv)) + plane.w;
+}
+
+// Smallest and largest value of a view-space plane over an implicit node: the frustum segment
+// {(X d, Y d, -d)} for X, Y in a tile range and d in a depth range. For a fixed d the value is
+// linear in (X, Y), so its extremes over the segment lie at its corners.
+vec2 ptsvFrustumRange(vec4 plane, vec2 xr, vec2 yr, vec2 dr) {
+    float gmin = min(plane.x * xr.x, plane.x * xr.y) + min(plane.y * yr.x, plane.y * yr.y) - plane.z;
+    float gmax = max(plane.x * xr.x, plane.x * xr.y) + max(plane.y * yr.x, plane.y * yr.y) - plane.z;
+    return vec2(min(dr.x * gmin, dr.y * gmin), max(dr.x * gmax, dr.y * gmax)) + plane.w;
+}
+
+// View-space extent of the implicit node: tan-scaled x and y ranges and the depth range, padded so
+// that rounding of the key computation can never leave a sample outside its node.
+void ptsvImplicitExtent(uint id, int depth, out vec2 xr, out vec2 yr, out vec2 dr) {
+    uvec3 lo, hi;
+    ptsvNodeRange(id, depth, lo, hi);
+    vec2 px = vec2(min(ivec2(lo.x, hi.x) * uTile, ivec2(uResolution.x)));
+    vec2 py = vec2(min(ivec2(lo.y, hi.y) * uTile, ivec2(uResolution.y)));
+    xr = (2.0 * px / float(uResolution.x) - 1.0) * uTanHalf.x;
+    yr = (2.0 * py / float(uResolution.y) - 1.0) * uTanHalf.y;
+    float d0 = uNear * exp(float(lo.z) * uSliceLog), d1 = uNear * exp(float(min(hi.z, uint(uSlices))) * uSliceLog);
+    dr = vec2(d0 * (1.0 - 1e-4), d1 * (1.0 + 1e-4));
+}

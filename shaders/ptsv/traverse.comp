@@ -1,0 +1,270 @@
+#version 450
+// Traversal (paper 2 and Algorithm 1): a workgroup walks each of its jobs' shadow volume down the
+// hierarchy, testing the 32 children of a node at once: outside any plane → rejected; inside all
+// four → trivially accepted (its bit is cleared in the node's mask, resolve.comp shadows its
+// samples); otherwise the additional culling planes may still reject it; else it is intersected
+// and visited in turn. At the leaf level the invocations test the tile's samples (test-and-set).
+//
+// PTSV_PASS 1: jobs are triangles, from the root. With PTSV_TWO_PASS a node reached at depth
+//              uSplitDepth is pushed as a (triangle, node) job instead of being visited (paper 2.2);
+//              when the job list is full it is visited here instead (counted, never dropped).
+// PTSV_PASS 2: jobs are the pushed pairs, continued from their node.
+//
+// PTSV_BALLOT 1: the workgroup is one subgroup of PTSV_LANES invocations (the driver's subgroup
+//   width, at most 32) and each invocation tests 32 / PTSV_LANES children: votes are
+//   ARB_shader_ballot words, with no shared memory and no barrier at all.
+// PTSV_BALLOT 0: 32 invocations, one child each, votes through shared memory and a barrier.
+//
+// The paper runs persistent threads, each warp taking jobs from a queue until it is empty; llvmpipe
+// caps the loop iterations of one invocation at 65535 in total, so here a workgroup takes a fixed
+// batch of PTSV_JOBS_PER_GROUP consecutive jobs and the hardware scheduler hands out the batches;
+// a job cut short by such a cap is detected (a loop left without its exit condition) and reported.
+#if PTSV_BALLOT
+#extension GL_ARB_shader_ballot : require
+#extension GL_ARB_gpu_shader_int64 : require
+#endif
+#include "common/light.glsl"
+#include "common/scene.glsl"
+#include "ptsv/ptsv.glsl"
+layout(local_size_x = PTSV_LANES) in;
+#define lane gl_LocalInvocationIndex
+#define ROUNDS (32u / uint(PTSV_LANES)) // children tested by each invocation per node
+
+uniform uint uTriangleCount;
+uniform int uSplitDepth;    // depth of the nodes pushed by pass one (1 .. levels)
+uniform uint uJobCapacity;  // entries of the job list
+uniform float uTolerance;   // world units: plane values this close to 0 count as touching
+uniform float uImplicitPad; // world units: how far a sample's q may lie outside its implicit node
+uniform mat4 uInvView;      // view → world (implicit bounds test in view space)
+
+// ---- Votes ---------------------------------------------------------------------------------------
+#if !PTSV_BALLOT
+// Three slots: slot i % 3 is written in vote i, read after its barrier, and cleared by invocation 0
+// after the barrier of vote i + 1 (when every invocation has read it), two votes before its reuse.
+shared uint sVote[3][2];
+shared uint sBroadcast;
+uint voteSeq = 0u;
+#endif
+
+// Bit `lane` of x: a, bit `lane` of y: b, over the workgroup (children round * PTSV_LANES + lane).
+uvec2 vote2(bool a, bool b) {
+#if PTSV_BALLOT
+    return uvec2(unpackUint2x32(ballotARB(a)).x, unpackUint2x32(ballotARB(b)).x);
+#else
+    uint slot = voteSeq % 3u;
+    if (a) atomicOr(sVote[slot][0], 1u << lane);
+    if (b) atomicOr(sVote[slot][1], 1u << lane);
+    barrier();
+    uvec2 r = uvec2(sVote[slot][0], sVote[slot][1]);
+    if (lane == 0u) sVote[(slot + 2u) % 3u] = uint[2](0u, 0u);
+    ++voteSeq;
+    return r;
+#endif
+}
+
+// A value invocation 0 computed, for every invocation.
+uint broadcast(uint v) {
+#if PTSV_BALLOT
+    return readFirstInvocationARB(v);
+#else
+    if (lane == 0u) sBroadcast = v;
+    barrier();
+    uint r = sBroadcast;
+    barrier();
+    return r;
+#endif
+}
+
+// ---- One job -------------------------------------------------------------------------------------
+const vec4 kZero7[7] = vec4[7](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
+vec4 gPlane[7] = kZero7; // world space: edges 0..2, triangle plane 3, culling planes 4..6
+vec4 gView[7] = kZero7;  // the same in view space (implicit bounds)
+uint gTriangle = 0u;
+uint gTests = 0u, gNodeTests = 0u, gLeafVisits = 0u, gAccepted = 0u, gIterations = 0u;
+bool gTruncated = false; // a loop ended without its exit condition: the driver's iteration cap
+
+// Classifies child `childId` at `depth` against the volume: x = rejected, y = trivially accepted.
+bvec2 classify(uint childId, int depth) {
+    vec2 r[4];
+#if PTSV_EXPLICIT_BOUNDS
+    uint b = 6u * (uNodeOffset[depth] + childId);
+    vec3 bmin = vec3(ptsvBounds[b], ptsvBounds[b + 1u], ptsvBounds[b + 2u]);
+    vec3 bmax = vec3(ptsvBounds[b + 3u], ptsvBounds[b + 4u], ptsvBounds[b + 5u]);
+    float pad = uTolerance;
+    for (int i = 0; i < 4; ++i) r[i] = ptsvBoxRange(gPlane[i], bmin, bmax);
+#else
+    vec2 xr, yr, dr;
+    ptsvImplicitExtent(childId, depth, xr, yr, dr);
+    float pad = uTolerance + uImplicitPad;
+    for (int i = 0; i < 4; ++i) r[i] = ptsvFrustumRange(gView[i], xr, yr, dr);
+#endif
+    bool rejected = false, accepted = true;
+    for (int i = 0; i < 4; ++i) {
+        rejected = rejected || r[i].x > pad;
+        accepted = accepted && r[i].y < -pad;
+    }
+#if PTSV_CULLING_PLANES
+    // Only where the four planes decide nothing, as in the paper.
+    for (int i = 4; i < 7 && !rejected && !accepted; ++i) {
+#if PTSV_EXPLICIT_BOUNDS
+        rejected = ptsvBoxRange(gPlane[i], bmin, bmax).x > pad;
+#else
+        rejected = ptsvFrustumRange(gView[i], xr, yr, dr).x > pad;
+#endif
+    }
+#endif
+    return bvec2(rejected, accepted && !rejected);
+}
+
+// Tests the samples of cluster `key`'s tile against the volume and marks the shadowed ones.
+void testSamples(uint key) {
+    ++gIterations;
+    uvec3 lo, hi;
+    ptsvNodeRange(key, uLevels, lo, hi);
+    uint first = (lo.y * uint(uTilesX) + lo.x) * ptsvTileSamples();
+    uint s = lane;
+    for (; s < ptsvTileSamples(); s += uint(PTSV_LANES)) {
+        uint k = ptsvKeys[first + s];
+#if PTSV_LEAF_CLUSTER_ONLY
+        if (k != key) continue;
+#else
+        if (k >= PTSV_KEY_AWAY) continue;
+#endif
+        ++gTests;
+#if PTSV_HEAT_MAP
+        atomicAdd(ptsvHeat[first + s], 1u);
+#endif
+        if (ptsvInVolume(gPlane[0], gPlane[1], gPlane[2], gPlane[3], ptsvSamples[first + s].xyz))
+            ptsvShadow[first + s] = 1u;
+    }
+    if (s < ptsvTileSamples()) gTruncated = true;
+    if (lane == 0u) ++gLeafVisits;
+}
+
+// Tests the children of node (depth, id); returns the intersected ones, clears the accepted ones.
+uint visit(int depth, uint id) {
+    ++gIterations;
+    uint maskIndex = uMaskOffset[depth] + id;
+    uint mask = ptsvMasks[maskIndex];
+    uvec2 v = uvec2(0u);
+    for (uint round = 0u; round < ROUNDS; ++round) {
+        uint c = round * uint(PTSV_LANES) + lane;
+        bool exists = ((mask >> c) & 1u) != 0u;
+        bvec2 r = exists ? classify(id * 32u + c, depth + 1) : bvec2(true, false);
+        if (exists) ++gNodeTests;
+        v |= vote2(!r.x && !r.y, r.y) << (round * uint(PTSV_LANES));
+    }
+    if (v.y != 0u && lane == 0u) {
+        atomicAnd(ptsvMasks[maskIndex], ~v.y);
+        gAccepted += uint(bitCount(v.y));
+    }
+    return v.x;
+}
+
+// Depth-first walk below node (depth, id). Entry d of the stack holds the node visited at depth d
+// and its intersected children still to visit; every invocation keeps the same stack.
+void traverse(int depth, uint id) {
+    uint stackId[PTSV_MAX_LEVELS];
+    uint stackMask[PTSV_MAX_LEVELS];
+    int top = depth;
+    stackId[top] = id;
+    stackMask[top] = visit(depth, id);
+    while (true) {
+        while (top >= depth && stackMask[top] == 0u) --top; // deepest level with children left
+        if (top < depth) break;
+        int c = findLSB(stackMask[top]);
+        stackMask[top] &= stackMask[top] - 1u;
+        uint childId = stackId[top] * 32u + uint(c);
+        int childDepth = top + 1;
+#if PTSV_PASS == 1 && PTSV_TWO_PASS
+        if (childDepth == uSplitDepth) {
+            uint slot = 0u;
+            if (lane == 0u) {
+                slot = atomicAdd(ptsvCounters[PTSV_C_JOBS_PUSHED], 1u);
+                if (slot < uJobCapacity) ptsvJobs[slot] = uvec2(gTriangle, childId);
+                else atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], 1u);
+            }
+            if (broadcast(slot) < uJobCapacity) continue; // pass two finishes it
+            // The list is full: finish this subtree here, exactly as the one-pass traversal would.
+        }
+#endif
+        if (childDepth == uLevels) {
+            testSamples(childId);
+            continue;
+        }
+        top = childDepth;
+        stackId[top] = childId;
+        stackMask[top] = visit(childDepth, childId);
+    }
+    if (top >= depth) gTruncated = true;
+}
+
+void loadTriangle(uint t) {
+    gTriangle = t;
+    for (uint i = 0u; i < 7u; ++i) {
+        gPlane[i] = ptsvPlane(t, i);
+#if !PTSV_EXPLICIT_BOUNDS
+        gView[i] = gPlane[i] * uInvView; // row vector: the plane's values carry over to view space
+#endif
+    }
+}
+
+// Per job: the Figure 7 statistics (invocation 0 speaks for the workgroup).
+void finishJob(uint job) {
+    if (lane != 0u) return;
+#if PTSV_JOB_ITERATIONS
+    ptsvJobIterations[PTSV_PASS == 1 ? job : uTriangleCount + job] = gIterations;
+#endif
+#if PTSV_PASS == 1
+    atomicMax(ptsvCounters[PTSV_C_ITER_MAX_1], gIterations);
+    atomicAdd(ptsvCounters[PTSV_C_ITER_SUM_1], gIterations);
+    atomicAdd(ptsvCounters[PTSV_C_JOBS_1], 1u);
+#else
+    atomicMax(ptsvCounters[PTSV_C_ITER_MAX_2], gIterations);
+    atomicAdd(ptsvCounters[PTSV_C_ITER_SUM_2], gIterations);
+#endif
+}
+
+void main() {
+    // Each workgroup takes PTSV_JOBS_PER_GROUP consecutive jobs (2D grid past 65535 groups).
+    uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+#if PTSV_PASS == 1
+    uint count = uTriangleCount;
+#else
+    uint count = min(ptsvCounters[PTSV_C_JOBS_PUSHED], uJobCapacity);
+#endif
+#if !PTSV_BALLOT
+    if (lane == 0u) sVote[0] = sVote[1] = sVote[2] = uint[2](0u, 0u);
+    barrier();
+#endif
+    for (uint k = 0u; k < uint(PTSV_JOBS_PER_GROUP); ++k) {
+        uint job = group * uint(PTSV_JOBS_PER_GROUP) + k;
+        if (job >= count) break; // the same for the whole workgroup
+        gIterations = 0u;
+#if PTSV_PASS == 1
+        if (ptsvStatus(job) != PTSV_CASTER_OK) continue;
+        loadTriangle(job);
+        traverse(0, 0u);
+#else
+        uvec2 pair = ptsvJobs[job];
+        loadTriangle(pair.x);
+        if (uSplitDepth == uLevels) testSamples(pair.y); // the job is a leaf cluster
+        else traverse(uSplitDepth, pair.y);
+#endif
+        finishJob(job);
+    }
+    // Totals (no barrier: one atomic per invocation that has something to add).
+    if (gTests != 0u) {
+        uint old = atomicAdd(ptsvCounters[PTSV_C_TESTS_LO], gTests);
+        if (old + gTests < old) atomicAdd(ptsvCounters[PTSV_C_TESTS_HI], 1u); // carry
+    }
+    if (gNodeTests != 0u) {
+        uint old = atomicAdd(ptsvCounters[PTSV_C_NODE_TESTS_LO], gNodeTests);
+        if (old + gNodeTests < old) atomicAdd(ptsvCounters[PTSV_C_NODE_TESTS_HI], 1u);
+    }
+    if (gTruncated) atomicAdd(ptsvCounters[PTSV_C_TRUNCATED], 1u);
+    if (lane == 0u) {
+        if (gAccepted != 0u) atomicAdd(ptsvCounters[PTSV_C_ACCEPTED], gAccepted);
+        if (gLeafVisits != 0u) atomicAdd(ptsvCounters[PTSV_C_LEAF_VISITS], gLeafVisits);
+    }
+}
