@@ -2,6 +2,7 @@
 #include "algorithms/ShadowAlgorithm.h"
 #include "algorithms/bvh_raytrace/BvhRaytrace.h"
 #include "algorithms/line_space/LineSpace.h"
+#include "algorithms/metric_tree/MetricTree.h"
 #include "algorithms/psv/Psv.h"
 #include "algorithms/ptsv/Ptsv.h"
 #include "algorithms/reference/Reference.h"
@@ -19,6 +20,7 @@ const std::vector<AlgorithmInfo>& algorithmRegistry() {
         bvhRaytraceInfo(),
         lineSpaceInfo(),
         ptsvInfo(),
+        metricTreeInfo(),
     };
     return registry;
 }

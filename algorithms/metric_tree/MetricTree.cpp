@@ -1,0 +1,351 @@
+#include "algorithms/metric_tree/MetricTree.h"
+
+#include "algorithms/metric_tree/ClusterCache.h"
+#include "algorithms/metric_tree/Clustering.h"
+#include "algorithms/metric_tree/CpuTree.h"
+#include "algorithms/metric_tree/MetricTreeGpuLayout.h"
+#include "algorithms/metric_tree/MetricTreeMath.h"
+#include "framework/core/Error.h"
+#include "framework/render/LightUniforms.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+
+namespace shadowlab {
+namespace {
+
+const ParamSchema& metricTreeSchema() {
+    static const ParamSchema s = ParamSchema()
+        .integer("cluster_size", 16, 2, 64, "triangles",
+                 "most triangles per cluster (paper: 16 to 32); fewer clusters build faster, more triangles are tested",
+                 ParamChange::Rebuild)
+        .boolean("capsules", true,
+                 "bound elongated clusters (OBB longest extent >= 2x the others) by capsules, else spheres only",
+                 ParamChange::Rebuild)
+        .boolean("slabs", true, "test the shadow ray against a cluster's two slabs before its triangles (paper step 2)",
+                 ParamChange::Rebuild)
+        .boolean("overlap_interval", true,
+                 "visit an overlap child only when the point's distance is inside its [min, max] (paper step 3)",
+                 ParamChange::Rebuild)
+        .boolean("depth_skip", true,
+                 "skip a subtree whose geometry is all farther from the light than the point (paper step 1)",
+                 ParamChange::Rebuild)
+        // Off by default: exact for closed meshes only (an open mesh would leak light through its back).
+        .boolean("normal_cone_culling", false,
+                 "drop clusters whose normal cone faces the light (paper 5.3); exact for closed meshes only",
+                 ParamChange::Rebuild)
+        .boolean("random_order", true,
+                 "insert the clusters in a seeded shuffled order (pivots spread over the scene) instead of Morton order",
+                 ParamChange::Rebuild)
+        .integer("seed", 1, 0, INT_MAX, "", "seed of the k-means seeding and of the insertion order", ParamChange::Rebuild)
+        .choice("tree_builder", "gpu", {"gpu", "cpu"},
+                "gpu: concurrent insertion with the delta-halving heuristic (paper 5.3); cpu: median partitioning "
+                "with Yianilos pivots (the paper's Table 2 reference, slow)",
+                ParamChange::Update)
+        .integer("stack_size", 64, 1, 256, "nodes",
+                 "query stack; a pixel that overflows it is written shadowed and counted", ParamChange::Rebuild)
+        .boolean("cache", true,
+                 "reuse the clustering from the disk cache ($XDG_CACHE_HOME or ~/.cache /shadowlab/metric_tree)",
+                 ParamChange::Rebuild)
+        // Same key, default and unit as the reference's: the query point is the reference's ray origin.
+        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
+              "query point offset along the surface normal, against self-shadowing", ParamChange::Update);
+    return s;
+}
+
+constexpr GLuint kGroup = 64;        ///< local_size_x of prepare.comp and insert.comp
+constexpr GLuint kMaxGroups = 65535; ///< GL's minimum max work group count per dimension
+/// Light-space margin of a point light, in radians: above the ~1e-7 rad rounding of the angles and
+/// the up to 5e-5 rad error of a short arc's great circle (see prepare.comp).
+constexpr float kAngularEps = 1e-4f;
+
+class MetricTree final : public ShadowAlgorithm {
+public:
+    explicit MetricTree(const ParamValues& p) : params_(p) { compile(); }
+
+    void setScene(const SceneGpu& scene) override {
+        scene_ = &scene;
+        const size_t n = scene.triangleCount();
+        if (n > size_t(MT_GEOMETRY_CHUNKS) * MT_TRIANGLES_PER_CHUNK)
+            throw RuntimeError("metric_tree: " + std::to_string(n) + " triangles exceed the " +
+                               std::to_string(size_t(MT_GEOMETRY_CHUNKS) * MT_TRIANGLES_PER_CHUNK) +
+                               " the geometry blocks hold");
+        clusters_ = GlBuffer(), nodes_ = GlBuffer();
+        for (GlBuffer& g : geometry_) g = GlBuffer();
+        mt::Clustering c = cluster(scene.cpu());
+        clusterCount_ = c.clusters.size();
+        capsuleCount_ = c.capsules;
+        clusters_ = GlBuffer::fromVector(c.clusters, 0);
+        nodes_ = GlBuffer(std::max<size_t>(1, clusterCount_) * MT_NODE_BYTES, nullptr, GL_DYNAMIC_STORAGE_BIT);
+        counters_ = GlBuffer(mt::kCounterBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+        counters_.clearUint(0);
+        // The triangles in cluster order, split over blocks of at most MT_TRIANGLES_PER_CHUNK.
+        geometryBytes_ = 0;
+        const Scene& s = scene.cpu();
+        for (size_t chunk = 0; chunk * MT_TRIANGLES_PER_CHUNK < n; ++chunk) {
+            const size_t begin = chunk * MT_TRIANGLES_PER_CHUNK, end = std::min(n, begin + MT_TRIANGLES_PER_CHUNK);
+            std::vector<float> v;
+            v.reserve(9 * (end - begin));
+            for (size_t i = begin; i < end; ++i)
+                for (int k = 0; k < 3; ++k) {
+                    const glm::vec3 p = s.positions[3 * size_t(c.order[i]) + k];
+                    v.insert(v.end(), {p.x, p.y, p.z});
+                }
+            geometry_[chunk] = GlBuffer::fromVector(v, 0);
+            geometryBytes_ += geometry_[chunk].size();
+        }
+        if (!geometry_[0]) geometry_[0] = GlBuffer(36, nullptr, 0); // an empty scene still binds its blocks
+        countersRead_ = false;
+    }
+
+    void resize(glm::ivec2 resolution) override {
+        resolution_ = resolution;
+        nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+        triangleTests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+        fruitless_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+        overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+    }
+
+    void paramsChanged(const ParamValues& p, ParamChange change) override {
+        params_ = p;
+        if (change == ParamChange::Rebuild) compile(); // setScene() follows a Rebuild
+    }
+
+    void computeVisibility(const FrameInputs& f) override {
+        if (!scene_) throw RuntimeError("metric_tree: computeVisibility() before setScene()");
+        if (f.light.type != LightType::Point && f.light.type != LightType::Directional)
+            throw RuntimeError(std::string("metric_tree supports point and directional lights, not ") + toString(f.light.type));
+        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
+        setUniforms(f.light);
+        bind();
+
+        f.timer.begin("build");
+        counters_.clearUint(0); // also empties the tree: its root pointer is counter word 0
+        if (clusterCount_ > 0) {
+            dispatchPerCluster(prepare_);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+            if (params_.getEnum("tree_builder") == "cpu") {
+                buildOnCpu(f.light);
+            } else {
+                dispatchPerCluster(insert_);
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            }
+        }
+        f.timer.end();
+
+        f.timer.begin("traverse");
+        glBindTextureUnit(0, f.gbuffer.position());
+        glBindTextureUnit(1, f.gbuffer.normal());
+        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(2, triangleTests_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(3, fruitless_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(4, overflow_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        query_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        f.timer.end();
+        countersRead_ = false;
+    }
+
+    std::vector<Counter> counters() const override {
+        const auto& c = readCounters();
+        auto wide = [&](int lo) { return double((uint64_t(c[lo + 1]) << 32) | c[lo]); };
+        const double px = c[MT_C_TRAVERSED];
+        auto perPixel = [&](int lo) { return px > 0 ? wide(lo) / px : 0.0; };
+        const double n = double(clusterCount_);
+        return {{"clusters", n},
+                {"capsule_percent", n > 0 ? 100.0 * double(capsuleCount_) / n : 0.0},
+                {"triangles_per_cluster", n > 0 ? double(scene_->triangleCount()) / n : 0.0},
+                {"bytes_per_cluster", n > 0 ? double(mt::structureBytes(clusterCount_)) / n : 0.0},
+                {"geometry_bytes", double(geometryBytes_)},
+                {"clusters_inserted", double(c[MT_C_INSERTED])},
+                {"clusters_culled", double(c[MT_C_CULLED])},
+                {"insert_depth_max", double(c[MT_C_INSERT_DEPTH_MAX])},
+                {"build_errors", double(c[MT_C_BUILD_ERRORS])},
+                {"traversed_pixels", px},
+                {"nodes_visited_mean", perPixel(MT_C_VISITED_LO)},
+                {"nodes_visited_max", double(c[MT_C_VISITED_MAX])},
+                {"triangle_tests_mean", perPixel(MT_C_TRIANGLES_LO)},
+                {"triangle_tests_max", double(c[MT_C_TRIANGLES_MAX])},
+                {"fruitless_clusters_mean", perPixel(MT_C_FRUITLESS_LO)},
+                {"fruitless_clusters_max", double(c[MT_C_FRUITLESS_MAX])},
+                {"cone_hits_mean", perPixel(MT_C_CONE_HITS_LO)},
+                {"slab_rejects_mean", perPixel(MT_C_SLAB_REJECTS_LO)},
+                {"depth_skips_mean", perPixel(MT_C_DEPTH_SKIPS_LO)},
+                {"stack_overflow_pixels", double(c[MT_C_STACK_OVERFLOW])},
+                {"cache_hit", cacheHit_ ? 1.0 : 0.0},
+                {"clustering_ms", clusteringMs_}};
+    }
+
+    std::vector<DebugView> debugViews() const override {
+        return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"},
+                {"triangle_tests", triangleTests_.id(), 0.0f, "triangles"},
+                {"fruitless_clusters", fruitless_.id(), 0.0f, "clusters"},
+                {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
+    }
+
+    /// Clusters and nodes (64 bytes each: 128 per cluster, the paper's figure) plus the 128-byte
+    /// counter block. Not counted, as in the paper: the triangles themselves, which metric_tree
+    /// keeps in cluster order (counter geometry_bytes), and the per-pixel debug images.
+    size_t memoryBytes() const override { return mt::structureBytes(clusterCount_) + mt::kCounterBytes; }
+
+    /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
+    uint64_t overflowCount() const override {
+        const auto& c = readCounters();
+        return uint64_t(c[MT_C_STACK_OVERFLOW]) + c[MT_C_BUILD_ERRORS];
+    }
+
+private:
+    void compile() {
+        auto flag = [&](const char* key) { return params_.getBool(key) ? std::string("1") : std::string("0"); };
+        const ShaderDefines defines = {{"MT_SLABS", flag("slabs")},
+                                       {"MT_OVERLAP_INTERVAL", flag("overlap_interval")},
+                                       {"MT_DEPTH_SKIP", flag("depth_skip")},
+                                       {"MT_NORMAL_CONE_CULLING", flag("normal_cone_culling")},
+                                       {"MT_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
+        prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
+        insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
+        query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
+    }
+
+    /// The clustering from the disk cache when allowed and valid, else computed (and cached).
+    mt::Clustering cluster(const Scene& scene) {
+        const auto start = std::chrono::steady_clock::now();
+        mt::ClusteringOptions o;
+        o.clusterSize = params_.getInt("cluster_size");
+        o.capsules = params_.getBool("capsules");
+        o.randomOrder = params_.getBool("random_order");
+        o.seed = uint32_t(params_.getInt("seed"));
+        cacheHit_ = false;
+        const std::string dir = params_.getBool("cache") ? mt::cacheDirectory() : std::string();
+        std::string path, why;
+        const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
+        if (!dir.empty()) {
+            path = mt::cacheFile(dir, hash, o);
+            if (std::optional<mt::Clustering> c = mt::loadCache(path, hash, o, scene.triangleCount(), &why)) {
+                cacheHit_ = true;
+                clusteringMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                return std::move(*c);
+            }
+            if (why.rfind("no cache file", 0) != 0)
+                std::fprintf(stderr, "metric_tree: ignoring cache file %s (%s); reclustering\n", path.c_str(), why.c_str());
+        }
+        mt::Clustering c = mt::clusterScene(scene, o);
+        if (!dir.empty() && !mt::saveCache(path, hash, o, scene.triangleCount(), c, &why))
+            std::fprintf(stderr, "metric_tree: cannot write the cache (%s); continuing without it\n", why.c_str());
+        clusteringMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return c;
+    }
+
+    void bind() const {
+        clusters_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_CLUSTER_BINDING);
+        nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_NODE_BINDING);
+        counters_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_COUNTER_BINDING);
+        for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i) // unused blocks alias chunk 0: never read, but bound
+            (geometry_[i] ? geometry_[i] : geometry_[0]).bindBase(GL_SHADER_STORAGE_BUFFER, MT_GEOMETRY_BINDING_0 + i);
+    }
+
+    void setUniforms(const Light& light) {
+        const Bounds& b = scene_->bounds();
+        const float radius = b.empty() ? 1.0f : b.radius();
+        const glm::vec3 centre = b.empty() ? glm::vec3(0.0f) : b.center();
+        const bool directional = light.type == LightType::Directional;
+        // Rounding grows with the coordinates' magnitude (and the light's); 4e-6 of it is far above
+        // float error and only widens bounds by that much.
+        float magnitude = glm::length(centre) + radius;
+        if (!directional) magnitude = std::max(magnitude, glm::length(light.position));
+        const float tolerance = 4e-6f * magnitude;
+        lsEps_ = directional ? tolerance : kAngularEps;
+        const glm::vec3 d = light.direction();
+        const glm::vec3 helper = std::abs(d.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+        const glm::vec3 u = glm::normalize(glm::cross(d, helper)), v = glm::cross(d, u);
+        // The initial partitioning distance: the scene's bounding sphere seen from the light.
+        float delta0 = radius;
+        if (!directional) {
+            const float dist = glm::length(centre - light.position);
+            delta0 = radius < 0.999f * dist ? std::asin(radius / dist) : 0.5f * mt::kPi;
+        }
+        const glm::vec3 depthOrigin = centre - d * (2.0f * radius);
+        const unsigned n = unsigned(clusterCount_);
+        for (const ShaderProgram* p : {&prepare_, &insert_, &query_}) {
+            setLightUniforms(*p, light);
+            p->set("uClusterCount", n);
+            p->set("uLsEps", lsEps_);
+            p->set("uLightU", u);
+            p->set("uLightV", v);
+            p->set("uDepthOrigin", depthOrigin);
+        }
+        prepare_.set("uDepthTolerance", tolerance);
+        insert_.set("uDelta0", delta0);
+        query_.set("uRayOffset", float(params_.getFloat("ray_offset")) * radius);
+        query_.set("uSlabTolerance", tolerance);
+    }
+
+    /// One invocation per cluster, as a 2D grid when the clusters need more than 65535 groups.
+    void dispatchPerCluster(const ShaderProgram& p) const {
+        const GLuint groups = GLuint((clusterCount_ + kGroup - 1) / kGroup);
+        const GLuint gx = std::min(groups, kMaxGroups), gy = (groups + gx - 1) / gx;
+        p.set("uInvocationsPerRow", unsigned(gx * kGroup));
+        p.use();
+        glDispatchCompute(gx, gy, 1);
+    }
+
+    /// The Table 2 reference: the nodes prepare.comp wrote, linked on the CPU, uploaded back.
+    void buildOnCpu(const Light& light) {
+        std::vector<mt::NodeGpu> nodes = nodes_.read<mt::NodeGpu>(clusterCount_);
+        mt::CpuTreeOptions o;
+        o.directional = light.type == LightType::Directional;
+        o.lsEps = lsEps_;
+        o.overlapInterval = params_.getBool("overlap_interval");
+        o.depthSkip = params_.getBool("depth_skip");
+        const uint32_t root = mt::buildCpuTree(nodes, o);
+        uint32_t inserted = 0, culled = 0;
+        for (const mt::NodeGpu& nd : nodes) (nd.flags & MT_NODE_CULLED ? culled : inserted) += 1;
+        nodes_.upload(nodes.data(), nodes.size() * sizeof(mt::NodeGpu));
+        const uint32_t head[3] = {root, inserted, culled}; // MT_C_ROOT, MT_C_INSERTED, MT_C_CULLED
+        static_assert(MT_C_ROOT == 0 && MT_C_INSERTED == 1 && MT_C_CULLED == 2);
+        counters_.upload(head, sizeof head);
+    }
+
+    const std::array<uint32_t, MT_COUNTER_WORDS>& readCounters() const {
+        if (!countersRead_ && counters_) {
+            counters_.download(counterValues_.data(), mt::kCounterBytes);
+            countersRead_ = true;
+        }
+        return counterValues_;
+    }
+
+    ParamValues params_;
+    const SceneGpu* scene_ = nullptr;
+    glm::ivec2 resolution_{0, 0};
+    ShaderProgram prepare_, insert_, query_;
+    GlBuffer clusters_, nodes_, counters_;
+    std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;
+    GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;
+    size_t clusterCount_ = 0, capsuleCount_ = 0, geometryBytes_ = 0;
+    float lsEps_ = kAngularEps;
+    bool cacheHit_ = false;
+    double clusteringMs_ = 0;
+    mutable std::array<uint32_t, MT_COUNTER_WORDS> counterValues_{};
+    mutable bool countersRead_ = false;
+};
+
+} // namespace
+
+AlgorithmInfo metricTreeInfo() {
+    AlgorithmInfo info;
+    info.name = "metric_tree";
+    info.summary = "clusters bounded by spheres/capsules in a per-frame ternary metric tree (compute), per-pixel query";
+    info.lights = {LightType::Point, LightType::Directional};
+    info.exact = true;
+    info.schema = &metricTreeSchema;
+    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<MetricTree>(p); };
+    return info;
+}
+
+} // namespace shadowlab

@@ -1,0 +1,94 @@
+#version 450
+// metric_tree build, pass 2 of 2 (one invocation per cluster, paper section 5.3): each cluster's
+// node is filtered down the ternary metric tree from the root and linked at the empty leaf it
+// reaches, with a compare-and-swap; a failed CAS returns the node another invocation linked there
+// first and the descent goes on from it, so concurrent insertions neither wait nor lose a cluster.
+// The pivot order is the cluster order (shuffled at preprocessing with random_order) as the
+// scheduler interleaves it. The partitioning distance starts at the scene's angular radius
+// (uDelta0) and is halved at every near step; a node's delta is written before the CAS that
+// publishes it, and nobody reads an unpublished node.
+#include "common/light.glsl"
+#include "metric_tree/tree.glsl"
+layout(local_size_x = 64) in;
+
+uniform uint uClusterCount;
+uniform uint uInvocationsPerRow;
+uniform float uDelta0;
+
+uint mtLink(uint node, uint slot, uint child) {
+    if (node == 0xFFFFFFFFu) return atomicCompSwap(mtCounters[MT_C_ROOT], MT_NO_CHILD, child);
+    if (slot == MT_CHILD_NEAR) return atomicCompSwap(mtNodes[node].child[0], MT_NO_CHILD, child);
+    if (slot == MT_CHILD_FAR) return atomicCompSwap(mtNodes[node].child[1], MT_NO_CHILD, child);
+    return atomicCompSwap(mtNodes[node].child[2], MT_NO_CHILD, child);
+}
+
+uint mtChild(uint node, uint slot) {
+    return node == 0xFFFFFFFFu ? mtCounters[MT_C_ROOT] : mtNodes[node].child[slot];
+}
+
+// Inserts cluster i; returns the counter its outcome adds to and the nodes it crossed.
+uint insertCluster(uint i, out uint crossed) {
+    crossed = 0u;
+    MtNode me = mtNodes[i];
+    if ((me.flags & MT_NODE_CULLED) != 0u) return MT_C_CULLED;
+    vec3 a = me.a.xyz, b = me.b.xyz;
+    float alpha = me.a.w, delta = uDelta0;
+    uint node = 0xFFFFFFFFu, slot = 0u; // the root pointer
+    while (true) {
+        uint child = mtChild(node, slot); // a stale 0 only makes the CAS below fail
+        if (child == MT_NO_CHILD) {
+            mtNodes[i].b.w = delta;
+            memoryBarrierBuffer(); // delta is visible before the node is
+            child = mtLink(node, slot, i + 1u);
+            if (child == MT_NO_CHILD) return MT_C_INSERTED;
+        }
+        if (child > uClusterCount || ++crossed > uClusterCount) return MT_C_BUILD_ERRORS;
+        node = child - 1u;
+        MtNode n = mtNodes[node];
+#if MT_DEPTH_SKIP
+        // Non-negative floats order like their bits. The bound only ever decreases, so a value read
+        // earlier is never below the current one: skipping the atomic when it is not smaller is
+        // safe, and keeps every insertion from hammering the root's cache line.
+        if (me.minDist < n.minDist) atomicMin(mtNodes[node].minDist, me.minDist);
+#endif
+        // Bounds on the distance from the pivot's centre to any point of this element, widened by
+        // uLsEps so that they hold once rounded.
+        float dMin = mtMinDist(n.a.xyz, n.b.xyz, a, b) - alpha - uLsEps;
+        float dMax = alpha >= kMtPi ? kMtInf : mtMaxDist(n.a.xyz, n.b.xyz, a, b) + alpha + uLsEps;
+        if (dMax <= n.b.w) {
+            slot = MT_CHILD_NEAR;
+            delta *= 0.5;
+        } else if (dMin > n.b.w) {
+            slot = MT_CHILD_FAR;
+        } else {
+            slot = MT_CHILD_OVERLAP;
+#if MT_OVERLAP_INTERVAL
+            // Only widening atomics, for the same reason (the interval only ever grows).
+            uint lo = floatBitsToUint(max(dMin, 0.0)), hi = floatBitsToUint(dMax);
+            if (lo < n.overlapMin) atomicMin(mtNodes[node].overlapMin, lo);
+            if (hi > n.overlapMax) atomicMax(mtNodes[node].overlapMax, hi);
+#endif
+        }
+    }
+    return MT_C_BUILD_ERRORS; // not reached
+}
+
+shared uint sOutcomes[4]; // MT_C_INSERTED, MT_C_CULLED, MT_C_BUILD_ERRORS at words 1..3
+shared uint sCrossedMax;
+
+void main() {
+    if (gl_LocalInvocationIndex < 4u) sOutcomes[gl_LocalInvocationIndex] = 0u;
+    if (gl_LocalInvocationIndex == 0u) sCrossedMax = 0u;
+    barrier();
+    uint i = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x;
+    if (i < uClusterCount) {
+        uint crossed;
+        uint outcome = insertCluster(i, crossed);
+        atomicAdd(sOutcomes[outcome], 1u);
+        atomicMax(sCrossedMax, crossed);
+    }
+    barrier();
+    if (gl_LocalInvocationIndex >= 1u && gl_LocalInvocationIndex < 4u && sOutcomes[gl_LocalInvocationIndex] != 0u)
+        atomicAdd(mtCounters[gl_LocalInvocationIndex], sOutcomes[gl_LocalInvocationIndex]);
+    if (gl_LocalInvocationIndex == 0u) atomicMax(mtCounters[MT_C_INSERT_DEPTH_MAX], sCrossedMax);
+}

@@ -1,0 +1,203 @@
+#version 450
+// metric_tree query (paper section 5.4), one invocation per pixel: the G-buffer point walks the
+// ternary metric tree with an explicit stack. Inside a pivot's cone or capsule-cone, the shadow ray
+// is tested against the cluster's slabs and then its triangles (exact; early exit on a hit). Steps
+// 1-3 of the paper: skip a subtree whose geometry is all farther from the light than the point
+// (MT_DEPTH_SKIP), slabs (MT_SLABS), visit an overlap child only inside its interval
+// (MT_OVERLAP_INTERVAL). Writes 1 lit, 0 shadowed.
+#define MT_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
+#include "common/light.glsl"
+#include "metric_tree/tree.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std430, binding = MT_GEOMETRY_BINDING_0) readonly buffer MtGeometry0 { float mtGeometry0[]; };
+layout(std430, binding = MT_GEOMETRY_BINDING_0 + 1) readonly buffer MtGeometry1 { float mtGeometry1[]; };
+layout(std430, binding = MT_GEOMETRY_BINDING_0 + 2) readonly buffer MtGeometry2 { float mtGeometry2[]; };
+layout(std430, binding = MT_GEOMETRY_BINDING_0 + 3) readonly buffer MtGeometry3 { float mtGeometry3[]; };
+layout(std430, binding = MT_GEOMETRY_BINDING_0 + 4) readonly buffer MtGeometry4 { float mtGeometry4[]; };
+layout(std430, binding = MT_GEOMETRY_BINDING_0 + 5) readonly buffer MtGeometry5 { float mtGeometry5[]; };
+#if MT_GEOMETRY_CHUNKS != 6
+#error "query.comp declares six geometry blocks"
+#endif
+
+layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
+layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
+layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
+layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat maps
+layout(r32f, binding = 2) writeonly uniform image2D uTriangleTests;
+layout(r32f, binding = 3) writeonly uniform image2D uFruitless;    // paper Figure 9
+layout(r32f, binding = 4) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
+uniform float uRayOffset;     // world units: the reference's shadow-ray origin offset along the normal
+uniform float uSlabTolerance; // world units added on both sides of a cluster's slabs
+
+// Triangle t of the cluster-ordered geometry. Vertices come out as vec3s: an array return value
+// would live in scratch memory on llvmpipe.
+#define MT_LOAD(buf, base, v0, v1, v2) { v0 = vec3(buf[base], buf[base + 1u], buf[base + 2u]); \
+    v1 = vec3(buf[base + 3u], buf[base + 4u], buf[base + 5u]); v2 = vec3(buf[base + 6u], buf[base + 7u], buf[base + 8u]); }
+void mtTriangle(uint t, out vec3 v0, out vec3 v1, out vec3 v2) {
+    uint chunk = t / uint(MT_TRIANGLES_PER_CHUNK);
+    uint base = 9u * (t - chunk * uint(MT_TRIANGLES_PER_CHUNK));
+    if (chunk == 0u) MT_LOAD(mtGeometry0, base, v0, v1, v2)
+    else if (chunk == 1u) MT_LOAD(mtGeometry1, base, v0, v1, v2)
+    else if (chunk == 2u) MT_LOAD(mtGeometry2, base, v0, v1, v2)
+    else if (chunk == 3u) MT_LOAD(mtGeometry3, base, v0, v1, v2)
+    else if (chunk == 4u) MT_LOAD(mtGeometry4, base, v0, v1, v2)
+    else MT_LOAD(mtGeometry5, base, v0, v1, v2)
+}
+
+// Segment o + t d, t in (0, tMax), against a triangle; both faces, like the reference. Barycentric
+// bounds are widened by 1e-6 so that a ray through an edge shared by two triangles hits one of them.
+bool mtHitTriangle(vec3 o, vec3 d, float tMax, vec3 v0, vec3 v1, vec3 v2) {
+    vec3 e1 = v1 - v0, e2 = v2 - v0;
+    vec3 pv = cross(d, e2);
+    float det = dot(e1, pv);
+    if (det == 0.0) return false; // the ray is parallel to the triangle's plane
+    float inv = 1.0 / det;
+    vec3 tv = o - v0;
+    float u = dot(tv, pv) * inv;
+    if (u < -1e-6 || u > 1.0 + 1e-6) return false;
+    vec3 qv = cross(tv, e1);
+    float w = dot(d, qv) * inv;
+    if (w < -1e-6 || u + w > 1.0 + 1e-6) return false;
+    float t = dot(e2, qv) * inv;
+    return t > 0.0 && t < tMax;
+}
+
+struct Result {
+    float visibility;
+    uint visited, triangles, fruitless, coneHits, slabRejects, depthSkips;
+    bool overflow;
+};
+
+Result query(vec3 q) {
+    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
+    // The shadow ray: to the light (t in (0, 1)), or towards it forever for a directional light.
+    vec3 dir = mtDirectional() ? -uLightDirection : uLightPosition - q;
+    float tMax = mtDirectional() ? kMtInf : 1.0;
+    vec3 p = mtToLightSpace(q);
+#if MT_DEPTH_SKIP
+    float depth = mtLightDepth(q);
+#endif
+    uint stack[MT_STACK_SIZE];
+    int sp = 0;
+    // Pushing onto a full stack would drop a subtree that may hold the occluder: stop and report.
+#define MT_PUSH(x) { if (sp == MT_STACK_SIZE) { r.overflow = true; break; } stack[sp++] = (x); }
+    uint next = mtCounters[MT_C_ROOT];
+    while (true) {
+        if (next == MT_NO_CHILD) {
+            if (sp == 0) break;
+            next = stack[--sp];
+        }
+        uint node = next - 1u;
+        ++r.visited;
+        MtNode n = mtNodes[node];
+#if MT_DEPTH_SKIP
+        // Mora et al. 2016: nothing in this subtree is nearer the light than q, so nothing in it
+        // can lie between q and the light.
+        if (depth <= uintBitsToFloat(n.minDist)) { ++r.depthSkips; next = MT_NO_CHILD; continue; }
+#endif
+        float dq = mtPointDist(p, n.a.xyz, n.b.xyz);
+        if (dq <= n.a.w + uLsEps) { // inside the cone or capsule-cone: the cluster may occlude q
+            ++r.coneHits;
+            MtCluster c = mtClusters[node];
+            bool test = true;
+#if MT_SLABS
+            // The shadow ray must cross the slab between the cluster's two planes (paper step 2).
+            float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
+            float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
+            float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
+            float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
+            test = sFar >= lo && sNear <= hi;
+            if (!test) ++r.slabRejects;
+#endif
+            if (test) {
+                bool hit = false;
+                for (uint k = 0u; k < c.count && !hit; ++k) {
+                    ++r.triangles;
+                    vec3 v0, v1, v2;
+                    mtTriangle(c.first + k, v0, v1, v2);
+                    hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
+                }
+                if (hit) { r.visibility = 0.0; break; }
+                ++r.fruitless;
+            }
+        }
+        uint follow = dq <= n.b.w ? n.child[MT_CHILD_NEAR] : n.child[MT_CHILD_FAR];
+        uint overlap = n.child[MT_CHILD_OVERLAP];
+#if MT_OVERLAP_INTERVAL
+        if (overlap != MT_NO_CHILD && (dq < uintBitsToFloat(n.overlapMin) || dq > uintBitsToFloat(n.overlapMax)))
+            overlap = MT_NO_CHILD;
+#endif
+        if (overlap != MT_NO_CHILD) {
+            if (follow == MT_NO_CHILD) follow = overlap;
+            else MT_PUSH(overlap);
+        }
+        next = follow;
+    }
+#undef MT_PUSH
+    // An overflowed pixel is never reported lit: it is written shadowed and counted.
+    if (r.overflow) r.visibility = 0.0;
+    return r;
+}
+
+shared uint sTraversed, sOverflow, sVisitedMax, sTrianglesMax, sFruitlessMax;
+shared uint sVisited, sTriangles, sFruitless, sConeHits, sSlabRejects, sDepthSkips;
+
+void addWide(uint lo, uint value) {
+    if (value == 0u) return;
+    uint old = atomicAdd(mtCounters[lo], value);
+    if (old + value < old) atomicAdd(mtCounters[lo + 1], 1u); // carry into the high word
+}
+
+void main() {
+    if (gl_LocalInvocationIndex == 0u) {
+        sTraversed = sOverflow = sVisitedMax = sTrianglesMax = sFruitlessMax = 0u;
+        sVisited = sTriangles = sFruitless = sConeHits = sSlabRejects = sDepthSkips = 0u;
+    }
+    barrier();
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (all(lessThan(px, imageSize(uVisibility)))) {
+        vec4 pos = texelFetch(uPosition, px, 0);
+        float visibility = 1.0; // background: nothing to shadow (the reference's convention)
+        Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
+        if (pos.w >= 0.5) {
+            vec3 x = pos.xyz, nrm = texelFetch(uNormal, px, 0).xyz;
+            visibility = 0.0; // facing away from the light
+            if (dot(nrm, toLight(x)) > 0.0) {
+                // The reference's ray origin: the same offset along the same (unnormalised) normal.
+                r = query(x + nrm * uRayOffset);
+                visibility = r.visibility;
+                atomicAdd(sTraversed, 1u);
+                atomicAdd(sVisited, r.visited);
+                atomicAdd(sTriangles, r.triangles);
+                atomicAdd(sFruitless, r.fruitless);
+                atomicAdd(sConeHits, r.coneHits);
+                atomicAdd(sSlabRejects, r.slabRejects);
+                atomicAdd(sDepthSkips, r.depthSkips);
+                atomicMax(sVisitedMax, r.visited);
+                atomicMax(sTrianglesMax, r.triangles);
+                atomicMax(sFruitlessMax, r.fruitless);
+                if (r.overflow) atomicAdd(sOverflow, 1u);
+            }
+        }
+        imageStore(uVisibility, px, vec4(visibility));
+        imageStore(uNodesVisited, px, vec4(float(r.visited)));
+        imageStore(uTriangleTests, px, vec4(float(r.triangles)));
+        imageStore(uFruitless, px, vec4(float(r.fruitless)));
+        imageStore(uOverflow, px, vec4(r.overflow ? 1.0 : 0.0));
+    }
+    barrier();
+    if (gl_LocalInvocationIndex == 0u && sTraversed != 0u) {
+        atomicAdd(mtCounters[MT_C_TRAVERSED], sTraversed);
+        addWide(MT_C_VISITED_LO, sVisited);
+        addWide(MT_C_TRIANGLES_LO, sTriangles);
+        addWide(MT_C_FRUITLESS_LO, sFruitless);
+        addWide(MT_C_CONE_HITS_LO, sConeHits);
+        addWide(MT_C_SLAB_REJECTS_LO, sSlabRejects);
+        addWide(MT_C_DEPTH_SKIPS_LO, sDepthSkips);
+        atomicMax(mtCounters[MT_C_VISITED_MAX], sVisitedMax);
+        atomicMax(mtCounters[MT_C_TRIANGLES_MAX], sTrianglesMax);
+        atomicMax(mtCounters[MT_C_FRUITLESS_MAX], sFruitlessMax);
+        if (sOverflow != 0u) atomicAdd(mtCounters[MT_C_STACK_OVERFLOW], sOverflow);
+    }
+}

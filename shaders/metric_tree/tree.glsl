@@ -1,0 +1,140 @@
+// metric_tree: the GPU structures (mirrored in algorithms/metric_tree/MetricTreeGpuLayout.h) and the
+// light-space distances the build and the query share (mirrored in MetricTreeMath.h, which the CPU
+// tree builder and the tests use).
+//
+// Light space. Point light: an element is an arc of unit directions from the light (a sphere's
+// centre is a point-arc, a = b; a capsule's segment is the arc from a to b) and distances are angles.
+// Directional light: an element is a point or a segment in the plane orthogonal to the light
+// direction, coordinates (u, v, 0), and distances are Euclidean (paper section 6, "Discussion").
+#include "metric_tree/layout.glsl"
+
+struct MtCluster {
+    vec4 a;      // world: sphere centre or capsule end A; w: radius
+    vec4 b;      // world: capsule end B (= a for a sphere); w: cos of the normal cone's half-angle
+    vec4 axis;   // normal cone axis (unit; also the slabs' normal); w: lower slab, dot(axis, x)
+    float slabMax;
+    uint first;  // first triangle in the cluster-ordered geometry
+    uint count;  // triangles
+    uint flags;  // MT_FLAG_*
+};
+
+struct MtNode {
+    vec4 a;           // light space: first end of the centre element; w: angular radius alpha
+    vec4 b;           // light space: second end (= a for a sphere); w: partitioning distance delta
+    uint child[3];    // near, far, overlap: node index + 1, MT_NO_CHILD = empty
+    uint minDist;     // float bits: smallest light distance of the subtree (its clusters' bounds)
+    uint overlapMin;  // float bits: [min, max] light-space distance from this pivot of every
+    uint overlapMax;  //   element of the overlap subtree (only meaningful when child[2] != 0)
+    uint flags;       // MT_NODE_*
+    uint pad;
+};
+
+#ifndef MT_NODE_ACCESS
+// The build reads child fields other invocations are changing: no stale cached values.
+#define MT_NODE_ACCESS coherent
+#endif
+layout(std430, binding = MT_CLUSTER_BINDING) readonly buffer MtClusters { MtCluster mtClusters[]; };
+layout(std430, binding = MT_NODE_BINDING) MT_NODE_ACCESS buffer MtNodes { MtNode mtNodes[]; };
+layout(std430, binding = MT_COUNTER_BINDING) coherent buffer MtCounters { uint mtCounters[]; };
+
+const float kMtPi = 3.14159265358979;
+const float kMtInf = uintBitsToFloat(0x7F800000u);
+
+uniform float uLsEps;   // light-space margin (rad, or world units for a directional light): far
+                        // above float rounding, so every bound stays conservative once rounded
+uniform vec3 uLightU;   // directional light: orthonormal basis of the plane orthogonal to it
+uniform vec3 uLightV;
+uniform vec3 uDepthOrigin; // directional light: depth is measured along its direction from here
+
+bool mtDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
+
+// Distance from the light along which shadow rays travel: an occluder of q is strictly nearer.
+float mtLightDepth(vec3 x) {
+    return mtDirectional() ? dot(x - uDepthOrigin, uLightDirection) : length(x - uLightPosition);
+}
+
+// World point -> light space.
+vec3 mtToLightSpace(vec3 x) {
+    if (mtDirectional()) return vec3(dot(x, uLightU), dot(x, uLightV), 0.0);
+    return normalize(x - uLightPosition);
+}
+
+float mtAngle(vec3 u, vec3 v) { return atan(length(cross(u, v)), dot(u, v)); }
+
+// ---- angular (point light) ----
+
+// Whether unit direction y, on the great circle of arc a->b (normal n = cross(a, b)), lies on the
+// arc. Arcs are shorter than pi (prepare.comp makes longer ones cover every direction).
+bool mtOnArc(vec3 y, vec3 a, vec3 b, vec3 n) { return dot(cross(a, y), n) >= 0.0 && dot(cross(y, b), n) >= 0.0; }
+
+float mtPointArc(vec3 p, vec3 a, vec3 b) {
+    float d = min(mtAngle(p, a), mtAngle(p, b));
+    vec3 n = cross(a, b);
+    float nl = length(n);
+    if (nl > 1e-12) {
+        n /= nl;
+        float s = dot(p, n);
+        vec3 q = p - s * n; // p projected on the arc's great circle
+        // atan rather than asin: asin loses half the digits near the circle's poles.
+        if (mtOnArc(q, a, b, n)) d = min(d, atan(abs(s), length(q)));
+    }
+    return d;
+}
+
+// Smallest angle between two arcs: 0 where they cross, else attained at an end of one of them
+// (the distance to a great circle grows away from where the circles cross).
+float mtArcArc(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
+    float d = min(min(mtPointArc(a1, a2, b2), mtPointArc(b1, a2, b2)), min(mtPointArc(a2, a1, b1), mtPointArc(b2, a1, b1)));
+    vec3 n1 = cross(a1, b1), n2 = cross(a2, b2);
+    vec3 x = cross(n1, n2);
+    float xl = length(x);
+    if (xl > 1e-12 && length(n1) > 1e-12 && length(n2) > 1e-12) {
+        x /= xl;
+        if ((mtOnArc(x, a1, b1, n1) && mtOnArc(x, a2, b2, n2)) || (mtOnArc(-x, a1, b1, n1) && mtOnArc(-x, a2, b2, n2)))
+            d = 0.0;
+    }
+    return d;
+}
+
+// ---- Euclidean (directional light, z = 0) ----
+
+float mtPointSeg(vec3 p, vec3 a, vec3 b) {
+    vec3 ab = b - a;
+    float l2 = dot(ab, ab);
+    float t = l2 > 0.0 ? clamp(dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+    return length(p - (a + t * ab));
+}
+
+float mtCross2(vec2 u, vec2 v) { return u.x * v.y - u.y * v.x; }
+
+float mtSegSeg(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
+    vec2 d1 = b1.xy - a1.xy, d2 = b2.xy - a2.xy;
+    float o1 = mtCross2(d1, a2.xy - a1.xy), o2 = mtCross2(d1, b2.xy - a1.xy);
+    float o3 = mtCross2(d2, a1.xy - a2.xy), o4 = mtCross2(d2, b1.xy - a2.xy);
+    if (((o1 < 0.0 && o2 > 0.0) || (o1 > 0.0 && o2 < 0.0)) && ((o3 < 0.0 && o4 > 0.0) || (o3 > 0.0 && o4 < 0.0)))
+        return 0.0;
+    return min(min(mtPointSeg(a1, a2, b2), mtPointSeg(b1, a2, b2)), min(mtPointSeg(a2, a1, b1), mtPointSeg(b2, a1, b1)));
+}
+
+// ---- what the tree uses ----
+
+// Distance from a light-space point to an element's centre.
+float mtPointDist(vec3 p, vec3 a, vec3 b) {
+    if (a == b) return mtDirectional() ? length(p - a) : mtAngle(p, a);
+    return mtDirectional() ? mtPointSeg(p, a, b) : mtPointArc(p, a, b);
+}
+
+// Smallest distance between two elements' centres.
+float mtMinDist(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
+    if (a1 == b1) return mtPointDist(a1, a2, b2);
+    if (a2 == b2) return mtPointDist(a2, a1, b1);
+    return mtDirectional() ? mtSegSeg(a1, b1, a2, b2) : mtArcArc(a1, b1, a2, b2);
+}
+
+// Largest distance between two elements' centres: Euclidean, at a pair of ends (convexity);
+// angular, pi minus the smallest distance from the antipodal element.
+float mtMaxDist(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
+    if (mtDirectional())
+        return max(max(length(a1 - a2), length(a1 - b2)), max(length(b1 - a2), length(b1 - b2)));
+    return kMtPi - mtMinDist(-a1, -b1, a2, b2);
+}
