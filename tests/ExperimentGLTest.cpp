@@ -71,6 +71,7 @@ const AccuracyCase kAccuracy[] = {
     // culling only ever sends work deeper: the bound of 0.1 % of lit pixels (measured: 0
     // on every smoke frame).
     {"configs/smoke.json", "ptsv", 0.001},
+    {kDemoSmall, "ptsv", 0.001},
     {kDemoSmall, "bvh_raytrace", 0.001},
     {"configs/line_space/soft_smoke.json", "bvh_raytrace", 0.001},
     // line_space is approximate by design: a ray crossing a non-empty shaft counts as blocked even
@@ -83,6 +84,7 @@ const AccuracyCase kAccuracy[] = {
     // metric_tree is exact (conservative culling, then the reference's own rays against the
     // triangles): the required bound of 0.1 % of lit pixels (measured: 0 on every smoke frame).
     {"configs/smoke.json", "metric_tree", 0.001},
+    {kDemoSmall, "metric_tree", 0.001},
     {"configs/line_space/soft_smoke.json", "line_space", 0.20},
 };
 
