@@ -190,6 +190,18 @@ TEST_P(LineSpaceErrGLTest, ErrsTowardsShadowAwayFromTheStartNode) {
     EXPECT_LT(o.accuracy.mismatchRatio, 0.25);
 }
 
+// The extremes of d: the root alone (no walk at all), and d = 5, where the walks of three
+// ancestors wait at once. Coarse sets: only the method's guarantees are checked.
+TEST_F(LineSpaceGLTest, ExtremeDepthsKeepTheGuarantees) {
+    for (auto [n, d] : {std::pair{4, 1}, std::pair{2, 5}}) {
+        Outcome o = run(pointShot(), {{"n", n}, {"d", d}});
+        print(("point_" + std::to_string(n) + "_" + std::to_string(d)).c_str(), o);
+        EXPECT_EQ(o.counters["under_occluded_elsewhere"], 0.0) << "d = " << d;
+        EXPECT_EQ(o.counters["classified_samples"], o.counters["rays"]) << "d = " << d;
+        EXPECT_EQ(o.overflow, 0u) << "d = " << d;
+    }
+}
+
 // Small blockers inside the start node are missed: the one way the method errs towards light.
 TEST_F(LineSpaceGLTest, BlockersInsideTheStartNodeAreMissed) {
     Outcome o = run(pebbleShot());

@@ -87,6 +87,13 @@ public:
             const size_t last = std::min(tree_.bits.size(), (c + 1) * nodesPerChunk_ * words);
             bitsBuf_[c] = GlBuffer((last - first) * sizeof(uint32_t), last > first ? tree_.bits.data() + first : nullptr, 0);
         }
+        // The shader reads the line-space pool with one load when it is a single block; a tree that
+        // needs more blocks gets the program that picks the block per node.
+        const int usedChunks = int(std::max<size_t>(1, chunks));
+        if (usedChunks != bitChunks_) {
+            bitChunks_ = usedChunks;
+            compile();
+        }
         counters_ = GlBuffer(LS_COUNTER_WORDS * sizeof(uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
         // The GPU holds the pools now; the CPU keeps only the node pool (start-node boxes for classify).
         tree_.tree = {};
@@ -202,7 +209,8 @@ private:
     ShaderDefines defines(bool classify) const {
         return {{"LS_N", std::to_string(params_.getInt("n"))},
                 {"LS_DEPTH", std::to_string(params_.getInt("d"))},
-                {"LS_CLASSIFY", classify ? "1" : "0"}};
+                {"LS_CLASSIFY", classify ? "1" : "0"},
+                {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)}};
     }
 
     void compile() {
@@ -264,6 +272,7 @@ private:
     GlBuffer nodesBuf_, treeBuf_, samples_, counters_, classifyBuf_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
     size_t nodesPerChunk_ = 1;
+    int bitChunks_ = 1; ///< line-space pool blocks the compiled programs read (LS_BIT_CHUNK_COUNT)
     GlTexture nodesVisited_;
     // classify: the frame to classify, the exact tracer (built on first use) and the result.
     CpuGBuffer pendingG_;

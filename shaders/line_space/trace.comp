@@ -8,7 +8,8 @@
 //   * a node the ray starts in cannot use its line space (the ray crosses no shaft of it): above the
 //     last level its children are visited, on the last level it is skipped (paper 4.1: the loss of
 //     detail near the receiver).
-// Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results).
+// Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
+// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans).
 #include "common/light.glsl"
 #include "line_space/layout.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -38,6 +39,9 @@ uniform int uSampleCount; // entries of lightSamples (1 for point and spot light
 uniform uint uNodeCount;  // 0: no geometry, nothing occludes
 uniform uint uNodesPerChunk; // nodes per line-space pool chunk (see layout.glsl)
 
+#ifndef LS_BIT_CHUNK_COUNT
+#define LS_BIT_CHUNK_COUNT LS_BIT_CHUNKS
+#endif
 const uint N2 = uint(LS_N * LS_N), N4 = N2 * N2;
 const uint WORDS = uint(LS_WORDS_PER_NODE(LS_N));
 const uint LS_NONE = 0xFFFFFFFFu;
@@ -55,48 +59,42 @@ void slabs(vec3 lo, vec3 size, Ray r, out float tIn, out float tOut, out int inA
     vec3 tmin = min(t0, t1), tmax = max(t0, t1);
     inAxis = tmin.x >= tmin.y ? (tmin.x >= tmin.z ? 0 : 2) : (tmin.y >= tmin.z ? 1 : 2);
     outAxis = tmax.x <= tmax.y ? (tmax.x <= tmax.z ? 0 : 2) : (tmax.y <= tmax.z ? 1 : 2);
-    tIn = tmin[inAxis];
-    tOut = tmax[outAxis];
+    tIn = max(max(tmin.x, tmin.y), tmin.z);
+    tOut = min(min(tmax.x, tmax.y), tmax.z);
 }
 
-// Sub-face (i, j) → j × N + i of the point p on a face of `axis`.
-uint subFace(vec3 p, LsNode n, int axis) {
-    int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    vec3 cell = n.size / float(LS_N);
-    int i = clamp(int(floor((p[u] - n.lo[u]) / cell[u])), 0, LS_N - 1);
-    int j = clamp(int(floor((p[v] - n.lo[v]) / cell[v])), 0, LS_N - 1);
-    return uint(j * LS_N + i);
+// Child cell of point p in a node: the cell index per axis, clamped. Per component it is the
+// expression the sub-face lookup used (floor((p - lo) / cell)), so one evaluation serves both the
+// DDA's first cell and the sub-face of the point on any face.
+ivec3 cellOf(vec3 p, vec3 lo, vec3 cellSize) {
+    return clamp(ivec3(floor((p - lo) / cellSize)), ivec3(0), ivec3(LS_N - 1));
 }
 
-// Word w of node `index`'s line space, from the pool chunk that holds the node.
+// Sub-face (i, j) → j × N + i on a face of `axis` (i along (axis + 1) % 3, j along (axis + 2) % 3),
+// from the point's cell: selects instead of dynamic vector indexing.
+uint subFace(ivec3 c, int axis) {
+    return uint(axis == 0 ? c.z * LS_N + c.y : (axis == 1 ? c.x * LS_N + c.z : c.y * LS_N + c.x));
+}
+
+// Word w of node `index`'s line space, from the pool chunk that holds the node. LS_BIT_CHUNK_COUNT
+// is the number of chunks the pool really uses (the host compiles per tree): with one chunk, one load.
 uint lineSpaceWord(uint index, uint w) {
+#if LS_BIT_CHUNK_COUNT <= 1
+    return lsBits0[index * WORDS + w];
+#else
     uint chunk = index / uNodesPerChunk, i = (index - chunk * uNodesPerChunk) * WORDS + w;
     if (chunk == 0u) return lsBits0[i];
     if (chunk == 1u) return lsBits1[i];
     if (chunk == 2u) return lsBits2[i];
     return lsBits3[i];
-}
-
-// The line-space bit of the shaft the ray crosses node `index` through (entering at tIn through
-// a face of axis ia, leaving at tOut through one of axis oa).
-bool shaftNonEmpty(uint index, LsNode n, Ray r, float tIn, float tOut, int ia, int oa) {
-    int fa = 2 * ia + (r.d[ia] >= 0.0 ? 0 : 1); // moving up an axis enters through its min face
-    int fb = 2 * oa + (r.d[oa] >= 0.0 ? 1 : 0);
-    // Entry and exit on one face: the ray only grazes the node along an edge. Such a shaft has no
-    // volume and no bit; answering "non-empty" keeps the method conservative.
-    if (fa == fb) return true;
-    // The exit is the infinite line's, even when the segment ends inside the node (a light inside
-    // the scene box): the shaft holds the segment, so the answer stays conservative.
-    uint sa = subFace(r.o + r.d * tIn, n, ia), sb = subFace(r.o + r.d * tOut, n, oa);
-    if (fa > fb) { int t = fa; fa = fb; fb = t; uint s = sa; sa = sb; sb = s; }
-    uint bit = uint(LS_PAIR_INDEX(fa, fb)) * N4 + sa * N2 + sb;
-    return ((lineSpaceWord(index, bit >> 5u) >> (bit & 31u)) & 1u) != 0u;
+#endif
 }
 
 // One subdivided node being walked: its children along the ray (3D DDA over the N³ cells).
 struct Frame {
     uint children; // tree pool offset of its children group
     ivec3 cell;    // current child cell
+    int child;     // its index in the children group, (z × N + y) × N + x
     vec3 lo, cellSize;
     vec3 tNext;    // ray parameter at which it leaves the current cell, per axis
     float t, tEnd; // current cell entered at t; the walk ends at tEnd
@@ -107,88 +105,84 @@ struct Frame {
 #define ENTER_OCCLUDED 1
 #define ENTER_DESCEND 2
 
-struct Trace {
-    bool occluded, overflow;
-    uint visited, shafts, cells, startNode;
-};
+// Set by enter(): nodes the current ray entered, shafts the pixel's rays read (counters), and the
+// start node skipped on the last level (classify).
+uint rayVisited = 0u, sumShafts = 0u, startNode = LS_NONE;
 
-// Enters node `index` of `level`: decides it, or prepares the walk over its children in `f`.
-int enter(uint index, int level, bool start, Ray r, inout Trace tr, out Frame f) {
-    ++tr.visited;
+// Enters node `index` (on the last subdivided level if `last`): decides it, or prepares the walk
+// over its children in `f`. `root`: node 0, whose start flag and segment test are decided here.
+int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
     LsNode n = lsNodes[index];
     float tIn, tOut;
     int ia, oa;
     slabs(n.lo, n.size, r, tIn, tOut, ia, oa);
-    if (!start) {
-        ++tr.shafts;
-        if (!shaftNonEmpty(index, n, r, tIn, tOut, ia, oa)) return ENTER_SKIP;
-        if (level == LS_DEPTH - 1) return ENTER_OCCLUDED; // "deep enough": the shaft stands for its leaves
-    } else if (level == LS_DEPTH - 1) {
-        tr.startNode = index; // the ray starts among this node's leaves: nothing can be said
+    if (root) {
+        if (max(tIn, 0.0) > min(tOut, r.tEnd)) return ENTER_SKIP; // the segment misses the scene box
+        start = tIn <= 0.0;
+    }
+    ++rayVisited; // a ray that misses the scene box visits nothing
+    if (start && last) {
+        startNode = index; // the ray starts among this node's leaves: nothing can be said
         return ENTER_SKIP;
+    }
+    vec3 cellSize = n.size / float(LS_N);
+    // The entry point's cell serves the DDA and the entry sub-face. A start node walks from the
+    // segment's start; any other node from where the line enters it (the same point unless
+    // rounding puts tIn a hair below 0, where the walk then starts one cell early: a superset).
+    ivec3 cIn = cellOf(r.o + r.d * (start ? max(tIn, 0.0) : tIn), n.lo, cellSize);
+    if (!start) {
+        ++sumShafts;
+        int fa = 2 * ia + (r.d[ia] >= 0.0 ? 0 : 1); // moving up an axis enters through its min face
+        int fb = 2 * oa + (r.d[oa] >= 0.0 ? 1 : 0);
+        // Entry and exit on one face: the ray only grazes the node along an edge. Such a shaft has
+        // no volume and no bit; answering "non-empty" keeps the method conservative.
+        bool nonEmpty = true;
+        if (fa != fb) {
+            // The exit is the infinite line's, even when the segment ends inside the node (a light
+            // inside the scene box): the shaft holds the segment, so the answer stays conservative.
+            uint sa = subFace(cIn, ia), sb = subFace(cellOf(r.o + r.d * tOut, n.lo, cellSize), oa);
+            bool swap = fa > fb;
+            int f0 = min(fa, fb), f1 = max(fa, fb);
+            uint bit = uint(LS_PAIR_INDEX(f0, f1)) * N4 + (swap ? sb : sa) * N2 + (swap ? sa : sb);
+            nonEmpty = ((lineSpaceWord(index, bit >> 5u) >> (bit & 31u)) & 1u) != 0u;
+        }
+        if (!nonEmpty) return ENTER_SKIP;
+        if (last) return ENTER_OCCLUDED; // "deep enough": the shaft stands for its leaves
     }
     f.children = n.children;
     f.lo = n.lo;
-    f.cellSize = n.size / float(LS_N);
+    f.cellSize = cellSize;
     f.t = max(tIn, 0.0);
     f.tEnd = min(tOut, r.tEnd);
     f.start = start;
-    vec3 p = r.o + r.d * f.t;
-    f.cell = clamp(ivec3(floor((p - n.lo) / f.cellSize)), ivec3(0), ivec3(LS_N - 1));
+    f.cell = cIn;
+    f.child = (cIn.z * LS_N + cIn.y) * LS_N + cIn.x;
     // The cell boundary ahead on each axis, with the float expression the build used for boxes.
-    vec3 ahead = n.lo + vec3(f.cell + ivec3(greaterThanEqual(r.d, vec3(0.0)))) * f.cellSize;
+    vec3 ahead = n.lo + vec3(cIn + ivec3(greaterThanEqual(r.d, vec3(0.0)))) * cellSize;
     f.tNext = (ahead - r.o) * r.invD;
     return ENTER_DESCEND;
 }
 
-Trace trace(Ray r) {
-    Trace tr = Trace(false, false, 0u, 0u, 0u, LS_NONE);
-    if (uNodeCount == 0u) return tr;
-    LsNode root = lsNodes[0];
-    float tIn, tOut;
-    int ia, oa;
-    slabs(root.lo, root.size, r, tIn, tOut, ia, oa);
-    if (max(tIn, 0.0) > min(tOut, r.tEnd)) return tr; // the segment misses the scene box
-    // `cur` walks the children of the node on level `level`; its ancestors' walks wait in `parents`.
-    // Keeping the active frame out of the (dynamically indexed) array saves a copy per cell.
-    Frame parents[LS_DEPTH];
-    Frame cur;
-    int level = 0;
-    int e = enter(0u, 0, tIn <= 0.0, r, tr, cur);
-    if (e == ENTER_OCCLUDED) { tr.occluded = true; return tr; }
-    if (e == ENTER_SKIP) return tr;
-    ivec3 stepDir = ivec3(greaterThanEqual(r.d, vec3(0.0))) * 2 - 1;
-    while (true) {
-        if (cur.t > cur.tEnd) { // walked past the node (or the segment's end)
-            if (level == 0) break;
-            cur = parents[--level];
-            continue;
-        }
-        ivec3 cell = cur.cell;
-        bool start = cur.start;
-        ++tr.cells;
-        // Advance to the next cell before descending into this one.
-        int a = cur.tNext.x <= cur.tNext.y ? (cur.tNext.x <= cur.tNext.z ? 0 : 2) : (cur.tNext.y <= cur.tNext.z ? 1 : 2);
-        float cellEnd = cur.tNext[a];
-        cur.cell[a] += stepDir[a];
-        cur.t = cur.cell[a] < 0 || cur.cell[a] >= LS_N ? kInf : cellEnd;
-        cur.tNext[a] = (cur.lo[a] + float(cur.cell[a] + (r.d[a] >= 0.0 ? 1 : 0)) * cur.cellSize[a] - r.o[a]) * r.invD[a];
-        cur.start = false;
-        uint child = lsTree[cur.children + uint((cell.z * LS_N + cell.y) * LS_N + cell.x)];
-        if (child == LS_EMPTY) continue; // Algorithm 1, line 8: empty children are skipped
-        Frame f;
-        e = enter(child, level + 1, start, r, tr, f);
-        if (e == ENTER_OCCLUDED) { tr.occluded = true; break; }
-        if (e == ENTER_DESCEND) {
-            // One frame per level above the last: LS_DEPTH always suffices. Checked anyway, so a
-            // corrupt tree shows as reported overflow, never as light.
-            if (level + 1 >= LS_DEPTH) { tr.overflow = true; tr.occluded = true; break; }
-            parents[level++] = cur;
-            cur = f;
-        }
-    }
-    return tr;
-}
+// Frames of the ancestors of the walked node. The walked node is at most on level d - 2 (a node
+// on level d - 1 is decided on entry), so at most d - 2 ancestors' walks wait, in separate
+// variables picked by level rather than an array: some compilers keep a dynamically indexed local
+// array in scratch memory (llvmpipe does; with `Frame parents[LS_DEPTH]` the whole walk ran ~9×
+// slower, docs/algorithms/line_space.md).
+#if LS_DEPTH > 5
+#error "at most 3 waiting frames: d <= 5 (ls::kMaxDepth)"
+#elif LS_DEPTH <= 3
+#define LS_PARENTS 1
+#define PUSH(level, f) parent0 = (f)
+#define POP(level, f) (f) = parent0
+#elif LS_DEPTH == 4
+#define LS_PARENTS 2
+#define PUSH(level, f) if ((level) == 0) parent0 = (f); else parent1 = (f)
+#define POP(level, f) if ((level) == 0) (f) = parent0; else (f) = parent1
+#else
+#define LS_PARENTS 3
+#define PUSH(level, f) if ((level) == 0) parent0 = (f); else if ((level) == 1) parent1 = (f); else parent2 = (f)
+#define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
+#endif
 
 bool illuminated(vec3 p) {
     if (uLightType == LIGHT_SPOT) return dot(normalize(p - uLightPosition), uLightDirection) > uLightCosCone;
@@ -215,7 +209,7 @@ void main() {
 #if LS_CLASSIFY
         uint stride = 1u + (uint(uSampleCount) + 31u) / 32u;
         uint base = uint(px.y * size.x + px.x) * stride;
-        uint startNode = LS_NONE;
+        uint pixelStartNode = LS_NONE;
         for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0u;
 #endif
         if (pos.w >= 0.5) {
@@ -225,7 +219,15 @@ void main() {
                 vec3 o = p + n * uRayOffset;
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
                 int count = directional ? 1 : uSampleCount;
-                uint unblocked = 0u, shafts = 0u, cells = 0u, occluded = 0u, maxVisited = 0u, overflow = 0u;
+                uint unblocked = 0u, cells = 0u, occluded = 0u, maxVisited = 0u, overflow = 0u;
+                sumShafts = 0u;
+#if LS_CLASSIFY
+                startNode = LS_NONE;
+#endif
+                // `cur` walks the children of the node on level `level`; its ancestors' walks wait
+                // in parent0..2.
+                Frame cur = Frame(0u, ivec3(0), 0, vec3(0.0), vec3(1.0), vec3(0.0), kInf, 0.0, false);
+                Frame parent0 = cur, parent1 = cur, parent2 = cur; // only LS_PARENTS of them are used
                 for (int s = 0; s < count; ++s) {
                     Ray r;
                     r.o = o;
@@ -243,20 +245,79 @@ void main() {
                     vec3 safe = mix(r.d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(r.d, vec3(0.0))),
                                     lessThan(abs(r.d), vec3(1e-30)));
                     r.invD = 1.0 / safe;
-                    Trace t = trace(r);
-                    visited += t.visited;
-                    shafts += t.shafts;
-                    cells += t.cells;
-                    maxVisited = max(maxVisited, t.visited);
-                    if (t.overflow) ++overflow;
-                    if (t.occluded) ++occluded;
-                    else ++unblocked;
+                    ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
+                    ivec3 childStep = stepDir * ivec3(1, LS_N, LS_N * LS_N);
+                    rayVisited = 0u;
+                    bool blocked = false;
+                    Frame f;
+                    int e = uNodeCount == 0u ? ENTER_SKIP : enter(0u, true, LS_DEPTH == 1, false, r, f);
+                    if (e == ENTER_OCCLUDED) blocked = true;
+                    if (e == ENTER_DESCEND) {
+                        cur = f;
+                        int level = 0;
+                        while (true) {
+                            // Step the DDA to the next non-empty child, leaving finished walks: a
+                            // loop of its own, so that neighbouring invocations (vector lanes in
+                            // lockstep) reach the node test below together.
+                            uint node = LS_NONE;
+                            bool nodeStart = false;
+                            while (true) {
+                                if (cur.t > cur.tEnd) { // walked past the node (or the segment's end)
+                                    if (level == 0) break;
+                                    --level;
+                                    POP(level, cur);
+                                    continue;
+                                }
+                                ++cells;
+                                int cell = cur.child;
+                                nodeStart = cur.start;
+                                // Advance to the next cell before descending into this one. The axis
+                                // and every update are selects: indexing a vector by a variable makes
+                                // some compilers (llvmpipe's among them) keep the frame in memory.
+                                float cellEnd = min(min(cur.tNext.x, cur.tNext.y), cur.tNext.z);
+                                bvec3 axis = equal(cur.tNext, vec3(cellEnd));
+                                // One axis only: the first of a tie, as the per-axis comparison picked.
+                                axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+                                ivec3 m = ivec3(axis);
+                                cur.cell += m * stepDir;
+                                cur.child += m.x * childStep.x + m.y * childStep.y + m.z * childStep.z;
+                                bool outside = any(lessThan(cur.cell, ivec3(0))) || any(greaterThanEqual(cur.cell, ivec3(LS_N)));
+                                cur.t = outside ? kInf : cellEnd;
+                                vec3 ahead = cur.lo + vec3(cur.cell + up) * cur.cellSize;
+                                cur.tNext = mix(cur.tNext, (ahead - r.o) * r.invD, axis);
+                                cur.start = false;
+                                uint child = lsTree[cur.children + uint(cell)];
+                                if (child != LS_EMPTY) { node = child; break; } // Algorithm 1, line 8: empty children are skipped
+                            }
+                            if (node == LS_NONE) break; // walked past the root: the ray is free
+                            e = enter(node, false, level + 1 == LS_DEPTH - 1, nodeStart, r, f);
+                            if (e == ENTER_OCCLUDED) { blocked = true; break; }
+                            if (e == ENTER_DESCEND) {
+                                // One frame per level above the last suffices by construction. Checked
+                                // anyway, so a corrupt tree shows as reported overflow, never as light.
+                                if (level >= LS_PARENTS) { ++overflow; blocked = true; break; }
+                                PUSH(level, cur);
+                                ++level;
+                                cur = f;
+                            }
+                        }
+                    }
+                    visited += rayVisited;
+                    maxVisited = max(maxVisited, rayVisited);
+                    if (blocked) {
+                        ++occluded;
 #if LS_CLASSIFY
-                    // The start node depends only on the origin: every sample reports the same one.
-                    if (t.startNode != LS_NONE) startNode = t.startNode;
-                    if (t.occluded) lsClassify[base + 1u + uint(s) / 32u] |= 1u << uint(s & 31);
+                        lsClassify[base + 1u + uint(s) / 32u] |= 1u << uint(s & 31);
 #endif
+                    } else {
+                        ++unblocked;
+                    }
                 }
+                uint shafts = sumShafts;
+#if LS_CLASSIFY
+                // The start node depends only on the origin: every sample reports the same one.
+                if (startNode != LS_NONE) pixelStartNode = startNode;
+#endif
                 visibility = float(unblocked) / float(count);
                 atomicAdd(sPixels, 1u);
                 atomicAdd(sRays, uint(count));
@@ -269,7 +330,7 @@ void main() {
             }
         }
 #if LS_CLASSIFY
-        lsClassify[base] = startNode;
+        lsClassify[base] = pixelStartNode;
 #endif
         imageStore(uVisibility, px, vec4(visibility));
         imageStore(uNodesVisited, px, vec4(float(visited)));
