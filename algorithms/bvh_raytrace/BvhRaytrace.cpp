@@ -1,8 +1,10 @@
 #include "algorithms/bvh_raytrace/BvhRaytrace.h"
 
+#include "algorithms/AlgorithmSupport.h"
 #include "algorithms/bvh_raytrace/BvhBuilder.h"
 #include "algorithms/bvh_raytrace/BvhGpuLayout.h"
 #include "framework/core/Error.h"
+#include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
 
 #include <array>
@@ -62,13 +64,11 @@ public:
         bvh::checkStorageBlock("the scene positions", scene.positions().size(), limit);
         nodes_ = GlBuffer::fromVector(tree.nodes, 0);
         indices_ = GlBuffer::fromVector(tree.triIndices, 0);
-        counters_ = GlBuffer(bvh::kCounterBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+        counters_.allocate();
         nodeCount_ = tree.nodes.size();
         depth_ = tree.depth;
         leaves_ = tree.leaves;
         sahCost_ = tree.sahCost;
-        countersRead_ = false;
-        counterValues_.fill(0);
     }
 
     void resize(glm::ivec2 resolution) override {
@@ -97,7 +97,7 @@ public:
         samples_.upload(samples.data(), samples.size() * sizeof(glm::vec4));
 
         f.timer.begin("trace");
-        counters_.clearUint(0);
+        counters_.clear();
         setLightUniforms(trace_, f.light);
         const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
         trace_.set("uRayOffset", float(params_.getFloat("ray_offset")) * radius);
@@ -107,20 +107,17 @@ public:
         indices_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_INDEX_BINDING);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
-        glBindTextureUnit(0, f.gbuffer.position());
-        glBindTextureUnit(1, f.gbuffer.normal());
-        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(2, overflow_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        bindPixelPassInputs(f);
+        bindDebugImage(1, nodesVisited_);
+        bindDebugImage(2, overflow_);
         trace_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        finishPixelPass();
         f.timer.end();
-        countersRead_ = false;
+        counters_.markStale();
     }
 
     std::vector<Counter> counters() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         auto wide = [&](int lo) { return double((uint64_t(c[size_t(lo) + 1]) << 32) | c[size_t(lo)]); };
         const double rays = wide(BVH_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
@@ -154,7 +151,7 @@ public:
     }
 
     /// Pixels with a ray whose stack overflowed (written shadowed): 0 means the image is exact.
-    uint64_t overflowCount() const override { return readCounters()[BVH_C_OVERFLOW_PIXELS]; }
+    uint64_t overflowCount() const override { return counters_.read()[BVH_C_OVERFLOW_PIXELS]; }
 
 private:
     void compile() {
@@ -162,39 +159,25 @@ private:
                                         {{"BVH_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}});
     }
 
-    const std::array<uint32_t, BVH_COUNTER_WORDS>& readCounters() const {
-        if (!countersRead_ && counters_) {
-            counters_.download(counterValues_.data(), bvh::kCounterBytes);
-            countersRead_ = true;
-        }
-        return counterValues_;
-    }
-
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     ShaderProgram trace_;
-    GlBuffer nodes_, indices_, samples_, counters_;
+    GlBuffer nodes_, indices_, samples_;
+    GpuCounters<BVH_COUNTER_WORDS> counters_;
     size_t sampleCapacity_ = 0;
     GlTexture nodesVisited_, overflow_;
     size_t nodeCount_ = 0, leaves_ = 0;
     int depth_ = 0;
     double sahCost_ = 0, buildMs_ = 0;
-    mutable std::array<uint32_t, BVH_COUNTER_WORDS> counterValues_{};
-    mutable bool countersRead_ = false;
 };
 
 } // namespace
 
 AlgorithmInfo bvhRaytraceInfo() {
-    AlgorithmInfo info;
-    info.name = "bvh_raytrace";
-    info.summary = "GLSL ray tracing of the reference's shadow rays through a binned-SAH BVH built on the CPU";
-    info.lights = {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area};
-    info.exact = true;
-    info.schema = &bvhSchema;
-    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<BvhRaytrace>(p); };
-    return info;
+    return makeAlgorithmInfo<BvhRaytrace>("bvh_raytrace",
+                                    "GLSL ray tracing of the reference's shadow rays through a binned-SAH BVH built on the CPU",
+                                    {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true, &bvhSchema);
 }
 
 } // namespace shadowlab

@@ -1,9 +1,11 @@
 #include "algorithms/line_space/LineSpace.h"
 
+#include "algorithms/AlgorithmSupport.h"
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "algorithms/line_space/NTree.h"
 #include "algorithms/line_space/SampleClassifier.h"
 #include "framework/core/Error.h"
+#include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
 
 #include <algorithm>
@@ -94,11 +96,10 @@ public:
             bitChunks_ = usedChunks;
             compile();
         }
-        counters_ = GlBuffer(LS_COUNTER_WORDS * sizeof(uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        counters_.allocate();
         // The GPU holds the pools now; the CPU keeps only the node pool (start-node boxes for classify).
         tree_.tree = {};
         tree_.bits = {};
-        counterValues_.fill(0);
         classes_.reset();
     }
 
@@ -131,7 +132,7 @@ public:
         const ShaderProgram& p = classify ? classifyProgram_ : trace_;
 
         f.timer.begin("trace");
-        counters_.clearUint(0);
+        counters_.clear();
         setLightUniforms(p, f.light);
         p.set("uRayOffset", rayOffset());
         p.set("uSampleCount", int(samples.size()));
@@ -144,15 +145,12 @@ public:
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_COUNTER_BINDING);
         if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
-        glBindTextureUnit(0, f.gbuffer.position());
-        glBindTextureUnit(1, f.gbuffer.normal());
-        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        bindPixelPassInputs(f);
+        bindDebugImage(1, nodesVisited_);
         p.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        finishPixelPass();
         f.timer.end();
-        countersRead_ = false;
+        counters_.markStale();
         classes_.reset();
         if (classify) { // classified lazily in counters(), outside the timed stages
             pendingG_ = f.cpuGBuffer();
@@ -161,7 +159,7 @@ public:
     }
 
     std::vector<Counter> counters() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         auto wide = [&](int lo) { return double((uint64_t(c[size_t(lo) + 1]) << 32) | c[size_t(lo)]); };
         const double rays = wide(LS_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
@@ -203,7 +201,7 @@ public:
 
     /// Traversal stack overflows: one frame per level always suffices, so this is 0 unless the
     /// pools are corrupt (an overflowing ray is counted occluded, never lit).
-    uint64_t overflowCount() const override { return readCounters()[LS_C_OVERFLOW]; }
+    uint64_t overflowCount() const override { return counters_.read()[LS_C_OVERFLOW]; }
 
 private:
     ShaderDefines defines(bool classify) const {
@@ -254,14 +252,6 @@ private:
         return *classes_;
     }
 
-    const std::array<uint32_t, LS_COUNTER_WORDS>& readCounters() const {
-        if (!countersRead_ && counters_) {
-            counters_.download(counterValues_.data(), LS_COUNTER_WORDS * sizeof(uint32_t));
-            countersRead_ = true;
-        }
-        return counterValues_;
-    }
-
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
@@ -269,7 +259,8 @@ private:
     ls::NTree tree_; ///< node pool and statistics (the tree and line-space pools live on the GPU only)
     bool cacheHit_ = false;
     std::array<size_t, 3> poolBytes_{}; ///< node, tree and line-space pools (a GlBuffer rounds empty ones up to 4 bytes)
-    GlBuffer nodesBuf_, treeBuf_, samples_, counters_, classifyBuf_;
+    GlBuffer nodesBuf_, treeBuf_, samples_, classifyBuf_;
+    GpuCounters<LS_COUNTER_WORDS> counters_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
     size_t nodesPerChunk_ = 1;
     int bitChunks_ = 1; ///< line-space pool blocks the compiled programs read (LS_BIT_CHUNK_COUNT)
@@ -279,21 +270,14 @@ private:
     Light pendingLight_;
     mutable std::unique_ptr<EmbreeTracer> tracer_;
     mutable std::optional<ls::SampleClasses> classes_;
-    mutable std::array<uint32_t, LS_COUNTER_WORDS> counterValues_{};
-    mutable bool countersRead_ = false;
 };
 
 } // namespace
 
 AlgorithmInfo lineSpaceInfo() {
-    AlgorithmInfo info;
-    info.name = "line_space";
-    info.summary = "approximate shadows from precomputed line-space visibility in an N-tree (no triangle tests)";
-    info.lights = {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area};
-    info.exact = false;
-    info.schema = &lineSpaceSchema;
-    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<LineSpace>(p); };
-    return info;
+    return makeAlgorithmInfo<LineSpace>("line_space",
+                                    "approximate shadows from precomputed line-space visibility in an N-tree (no triangle tests)",
+                                    {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, false, &lineSpaceSchema);
 }
 
 } // namespace shadowlab

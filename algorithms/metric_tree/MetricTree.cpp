@@ -1,11 +1,13 @@
 #include "algorithms/metric_tree/MetricTree.h"
 
+#include "algorithms/AlgorithmSupport.h"
 #include "algorithms/metric_tree/ClusterCache.h"
 #include "algorithms/metric_tree/Clustering.h"
 #include "algorithms/metric_tree/CpuTree.h"
 #include "algorithms/metric_tree/MetricTreeGpuLayout.h"
 #include "algorithms/metric_tree/MetricTreeMath.h"
 #include "framework/core/Error.h"
+#include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
 
 #include <algorithm>
@@ -81,8 +83,7 @@ public:
         capsuleCount_ = c.capsules;
         clusters_ = GlBuffer::fromVector(c.clusters, 0);
         nodes_ = GlBuffer(std::max<size_t>(1, clusterCount_) * MT_NODE_BYTES, nullptr, GL_DYNAMIC_STORAGE_BIT);
-        counters_ = GlBuffer(mt::kCounterBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
-        counters_.clearUint(0);
+        counters_.allocate();
         // The triangles in cluster order, split over blocks of at most MT_TRIANGLES_PER_CHUNK.
         geometryBytes_ = 0;
         const Scene& s = scene.cpu();
@@ -99,7 +100,6 @@ public:
             geometryBytes_ += geometry_[chunk].size();
         }
         if (!geometry_[0]) geometry_[0] = GlBuffer(36, nullptr, 0); // an empty scene still binds its blocks
-        countersRead_ = false;
     }
 
     void resize(glm::ivec2 resolution) override {
@@ -124,7 +124,7 @@ public:
         bind();
 
         f.timer.begin("build");
-        counters_.clearUint(0); // also empties the tree: its root pointer is counter word 0
+        counters_.clear(); // also empties the tree: its root pointer is counter word 0
         if (clusterCount_ > 0) {
             dispatchPerCluster(prepare_);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -138,22 +138,19 @@ public:
         f.timer.end();
 
         f.timer.begin("traverse");
-        glBindTextureUnit(0, f.gbuffer.position());
-        glBindTextureUnit(1, f.gbuffer.normal());
-        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(2, triangleTests_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(3, fruitless_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(4, overflow_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        bindPixelPassInputs(f);
+        bindDebugImage(1, nodesVisited_);
+        bindDebugImage(2, triangleTests_);
+        bindDebugImage(3, fruitless_);
+        bindDebugImage(4, overflow_);
         query_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        finishPixelPass();
         f.timer.end();
-        countersRead_ = false;
+        counters_.markStale();
     }
 
     std::vector<Counter> counters() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         auto wide = [&](int lo) { return double((uint64_t(c[lo + 1]) << 32) | c[lo]); };
         const double px = c[MT_C_TRAVERSED];
         auto perPixel = [&](int lo) { return px > 0 ? wide(lo) / px : 0.0; };
@@ -196,7 +193,7 @@ public:
 
     /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
     uint64_t overflowCount() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         return uint64_t(c[MT_C_STACK_OVERFLOW]) + c[MT_C_BUILD_ERRORS];
     }
 
@@ -312,40 +309,26 @@ private:
         counters_.upload(head, sizeof head);
     }
 
-    const std::array<uint32_t, MT_COUNTER_WORDS>& readCounters() const {
-        if (!countersRead_ && counters_) {
-            counters_.download(counterValues_.data(), mt::kCounterBytes);
-            countersRead_ = true;
-        }
-        return counterValues_;
-    }
-
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     ShaderProgram prepare_, insert_, query_;
-    GlBuffer clusters_, nodes_, counters_;
+    GlBuffer clusters_, nodes_;
+    GpuCounters<MT_COUNTER_WORDS> counters_;
     std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;
     GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;
     size_t clusterCount_ = 0, capsuleCount_ = 0, geometryBytes_ = 0;
     float lsEps_ = kAngularEps;
     bool cacheHit_ = false;
     double clusteringMs_ = 0;
-    mutable std::array<uint32_t, MT_COUNTER_WORDS> counterValues_{};
-    mutable bool countersRead_ = false;
 };
 
 } // namespace
 
 AlgorithmInfo metricTreeInfo() {
-    AlgorithmInfo info;
-    info.name = "metric_tree";
-    info.summary = "clusters bounded by spheres/capsules in a per-frame ternary metric tree (compute), per-pixel query";
-    info.lights = {LightType::Point, LightType::Directional};
-    info.exact = true;
-    info.schema = &metricTreeSchema;
-    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<MetricTree>(p); };
-    return info;
+    return makeAlgorithmInfo<MetricTree>("metric_tree",
+                                    "clusters bounded by spheres/capsules in a per-frame ternary metric tree (compute), per-pixel query",
+                                    {LightType::Point, LightType::Directional}, true, &metricTreeSchema);
 }
 
 } // namespace shadowlab

@@ -1,8 +1,10 @@
 #include "algorithms/psv/Psv.h"
 
+#include "algorithms/AlgorithmSupport.h"
 #include "algorithms/psv/PsvGpuLayout.h"
 #include "algorithms/psv/PsvPermutation.h"
 #include "framework/core/Error.h"
+#include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
 
 #include <algorithm>
@@ -53,11 +55,9 @@ public:
         if (psv::nodeCount(n) > size_t(UINT32_MAX))
             throw RuntimeError("psv: " + std::to_string(n) + " triangles exceed 32-bit node indices");
         nodes_ = GlBuffer(psv::nodeCount(n) * PSV_NODE_BYTES, nullptr, 0);
-        counters_ = GlBuffer(psv::kCounterBytes, nullptr, 0);
+        counters_.allocate();
         nodes_.clearUint(0);
-        counters_.clearUint(0);
         permutation_ = psv::makePermutation(uint32_t(n), uint32_t(params_.getInt("seed")));
-        countersRead_ = false;
     }
 
     void resize(glm::ivec2 resolution) override {
@@ -80,7 +80,7 @@ public:
         setUniforms(f.light);
 
         f.timer.begin("build");
-        counters_.clearUint(0);
+        counters_.clear();
         // Node 0 is the sentinel whose `pos` is the root pointer: emptying it empties the tree.
         // The other nodes need no clearing: frusta.comp rewrites every node that can be linked.
         const GLuint zero = 0;
@@ -100,20 +100,17 @@ public:
         // scene, so a light-view frustum culls nothing for the lights psv supports (a spot light
         // would cull the triangles outside its cone).
         f.timer.begin("traverse");
-        glBindTextureUnit(0, f.gbuffer.position());
-        glBindTextureUnit(1, f.gbuffer.normal());
-        glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(1, nodesVisited_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(2, overflow_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        bindPixelPassInputs(f);
+        bindDebugImage(1, nodesVisited_);
+        bindDebugImage(2, overflow_);
         query_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        finishPixelPass();
         f.timer.end();
-        countersRead_ = false;
+        counters_.markStale();
     }
 
     std::vector<Counter> counters() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         const double visited = double((uint64_t(c[PSV_C_VISITED_HI]) << 32) | c[PSV_C_VISITED_LO]);
         const double traversed = c[PSV_C_TRAVERSED];
         return {{"nodes_visited_mean", traversed > 0 ? visited / traversed : 0.0},
@@ -139,7 +136,7 @@ public:
 
     /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
     uint64_t overflowCount() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         return uint64_t(c[PSV_C_STACK_OVERFLOW]) + c[PSV_C_BUILD_ERRORS];
     }
 
@@ -191,36 +188,22 @@ private:
         glDispatchCompute(gx, gy, 1);
     }
 
-    const std::array<uint32_t, PSV_COUNTER_WORDS>& readCounters() const {
-        if (!countersRead_ && counters_) {
-            counters_.download(counterValues_.data(), psv::kCounterBytes);
-            countersRead_ = true;
-        }
-        return counterValues_;
-    }
-
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     ShaderProgram frusta_, build_, query_;
-    GlBuffer nodes_, counters_;
+    GlBuffer nodes_;
+    GpuCounters<PSV_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
     psv::Permutation permutation_;
-    mutable std::array<uint32_t, PSV_COUNTER_WORDS> counterValues_{};
-    mutable bool countersRead_ = false;
 };
 
 } // namespace
 
 AlgorithmInfo psvInfo() {
-    AlgorithmInfo info;
-    info.name = "psv";
-    info.summary = "partitioned shadow volumes: per-frame TOP tree of shadow frusta (compute), per-pixel stack query";
-    info.lights = {LightType::Point, LightType::Directional};
-    info.exact = true;
-    info.schema = &psvSchema;
-    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<Psv>(p); };
-    return info;
+    return makeAlgorithmInfo<Psv>("psv",
+                                    "partitioned shadow volumes: per-frame TOP tree of shadow frusta (compute), per-pixel stack query",
+                                    {LightType::Point, LightType::Directional}, true, &psvSchema);
 }
 
 } // namespace shadowlab

@@ -1,7 +1,9 @@
 #include "algorithms/ptsv/Ptsv.h"
 
+#include "algorithms/AlgorithmSupport.h"
 #include "algorithms/ptsv/PtsvLayout.h"
 #include "framework/core/Error.h"
+#include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
 
 #include <algorithm>
@@ -87,9 +89,7 @@ public:
         if (n * PTSV_PLANES_PER_TRIANGLE * 16 > maxBlockBytes())
             throw RuntimeError("ptsv: " + std::to_string(n) + " triangles exceed the largest storage block");
         planes_ = GlBuffer(std::max<size_t>(n, 1) * PTSV_PLANES_PER_TRIANGLE * 16, nullptr, 0);
-        counters_ = GlBuffer(PTSV_COUNTER_WORDS * sizeof(uint32_t), nullptr, 0);
-        counters_.clearUint(0);
-        countersRead_ = false;
+        counters_.allocate();
         layoutKey_ = {}; // the per-job iteration record is sized by the triangle count
     }
 
@@ -116,7 +116,7 @@ public:
         bindAll();
 
         f.timer.begin("hierarchy");
-        counters_.clearUint(0);
+        counters_.clear();
         if (params_.getBool("job_iterations")) jobIterations_.clearUint(0);
         glClearNamedBufferSubData(masks_.id(), GL_R32UI, 0, GLsizeiptr(layout_.maskWords * 4), GL_RED_INTEGER,
                                   GL_UNSIGNED_INT, nullptr);
@@ -167,17 +167,16 @@ public:
 
         f.timer.begin("resolve");
         glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindImageTexture(1, heat_.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        bindDebugImage(1, heat_);
         resolve_.use();
         glDispatchCompute(GLuint(layout_.tilesX), GLuint(layout_.tilesY), 1);
-        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                        GL_BUFFER_UPDATE_BARRIER_BIT);
+        finishPixelPass();
         f.timer.end();
-        countersRead_ = false;
+        counters_.markStale();
     }
 
     std::vector<Counter> counters() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         auto wide = [&](int lo, int hi) { return double((uint64_t(c[size_t(hi)]) << 32) | c[size_t(lo)]); };
         const double jobs1 = c[PTSV_C_JOBS_1];
         const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(params_.getInt("job_capacity")));
@@ -232,7 +231,7 @@ public:
     /// heat-map image, a debug aid).
     size_t memoryBytes() const override {
         size_t bytes = 0;
-        for (const GlBuffer* b : {&masks_, &bounds_, &samples_, &keys_, &shadow_, &heatCounts_, &planes_, &jobs_, &counters_,
+        for (const GlBuffer* b : {&masks_, &bounds_, &samples_, &keys_, &shadow_, &heatCounts_, &planes_, &jobs_, &counters_.buffer(),
                                   &jobIterations_})
             bytes += b->size();
         return bytes;
@@ -242,7 +241,7 @@ public:
     /// count says the list was too small for the two-pass balance), plus jobs the driver's loop cap
     /// cut short (their shadows may be missing: must stay 0).
     uint64_t overflowCount() const override {
-        const auto& c = readCounters();
+        const auto& c = counters_.read();
         return uint64_t(c[PTSV_C_JOB_OVERFLOW]) + c[PTSV_C_TRUNCATED];
     }
 
@@ -398,14 +397,6 @@ private:
         glDispatchCompute(gx, gy, 1);
     }
 
-    const std::array<uint32_t, PTSV_COUNTER_WORDS>& readCounters() const {
-        if (!countersRead_ && counters_) {
-            counters_.download(counterValues_.data(), PTSV_COUNTER_WORDS * sizeof(uint32_t));
-            countersRead_ = true;
-        }
-        return counterValues_;
-    }
-
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
@@ -416,23 +407,17 @@ private:
     std::array<float, 6> layoutKey_{};
     bool warnedSplit_ = false;
     ShaderProgram hierarchy_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
-    GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, counters_, jobIterations_;
+    GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
+    GpuCounters<PTSV_COUNTER_WORDS> counters_;
     GlTexture heat_;
-    mutable std::array<uint32_t, PTSV_COUNTER_WORDS> counterValues_{};
-    mutable bool countersRead_ = false;
 };
 
 } // namespace
 
 AlgorithmInfo ptsvInfo() {
-    AlgorithmInfo info;
-    info.name = "ptsv";
-    info.summary = "per-triangle shadow volumes through a per-frame view-sample cluster hierarchy (compute)";
-    info.lights = {LightType::Point, LightType::Directional};
-    info.exact = true;
-    info.schema = &ptsvSchema;
-    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<Ptsv>(p); };
-    return info;
+    return makeAlgorithmInfo<Ptsv>("ptsv",
+                                    "per-triangle shadow volumes through a per-frame view-sample cluster hierarchy (compute)",
+                                    {LightType::Point, LightType::Directional}, true, &ptsvSchema);
 }
 
 } // namespace shadowlab

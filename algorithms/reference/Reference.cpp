@@ -1,5 +1,6 @@
 #include "algorithms/reference/Reference.h"
 
+#include "algorithms/AlgorithmSupport.h"
 #include "algorithms/reference/EmbreeTracer.h"
 
 #include <chrono>
@@ -69,16 +70,10 @@ private:
 } // namespace
 
 AlgorithmInfo referenceInfo() {
-    AlgorithmInfo info;
-    info.name = "reference";
-    info.summary = "ground truth: exact shadows ray-traced on the CPU with Embree (multi-threaded)";
-    info.lights = {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area};
-    info.exact = true;
-    info.schema = &referenceSchema;
-    info.create = [](const ParamValues& params) -> std::unique_ptr<ShadowAlgorithm> {
-        return std::make_unique<Reference>(params);
-    };
-    return info;
+    return makeAlgorithmInfo<Reference>("reference",
+                                        "ground truth: exact shadows ray-traced on the CPU with Embree (multi-threaded)",
+                                        {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area},
+                                        true, &referenceSchema);
 }
 
 } // namespace shadowlab

@@ -1,5 +1,6 @@
 #include "algorithms/shadow_map/ShadowMap.h"
 
+#include "algorithms/AlgorithmSupport.h"
 #include "framework/core/Error.h"
 #include "framework/render/LightUniforms.h"
 
@@ -172,12 +173,9 @@ private:
 } // namespace
 
 AlgorithmInfo shadowMapInfo() {
-    return {"shadow_map",
-            "shadow maps: 2D for spot/directional, cube map for point lights, constant + slope bias, PCF",
-            {LightType::Point, LightType::Spot, LightType::Directional},
-            false,
-            &schema,
-            [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<ShadowMap>(p); }};
+    return makeAlgorithmInfo<ShadowMap>("shadow_map",
+                                        "shadow maps: 2D for spot/directional, cube map for point lights, constant + slope bias, PCF",
+                                        {LightType::Point, LightType::Spot, LightType::Directional}, false, &schema);
 }
 
 } // namespace shadowlab

@@ -1,0 +1,47 @@
+#pragma once
+// What several algorithm plugins share besides the interface: their registry entry, and the
+// binding convention of per-pixel compute passes.
+#include "algorithms/ShadowAlgorithm.h"
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace shadowlab {
+
+/// The registry entry of algorithm class T, built from its validated ParamValues.
+template <class T>
+AlgorithmInfo makeAlgorithmInfo(std::string name, std::string summary, std::vector<LightType> lights, bool exact,
+                                const ParamSchema& (*schema)()) {
+    AlgorithmInfo info;
+    info.name = std::move(name);
+    info.summary = std::move(summary);
+    info.lights = std::move(lights);
+    info.exact = exact;
+    info.schema = schema;
+    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<T>(p); };
+    return info;
+}
+
+/// Per-pixel passes read the G-buffer's world position (texture unit 0) and camera-facing normal
+/// (unit 1) and write visibility to image unit 0 (R32F); units above are the algorithm's own.
+inline void bindPixelPassInputs(const FrameInputs& f) {
+    glBindTextureUnit(0, f.gbuffer.position());
+    glBindTextureUnit(1, f.gbuffer.normal());
+    glBindImageTexture(0, f.visibility, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+}
+
+/// Binds an R32F debug image (heat map, overflow mask) a per-pixel pass writes.
+inline void bindDebugImage(GLuint unit, const GlTexture& image) {
+    glBindImageTexture(unit, image.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+}
+
+/// After a per-pixel pass: its images are read by the shading pass and read back, its counters
+/// downloaded.
+inline void finishPixelPass() {
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                    GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+} // namespace shadowlab
