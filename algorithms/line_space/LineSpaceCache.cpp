@@ -1,11 +1,11 @@
 #include "algorithms/line_space/LineSpaceCache.h"
 
+#include "framework/core/DiskCache.h"
+
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 namespace shadowlab::ls {
 namespace {
@@ -27,18 +27,7 @@ struct Header {
     uint64_t headerChecksum; ///< of every byte above
 };
 
-/// FNV-1a over 64-bit words (8× faster than per byte on the ~100 MB pools; the tail per byte).
-uint64_t checksum(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    size_t i = 0;
-    for (; i + 8 <= bytes; i += 8) {
-        uint64_t w;
-        std::memcpy(&w, p + i, 8);
-        h = (h ^ w) * 1099511628211ull;
-    }
-    for (; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
+using diskcache::checksum;
 
 uint64_t payloadChecksum(const NTree& t) {
     uint64_t h = checksum(t.nodes.data(), t.nodes.size() * sizeof(NodeGpu));
@@ -46,18 +35,9 @@ uint64_t payloadChecksum(const NTree& t) {
     return checksum(t.bits.data(), t.bits.size() * sizeof(uint32_t), h);
 }
 
-bool fail(std::string* why, const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-}
-
 } // namespace
 
-std::string cacheDirectory() {
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/shadowlab/line_space";
-    if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/shadowlab/line_space";
-    return "";
-}
+std::string cacheDirectory() { return diskcache::directory("line_space"); }
 
 std::string cacheFile(const std::string& dir, uint64_t sceneHash, int n, int d) {
     char name[64];
@@ -78,34 +58,19 @@ bool saveCache(const std::string& path, uint64_t sceneHash, const NTree& t, std:
     h.payloadChecksum = payloadChecksum(t);
     h.headerChecksum = checksum(&h, offsetof(Header, headerChecksum));
 
-    std::error_code ec;
-    fs::create_directories(fs::path(path).parent_path(), ec);
-    // Written beside the target and renamed over it: a reader never sees half a file, and two
-    // processes building the same key at once each replace the file whole.
-    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) return fail(why, "cannot create " + tmp);
-        out.write(reinterpret_cast<const char*>(&h), sizeof h);
-        out.write(reinterpret_cast<const char*>(t.nodes.data()), std::streamsize(t.nodes.size() * sizeof(NodeGpu)));
-        out.write(reinterpret_cast<const char*>(t.tree.data()), std::streamsize(t.tree.size() * sizeof(uint32_t)));
-        out.write(reinterpret_cast<const char*>(t.bits.data()), std::streamsize(t.bits.size() * sizeof(uint32_t)));
-        if (!out) {
-            fs::remove(tmp, ec);
-            return fail(why, "cannot write " + tmp);
-        }
-    }
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        return fail(why, "cannot rename " + tmp + " to " + path);
-    }
-    return true;
+    // A reader never sees half a file, and two processes building the same key at once each
+    // replace the file whole.
+    return diskcache::writeAtomically(path,
+                                      {{&h, sizeof h},
+                                       {t.nodes.data(), t.nodes.size() * sizeof(NodeGpu)},
+                                       {t.tree.data(), t.tree.size() * sizeof(uint32_t)},
+                                       {t.bits.data(), t.bits.size() * sizeof(uint32_t)}},
+                                      why);
 }
 
 std::optional<NTree> loadCache(const std::string& path, uint64_t sceneHash, int n, int d, std::string* why) {
     auto bad = [why](const std::string& reason) {
-        fail(why, reason);
+        if (why) *why = reason;
         return std::optional<NTree>{};
     };
     std::ifstream in(path, std::ios::binary);

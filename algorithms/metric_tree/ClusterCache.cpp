@@ -1,11 +1,11 @@
 #include "algorithms/metric_tree/ClusterCache.h"
 
+#include "framework/core/DiskCache.h"
+
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 namespace shadowlab::mt {
 namespace {
@@ -23,35 +23,16 @@ struct Header {
     uint64_t headerChecksum; ///< of every byte above
 };
 
-uint64_t checksum(const void* data, size_t bytes, uint64_t h = 1469598103934665603ull) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    size_t i = 0;
-    for (; i + 8 <= bytes; i += 8) {
-        uint64_t w;
-        std::memcpy(&w, p + i, 8);
-        h = (h ^ w) * 1099511628211ull;
-    }
-    for (; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
+using diskcache::checksum;
 
 uint64_t payloadChecksum(const Clustering& c) {
     return checksum(c.order.data(), c.order.size() * sizeof(uint32_t),
                     checksum(c.clusters.data(), c.clusters.size() * sizeof(ClusterGpu)));
 }
 
-bool fail(std::string* why, const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-}
-
 } // namespace
 
-std::string cacheDirectory() {
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/shadowlab/metric_tree";
-    if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/shadowlab/metric_tree";
-    return "";
-}
+std::string cacheDirectory() { return diskcache::directory("metric_tree"); }
 
 std::string cacheFile(const std::string& dir, uint64_t sceneHash, const ClusteringOptions& o) {
     char name[96];
@@ -69,33 +50,18 @@ bool saveCache(const std::string& path, uint64_t sceneHash, const ClusteringOpti
     h.sceneHash = sceneHash, h.triangles = triangles, h.clusters = c.clusters.size(), h.capsuleCount = c.capsules;
     h.payloadChecksum = payloadChecksum(c);
     h.headerChecksum = checksum(&h, offsetof(Header, headerChecksum));
-    std::error_code ec;
-    fs::create_directories(fs::path(path).parent_path(), ec);
-    // Written beside the target and renamed over it: a reader never sees half a file.
-    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) return fail(why, "cannot create " + tmp);
-        out.write(reinterpret_cast<const char*>(&h), sizeof h);
-        out.write(reinterpret_cast<const char*>(c.clusters.data()), std::streamsize(c.clusters.size() * sizeof(ClusterGpu)));
-        out.write(reinterpret_cast<const char*>(c.order.data()), std::streamsize(c.order.size() * sizeof(uint32_t)));
-        if (!out) {
-            fs::remove(tmp, ec);
-            return fail(why, "cannot write " + tmp);
-        }
-    }
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        return fail(why, "cannot rename " + tmp + " to " + path);
-    }
-    return true;
+    // A reader never sees half a file.
+    return diskcache::writeAtomically(path,
+                                      {{&h, sizeof h},
+                                       {c.clusters.data(), c.clusters.size() * sizeof(ClusterGpu)},
+                                       {c.order.data(), c.order.size() * sizeof(uint32_t)}},
+                                      why);
 }
 
 std::optional<Clustering> loadCache(const std::string& path, uint64_t sceneHash, const ClusteringOptions& o,
                                     size_t triangles, std::string* why) {
     auto bad = [why](const std::string& reason) {
-        fail(why, reason);
+        if (why) *why = reason;
         return std::optional<Clustering>{};
     };
     std::ifstream in(path, std::ios::binary);
