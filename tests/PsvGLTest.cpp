@@ -4,12 +4,9 @@
 #include "algorithms/psv/Psv.h"
 #include "algorithms/psv/PsvGpuLayout.h"
 #include "algorithms/psv/PsvPermutation.h"
-#include "algorithms/reference/EmbreeTracer.h"
-#include "framework/metrics/Accuracy.h"
 #include "framework/scene/Procedural.h"
+#include "tests/AlgorithmHarness.h"
 #include "tests/TestSupport.h"
-
-#include <glm/gtc/matrix_transform.hpp>
 
 #include <cstdio>
 #include <cstring>
@@ -20,114 +17,9 @@
 namespace shadowlab {
 namespace {
 
-// ---- Scenes ------------------------------------------------------------------------------------
+using namespace test;
 
-glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
-glm::mat4 rotate(float deg, glm::vec3 axis) { return glm::rotate(glm::mat4(1.0f), glm::radians(deg), axis); }
-
-Scene ground(float size = 10.0f) { return makePlane({size, size}, 4, Material{glm::vec3(0.7f), 1.0f}); }
-
-struct Shot {
-    Scene scene;
-    Camera camera;
-    Light light;
-};
-
-Camera lookAt(glm::vec3 from, glm::vec3 to) {
-    Camera c;
-    c.position = from;
-    c.target = to;
-    c.fovYDeg = 60.0f;
-    c.nearPlane = 0.02f;
-    c.farPlane = 50.0f;
-    return c;
-}
-
-Light pointLight(glm::vec3 p) {
-    Light l;
-    l.type = LightType::Point;
-    l.position = p;
-    return l;
-}
-
-// Three big triangles crossing one another, one of them also piercing the ground they shadow.
-Shot intersectingTriangles() {
-    Shot s;
-    s.scene = ground();
-    Material m{glm::vec3(0.8f, 0.4f, 0.3f), 1.0f};
-    s.scene.addTriangles({{-1.2f, 0.4f, -0.6f}, {1.2f, 0.4f, -0.6f}, {0.0f, 1.2f, 0.9f},     // gently sloped
-                          {-0.9f, 1.3f, -0.9f}, {1.0f, 0.3f, 0.8f}, {0.7f, 1.4f, 0.1f},      // crosses the first
-                          {-1.6f, -0.6f, 1.0f}, {-0.3f, -0.6f, 1.2f}, {-0.9f, 1.1f, 0.4f}}, // pierces the ground
-                         m);
-    s.camera = lookAt({2.5f, 3.0f, 3.5f}, {0, 0.3f, 0});
-    s.light = pointLight({0.6f, 4.0f, -0.4f});
-    return s;
-}
-
-// A sphere shell with six holes around a point light, inside a closed room: light escapes in every
-// direction (floor, ceiling, four walls), so every side of the omni light is exercised.
-Shot omniInsideShell() {
-    Shot s;
-    const glm::vec3 c(0.0f, 1.5f, 0.0f);
-    Scene sphere = makeSphere(0.6f, 800, Material{});
-    std::vector<glm::vec3> kept;
-    const glm::vec3 holes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0.6f, 0, -0.8f}};
-    for (size_t t = 0; t < sphere.triangleCount(); ++t) {
-        glm::vec3 centroid = (sphere.positions[3 * t] + sphere.positions[3 * t + 1] + sphere.positions[3 * t + 2]) / 3.0f;
-        bool hole = false;
-        for (glm::vec3 h : holes) hole = hole || glm::dot(glm::normalize(centroid), glm::normalize(h)) > 0.97f;
-        if (!hole)
-            for (int k = 0; k < 3; ++k) kept.push_back(sphere.positions[3 * t + k] + c);
-    }
-    s.scene.addTriangles(kept, Material{glm::vec3(0.9f, 0.8f, 0.3f), 1.0f});
-    Scene wall = makePlane({6, 6}, 3, Material{glm::vec3(0.7f), 1.0f});
-    s.scene.append(wall, glm::mat4(1.0f));                                            // floor
-    s.scene.append(wall, translate({0, 3, 0}) * rotate(180, {1, 0, 0}));               // ceiling
-    s.scene.append(wall, translate({-3, 1.5f, 0}) * rotate(-90, {0, 0, 1}));           // walls
-    s.scene.append(wall, translate({3, 1.5f, 0}) * rotate(90, {0, 0, 1}));
-    s.scene.append(wall, translate({0, 1.5f, -3}) * rotate(90, {1, 0, 0}));
-    s.scene.append(wall, translate({0, 1.5f, 3}) * rotate(-90, {1, 0, 0}));
-    s.camera = lookAt({2.6f, 2.6f, 2.6f}, {-0.5f, 1.0f, -0.5f});
-    s.camera.fovYDeg = 100.0f;
-    s.light = pointLight(c + glm::vec3(0.05f, -0.03f, 0.02f));
-    return s;
-}
-
-// Closed objects on a plane under an oblique directional light.
-Shot directionalObjects() {
-    Shot s;
-    s.scene = ground();
-    s.scene.append(makeSphere(0.6f, 600, Material{}), translate({-0.8f, 0.8f, 0}));
-    s.scene.append(makeTorus(0.5f, 0.15f, 500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
-    s.scene.append(makeCylinder(0.25f, 1.2f, 200, Material{}), translate({0.2f, 0.0f, -1.0f}));
-    s.camera = lookAt({0.0f, 3.0f, 4.5f}, {0, 0.3f, 0});
-    s.light.type = LightType::Directional;
-    s.light.position = {3.0f, 5.0f, 2.0f};
-    s.light.target = {0, 0, 0};
-    return s;
-}
-
-// The camera sits under a roof, inside the roof's shadow volume, looking out at the lit ground.
-Shot cameraInsideShadow() {
-    Shot s;
-    s.scene = ground();
-    s.scene.append(makePlane({3, 3}, 2, Material{}), translate({0, 1.5f, 0}));
-    s.scene.append(makeSphere(0.3f, 300, Material{}), translate({0.8f, 0.3f, 0.8f}));
-    s.camera = lookAt({0.2f, 0.8f, 0.3f}, {3.0f, 0.0f, 3.0f});
-    s.light = pointLight({0.3f, 5.0f, 0.2f});
-    return s;
-}
-
-// A few thousand triangles of closed meshes (the wedge and stack tests).
-Shot thousandsOfTriangles() {
-    Shot s;
-    s.scene = ground();
-    s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
-    s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
-    s.camera = lookAt({0.0f, 3.0f, 5.0f}, {0, 0.4f, 0});
-    s.light = pointLight({2.0f, 4.0f, 1.5f});
-    return s;
-}
+// ---- Scenes (the shared ones are in tests/ShadowTestScenes.h) -----------------------------------
 
 // Overlapping semi-transparent spheres and an opaque box-like cylinder (x-ray shadows).
 Shot transparentCasters() {
@@ -143,61 +35,26 @@ Shot transparentCasters() {
 
 // ---- Running psv and the reference ---------------------------------------------------------------
 
-constexpr int kRes = 96; // small: GLSL runs on the CPU here
-
-struct Outcome {
-    std::vector<float> visibility, reference;
-    std::vector<uint8_t> lit;
-    std::vector<float> overflowMask;
-    std::map<std::string, double> counters;
-    uint64_t overflow = 0;
-    size_t memory = 0;
-    StageTime build, traverse; ///< GL timer and CPU clock per stage
-    Accuracy accuracy;
+struct Outcome : AlgorithmRun {
+    StageTime build, traverse;       ///< GL timer and CPU clock per stage
     std::vector<psv::NodeGpu> nodes; ///< the TOP tree, read back from the SSBO psv left bound
 };
 
 class PsvGLTest : public test::GLTest {
 protected:
     Outcome run(const Shot& s, const std::map<std::string, ParamValue>& overrides = {}, bool withReference = true) {
-        const AlgorithmInfo info = psvInfo();
-        ParamValues params(info.schema());
-        for (const auto& [k, v] : overrides) params.set(k, v);
-        SceneGpu gpu(s.scene);
-        GBuffer gbuffer({kRes, kRes});
-        gbuffer.render(gpu, s.camera);
-        std::unique_ptr<ShadowAlgorithm> psv = info.create(params);
-        psv->setScene(gpu);
-        psv->resize({kRes, kRes});
-        GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
-        StageTimer timer;
-        CpuGBuffer cpu = gbuffer.readBack();
-        const FrameInputs frame{gbuffer, [&]() -> const CpuGBuffer& { return cpu; }, s.camera, s.light, 0, visibility.id(), timer};
-        // A first, untimed frame: llvmpipe compiles shaders at their first dispatch, and rasterises
-        // the G-buffer lazily, so neither belongs in psv's stage times.
-        psv->computeVisibility(frame);
-        glFinish();
-        timer.collect();
-        psv->computeVisibility(frame);
         Outcome o;
-        for (const StageTime& t : timer.collect()) (t.name == "build" ? o.build : o.traverse) = t;
-        o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
-        for (const Counter& c : psv->counters()) o.counters[c.name] = c.value;
-        o.overflow = psv->overflowCount();
-        o.memory = psv->memoryBytes();
-        for (const DebugView& v : psv->debugViews())
-            if (v.name == "stack_overflow") o.overflowMask = readTextureR32F(v.texture, kRes, kRes);
-        GLint nodeBuffer = 0; // test-only peek at the tree: psv leaves its node SSBO bound
-        glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, PSV_NODE_BINDING, &nodeBuffer);
-        o.nodes.resize(psv::nodeCount(s.scene.triangleCount()));
-        glGetNamedBufferSubData(GLuint(nodeBuffer), 0, GLsizeiptr(o.nodes.size() * sizeof(psv::NodeGpu)), o.nodes.data());
-        o.lit = litMask(cpu, s.light);
-        if (withReference) {
-            EmbreeTracer tracer(s.scene);
-            float radius = s.scene.bounds.radius();
-            tracer.traceVisibility(cpu, s.light, float(params.getFloat("ray_offset")) * radius, 0, o.reference);
-            o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
-        }
+        RunOptions options;
+        options.warmUp = true; // psv's stage times are measured: keep shader compilation out of them
+        options.withReference = withReference;
+        options.inspect = [&](const AlgorithmRun&) {
+            GLint nodeBuffer = 0; // test-only peek at the tree: psv leaves its node SSBO bound
+            glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, PSV_NODE_BINDING, &nodeBuffer);
+            o.nodes.resize(psv::nodeCount(s.scene.triangleCount()));
+            glGetNamedBufferSubData(GLuint(nodeBuffer), 0, GLsizeiptr(o.nodes.size() * sizeof(psv::NodeGpu)), o.nodes.data());
+        };
+        static_cast<AlgorithmRun&>(o) = runAlgorithm(psvInfo(), s, overrides, options);
+        for (const StageTime& t : o.stages) (t.name == "build" ? o.build : o.traverse) = t;
         return o;
     }
 };
@@ -211,6 +68,11 @@ struct AccuracyCase {
     double maxMismatch; ///< share of lit pixels whose binary visibility differs from the reference
     double maxRmse;     ///< root mean square visibility difference over lit pixels
 };
+
+void PrintTo(const AccuracyCase& c, std::ostream* os) {
+    printCase(*os, c.name, c.params);
+    *os << " mismatch ≤ " << c.maxMismatch << ", rmse ≤ " << c.maxRmse;
+}
 
 // psv is exact: every row is held to the goal of 0.01 % of lit pixels (the requirement is 0.1 %),
 // which at 96² (5,000 to 9,000 lit pixels) allows no mismatching pixel at all; llvmpipe meets it
@@ -294,15 +156,9 @@ TEST_F(PsvGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
     std::printf("[psv] stack_size 1: %.0f overflowing pixels, overflowCount %llu\n", pixels, (unsigned long long)o.overflow);
     ASSERT_GT(pixels, 0.0);
     EXPECT_EQ(o.overflow, uint64_t(pixels));
-    size_t marked = 0;
-    for (size_t i = 0; i < o.visibility.size(); ++i) {
-        if (o.overflowMask[i] > 0.5f) {
-            ++marked;
-            EXPECT_EQ(o.visibility[i], 0.0f) << "pixel " << i << " overflowed but is not written shadowed";
-        }
+    expectOverflowedPixelsShadowed(o, pixels);
+    for (size_t i = 0; i < o.visibility.size(); ++i)
         if (o.lit[i] && o.reference[i] < 0.5f) EXPECT_LT(o.visibility[i], 0.5f) << "pixel " << i << " lit by overflow";
-    }
-    EXPECT_EQ(double(marked), pixels);
 }
 
 // The tree built by concurrent compare-and-swap, checked against the TOP tree's definition: every

@@ -4,120 +4,23 @@
 // heat map, and the vote paths agreeing.
 #include "algorithms/ptsv/Ptsv.h"
 #include "algorithms/ptsv/PtsvLayout.h"
-#include "algorithms/reference/EmbreeTracer.h"
-#include "framework/metrics/Accuracy.h"
 #include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
+#include "tests/AlgorithmHarness.h"
 #include "tests/TestSupport.h"
-
-#include <glm/gtc/matrix_transform.hpp>
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <set>
 
 namespace shadowlab {
 namespace {
 
-// ---- Scenes ------------------------------------------------------------------------------------
+using namespace test;
 
-glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
-glm::mat4 rotate(float deg, glm::vec3 axis) { return glm::rotate(glm::mat4(1.0f), glm::radians(deg), axis); }
-glm::mat4 scale(glm::vec3 s) { return glm::scale(glm::mat4(1.0f), s); }
-
-Scene ground(float size = 10.0f) { return makePlane({size, size}, 4, Material{glm::vec3(0.7f), 1.0f}); }
-
-struct Shot {
-    Scene scene;
-    Camera camera;
-    Light light;
-};
-
-Camera lookAt(glm::vec3 from, glm::vec3 to) {
-    Camera c;
-    c.position = from;
-    c.target = to;
-    c.fovYDeg = 60.0f;
-    c.nearPlane = 0.02f;
-    c.farPlane = 50.0f;
-    return c;
-}
-
-Light pointLight(glm::vec3 p) {
-    Light l;
-    l.type = LightType::Point;
-    l.position = p;
-    return l;
-}
-
-// Three big triangles crossing one another, one of them also piercing the ground they shadow.
-Shot intersectingTriangles() {
-    Shot s;
-    s.scene = ground();
-    Material m{glm::vec3(0.8f, 0.4f, 0.3f), 1.0f};
-    s.scene.addTriangles({{-1.2f, 0.4f, -0.6f}, {1.2f, 0.4f, -0.6f}, {0.0f, 1.2f, 0.9f},
-                          {-0.9f, 1.3f, -0.9f}, {1.0f, 0.3f, 0.8f}, {0.7f, 1.4f, 0.1f},
-                          {-1.6f, -0.6f, 1.0f}, {-0.3f, -0.6f, 1.2f}, {-0.9f, 1.1f, 0.4f}},
-                         m);
-    s.camera = lookAt({2.5f, 3.0f, 3.5f}, {0, 0.3f, 0});
-    s.light = pointLight({0.6f, 4.0f, -0.4f});
-    return s;
-}
-
-// A point light inside a sphere shell with six holes, inside a closed room: shadow volumes point
-// in every direction, and the camera looks across several of them.
-Shot omniInsideShell() {
-    Shot s;
-    const glm::vec3 c(0.0f, 1.5f, 0.0f);
-    Scene sphere = makeSphere(0.6f, 800, Material{});
-    std::vector<glm::vec3> kept;
-    const glm::vec3 holes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0.6f, 0, -0.8f}};
-    for (size_t t = 0; t < sphere.triangleCount(); ++t) {
-        glm::vec3 centroid = (sphere.positions[3 * t] + sphere.positions[3 * t + 1] + sphere.positions[3 * t + 2]) / 3.0f;
-        bool hole = false;
-        for (glm::vec3 h : holes) hole = hole || glm::dot(glm::normalize(centroid), glm::normalize(h)) > 0.97f;
-        if (!hole)
-            for (int k = 0; k < 3; ++k) kept.push_back(sphere.positions[3 * t + k] + c);
-    }
-    s.scene.addTriangles(kept, Material{glm::vec3(0.9f, 0.8f, 0.3f), 1.0f});
-    Scene wall = makePlane({6, 6}, 3, Material{glm::vec3(0.7f), 1.0f});
-    s.scene.append(wall, glm::mat4(1.0f));
-    s.scene.append(wall, translate({0, 3, 0}) * rotate(180, {1, 0, 0}));
-    s.scene.append(wall, translate({-3, 1.5f, 0}) * rotate(-90, {0, 0, 1}));
-    s.scene.append(wall, translate({3, 1.5f, 0}) * rotate(90, {0, 0, 1}));
-    s.scene.append(wall, translate({0, 1.5f, -3}) * rotate(90, {1, 0, 0}));
-    s.scene.append(wall, translate({0, 1.5f, 3}) * rotate(-90, {1, 0, 0}));
-    s.camera = lookAt({2.6f, 2.6f, 2.6f}, {-0.5f, 1.0f, -0.5f});
-    s.camera.fovYDeg = 100.0f;
-    s.light = pointLight(c + glm::vec3(0.05f, -0.03f, 0.02f));
-    return s;
-}
-
-// Closed objects on a plane under an oblique directional light.
-Shot directionalObjects() {
-    Shot s;
-    s.scene = ground();
-    s.scene.append(makeSphere(0.6f, 600, Material{}), translate({-0.8f, 0.8f, 0}));
-    s.scene.append(makeTorus(0.5f, 0.15f, 500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
-    s.scene.append(makeCylinder(0.25f, 1.2f, 200, Material{}), translate({0.2f, 0.0f, -1.0f}));
-    s.camera = lookAt({0.0f, 3.0f, 4.5f}, {0, 0.3f, 0});
-    s.light.type = LightType::Directional;
-    s.light.position = {3.0f, 5.0f, 2.0f};
-    s.light.target = {0, 0, 0};
-    return s;
-}
-
-// The camera sits under a roof, inside the roof's shadow volume, looking out at the lit ground.
-Shot cameraInsideShadow() {
-    Shot s;
-    s.scene = ground();
-    s.scene.append(makePlane({3, 3}, 2, Material{}), translate({0, 1.5f, 0}));
-    s.scene.append(makeSphere(0.3f, 300, Material{}), translate({0.8f, 0.3f, 0.8f}));
-    s.camera = lookAt({0.2f, 0.8f, 0.3f}, {3.0f, 0.0f, 3.0f});
-    s.light = pointLight({0.3f, 5.0f, 0.2f});
-    return s;
-}
+// ---- Scenes (the shared ones are in tests/ShadowTestScenes.h) -----------------------------------
 
 // The paper's Figure 1 situation: a far building seen through a near fence (every tile holds
 // samples at two very different depths), thin posts and a sphere casting in between.
@@ -136,17 +39,6 @@ Shot fenceDiscontinuity() {
     return s;
 }
 
-// A few thousand triangles of closed meshes.
-Shot thousandsOfTriangles() {
-    Shot s;
-    s.scene = ground();
-    s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
-    s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
-    s.camera = lookAt({0.0f, 3.0f, 5.0f}, {0, 0.4f, 0});
-    s.light = pointLight({2.0f, 4.0f, 1.5f});
-    return s;
-}
-
 // The 2CylinderEngine (a real CAD model, ~100k triangles), a ground under it, point light.
 Shot engine() {
     Shot s;
@@ -162,63 +54,26 @@ Shot engine() {
 
 // ---- Running ptsv and the reference --------------------------------------------------------------
 
-constexpr int kRes = 96; // small: GLSL runs on the CPU here
-
-struct Outcome {
-    std::vector<float> visibility, reference, heat;
-    std::vector<uint8_t> lit;
-    std::map<std::string, double> counters;
-    uint64_t overflow = 0;
-    Accuracy accuracy;
-    CpuGBuffer gbuffer;
+struct Outcome : AlgorithmRun {
+    std::vector<float> heat;
 };
 
 class PtsvGLTest : public test::GLTest {
 protected:
     Outcome run(const Shot& s, const std::map<std::string, ParamValue>& overrides = {}, bool withReference = true,
                 const std::function<void()>& inspect = {}) {
-        const AlgorithmInfo info = ptsvInfo();
-        ParamValues params(info.schema());
-        for (const auto& [k, v] : overrides) params.set(k, v);
-        SceneGpu gpu(s.scene);
-        GBuffer gbuffer({kRes, kRes});
-        gbuffer.render(gpu, s.camera);
-        std::unique_ptr<ShadowAlgorithm> ptsv = info.create(params);
-        ptsv->setScene(gpu);
-        ptsv->resize({kRes, kRes});
-        GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
-        StageTimer timer;
+        RunOptions options;
+        options.withReference = withReference;
+        options.debugViews = {"tests_per_pixel"};
+        if (inspect) options.inspect = [&](const AlgorithmRun&) { inspect(); }; // ptsv's buffers are still bound here
         Outcome o;
-        o.gbuffer = gbuffer.readBack();
-        const FrameInputs frame{gbuffer, [&]() -> const CpuGBuffer& { return o.gbuffer; }, s.camera, s.light, 0,
-                                visibility.id(), timer};
-        ptsv->computeVisibility(frame);
-        timer.collect();
-        o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
-        for (const Counter& c : ptsv->counters()) o.counters[c.name] = c.value;
-        o.overflow = ptsv->overflowCount();
-        for (const DebugView& v : ptsv->debugViews())
-            if (v.name == "tests_per_pixel") o.heat = readTextureR32F(v.texture, kRes, kRes);
-        if (inspect) inspect(); // ptsv's buffers are still bound here
-        o.lit = litMask(o.gbuffer, s.light);
-        if (withReference) {
-            EmbreeTracer tracer(s.scene);
-            tracer.traceVisibility(o.gbuffer, s.light, float(params.getFloat("ray_offset")) * s.scene.bounds.radius(), 0,
-                                   o.reference);
-            o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
-        }
+        static_cast<AlgorithmRun&>(o) = runAlgorithm(ptsvInfo(), s, overrides, options);
+        o.heat = std::move(o.views["tests_per_pixel"]);
         return o;
     }
 };
 
 // ---- Accuracy table ------------------------------------------------------------------------------
-
-struct AccuracyCase {
-    const char* name;
-    Shot (*make)();
-    std::map<std::string, ParamValue> params;
-    double maxMismatch; ///< share of lit pixels whose binary visibility differs from the reference
-};
 
 // ptsv is exact: its per-sample test is the reference's ray (same origin, same closed-edge
 // convention as a watertight ray-triangle test), so every row is held to the goal of 0.01 % of lit

@@ -1,0 +1,82 @@
+#include "tests/AlgorithmHarness.h"
+
+#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/gl/GlObjects.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <ostream>
+
+namespace shadowlab::test {
+
+AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std::map<std::string, ParamValue>& overrides,
+                          const RunOptions& options) {
+    ParamValues params(info.schema());
+    for (const auto& [k, v] : overrides) params.set(k, v);
+    SceneGpu gpu(shot.scene);
+    GBuffer gbuffer({kRes, kRes});
+    gbuffer.render(gpu, shot.camera);
+    std::unique_ptr<ShadowAlgorithm> algorithm = info.create(params);
+    algorithm->setScene(gpu);
+    algorithm->resize({kRes, kRes});
+    GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
+    StageTimer timer;
+    AlgorithmRun o;
+    o.gbuffer = gbuffer.readBack();
+    const FrameInputs frame{gbuffer, [&]() -> const CpuGBuffer& { return o.gbuffer; }, shot.camera, shot.light, 0,
+                            visibility.id(), timer};
+    if (options.warmUp) {
+        algorithm->computeVisibility(frame);
+        glFinish();
+        timer.collect();
+    }
+    algorithm->computeVisibility(frame);
+    o.stages = timer.collect();
+    o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
+    for (const Counter& c : algorithm->counters()) o.counters[c.name] = c.value;
+    o.overflow = algorithm->overflowCount();
+    o.memory = algorithm->memoryBytes();
+    for (const DebugView& v : algorithm->debugViews())
+        if (v.name == "stack_overflow") o.overflowMask = readTextureR32F(v.texture, kRes, kRes);
+        else if (std::find(options.debugViews.begin(), options.debugViews.end(), v.name) != options.debugViews.end())
+            o.views[v.name] = readTextureR32F(v.texture, kRes, kRes);
+    if (options.inspect) options.inspect(o);
+    o.lit = litMask(o.gbuffer, shot.light);
+    if (options.withReference) {
+        EmbreeTracer tracer(shot.scene);
+        // The algorithm's own offset, so both trace from the same points and only the tests differ.
+        tracer.traceVisibility(o.gbuffer, shot.light, float(params.getFloat("ray_offset")) * shot.scene.bounds.radius(), 0,
+                               o.reference);
+        o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
+    }
+    return o;
+}
+
+void printCase(std::ostream& os, const char* name, const std::map<std::string, ParamValue>& params) {
+    os << name;
+    const char* sep = " {";
+    for (const auto& [k, v] : params) {
+        os << sep << k << "=" << toString(v);
+        sep = ", ";
+    }
+    if (!params.empty()) os << "}";
+}
+
+void PrintTo(const AccuracyCase& c, std::ostream* os) {
+    printCase(*os, c.name, c.params);
+    *os << " mismatch ≤ " << c.maxMismatch;
+}
+
+void expectOverflowedPixelsShadowed(const AlgorithmRun& o, double pixels) {
+    size_t marked = 0;
+    for (size_t i = 0; i < o.visibility.size(); ++i)
+        if (o.overflowMask[i] > 0.5f) {
+            ++marked;
+            EXPECT_EQ(o.visibility[i], 0.0f) << "pixel " << i << " overflowed but is not written shadowed";
+        }
+    EXPECT_EQ(double(marked), pixels);
+}
+
+} // namespace shadowlab::test

@@ -1,0 +1,73 @@
+#pragma once
+// Runs one shadow algorithm for one frame on a test shot and compares it with the Embree reference,
+// as the algorithms' GL tests all do: render the G-buffer, run the algorithm, read back what it
+// reports (visibility, counters, overflow, memory, debug views), trace the reference with the
+// algorithm's own ray offset, and compare over the lit pixels.
+#include "algorithms/ShadowAlgorithm.h"
+#include "framework/gl/StageTimer.h"
+#include "framework/metrics/Accuracy.h"
+#include "tests/ShadowTestScenes.h"
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace shadowlab::test {
+
+/// The tests' resolution: small, since GLSL runs on the CPU (llvmpipe) here.
+inline constexpr int kRes = 96;
+
+/// What one frame of an algorithm produced, next to the reference.
+struct AlgorithmRun {
+    std::vector<float> visibility, reference;
+    std::vector<uint8_t> lit;
+    std::map<std::string, double> counters;
+    uint64_t overflow = 0;
+    size_t memory = 0;
+    std::vector<float> overflowMask;                 ///< the "stack_overflow" debug view, where there is one
+    std::map<std::string, std::vector<float>> views; ///< the other debug views asked for, by name
+    std::vector<StageTime> stages;                   ///< of the measured frame
+    Accuracy accuracy;                               ///< only with the reference
+    CpuGBuffer gbuffer;                              ///< the frame's G-buffer, as the reference saw it
+};
+
+struct RunOptions {
+    /// Run an untimed frame first: llvmpipe compiles shaders at their first dispatch and rasterises
+    /// the G-buffer lazily, so neither belongs in the measured frame's stage times.
+    bool warmUp = false;
+    bool withReference = true;
+    /// Debug views read back into AlgorithmRun::views where the algorithm offers them.
+    std::vector<std::string> debugViews;
+    /// Called after the frame, before the reference, while the algorithm still exists and its
+    /// buffers are still bound: where a test reads the algorithm's own structures back.
+    std::function<void(const AlgorithmRun&)> inspect;
+};
+
+/// Runs the algorithm `info` with `overrides` on its schema's defaults for one frame at kRes².
+AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std::map<std::string, ParamValue>& overrides,
+                          const RunOptions& options = {});
+
+/// Prints `name` and its parameter overrides, for gtest's names of parameterised cases.
+void printCase(std::ostream& os, const char* name, const std::map<std::string, ParamValue>& params);
+
+/// One row of an algorithm's accuracy table: a shot, overrides of the algorithm's defaults, and the
+/// bound on the mismatch.
+struct AccuracyCase {
+    const char* name;
+    Shot (*make)();
+    std::map<std::string, ParamValue> params;
+    double maxMismatch; ///< share of lit pixels whose binary visibility differs from the reference
+};
+
+/// Readable in ctest's listing (gtest would otherwise print the row's bytes).
+void PrintTo(const AccuracyCase& c, std::ostream* os);
+
+/// The stack-overflow contract of the traversing algorithms: every pixel their "stack_overflow"
+/// view marks is written fully shadowed (never lit by mistake), and the view marks exactly the
+/// `pixels` their counter reports.
+void expectOverflowedPixelsShadowed(const AlgorithmRun& o, double pixels);
+
+} // namespace shadowlab::test

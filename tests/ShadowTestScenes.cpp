@@ -1,0 +1,112 @@
+#include "tests/ShadowTestScenes.h"
+
+#include "framework/scene/Procedural.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <vector>
+
+namespace shadowlab::test {
+
+glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
+glm::mat4 rotate(float deg, glm::vec3 axis) { return glm::rotate(glm::mat4(1.0f), glm::radians(deg), axis); }
+glm::mat4 scale(glm::vec3 s) { return glm::scale(glm::mat4(1.0f), s); }
+
+Scene ground(float size) { return makePlane({size, size}, 4, Material{glm::vec3(0.7f), 1.0f}); }
+
+Camera lookAt(glm::vec3 from, glm::vec3 to, float fovYDeg) {
+    Camera c;
+    c.position = from;
+    c.target = to;
+    c.fovYDeg = fovYDeg;
+    c.nearPlane = 0.02f;
+    c.farPlane = 50.0f;
+    return c;
+}
+
+Light pointLight(glm::vec3 position) {
+    Light l;
+    l.type = LightType::Point;
+    l.position = position;
+    return l;
+}
+
+Light directionalLight(glm::vec3 from) {
+    Light l;
+    l.type = LightType::Directional;
+    l.position = from;
+    l.target = {0, 0, 0};
+    return l;
+}
+
+Shot intersectingTriangles() {
+    Shot s;
+    s.scene = ground();
+    Material m{glm::vec3(0.8f, 0.4f, 0.3f), 1.0f};
+    s.scene.addTriangles({{-1.2f, 0.4f, -0.6f}, {1.2f, 0.4f, -0.6f}, {0.0f, 1.2f, 0.9f},     // gently sloped
+                          {-0.9f, 1.3f, -0.9f}, {1.0f, 0.3f, 0.8f}, {0.7f, 1.4f, 0.1f},      // crosses the first
+                          {-1.6f, -0.6f, 1.0f}, {-0.3f, -0.6f, 1.2f}, {-0.9f, 1.1f, 0.4f}}, // pierces the ground
+                         m);
+    s.camera = lookAt({2.5f, 3.0f, 3.5f}, {0, 0.3f, 0});
+    s.light = pointLight({0.6f, 4.0f, -0.4f});
+    return s;
+}
+
+Shot omniInsideShell() {
+    Shot s;
+    const glm::vec3 c(0.0f, 1.5f, 0.0f);
+    Scene sphere = makeSphere(0.6f, 800, Material{});
+    std::vector<glm::vec3> kept;
+    const glm::vec3 holes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0.6f, 0, -0.8f}};
+    for (size_t t = 0; t < sphere.triangleCount(); ++t) {
+        glm::vec3 centroid = (sphere.positions[3 * t] + sphere.positions[3 * t + 1] + sphere.positions[3 * t + 2]) / 3.0f;
+        bool hole = false;
+        for (glm::vec3 h : holes) hole = hole || glm::dot(glm::normalize(centroid), glm::normalize(h)) > 0.97f;
+        if (!hole)
+            for (int k = 0; k < 3; ++k) kept.push_back(sphere.positions[3 * t + k] + c);
+    }
+    s.scene.addTriangles(kept, Material{glm::vec3(0.9f, 0.8f, 0.3f), 1.0f});
+    Scene wall = makePlane({6, 6}, 3, Material{glm::vec3(0.7f), 1.0f});
+    s.scene.append(wall, glm::mat4(1.0f));                                  // floor
+    s.scene.append(wall, translate({0, 3, 0}) * rotate(180, {1, 0, 0}));     // ceiling
+    s.scene.append(wall, translate({-3, 1.5f, 0}) * rotate(-90, {0, 0, 1})); // walls
+    s.scene.append(wall, translate({3, 1.5f, 0}) * rotate(90, {0, 0, 1}));
+    s.scene.append(wall, translate({0, 1.5f, -3}) * rotate(90, {1, 0, 0}));
+    s.scene.append(wall, translate({0, 1.5f, 3}) * rotate(-90, {1, 0, 0}));
+    s.camera = lookAt({2.6f, 2.6f, 2.6f}, {-0.5f, 1.0f, -0.5f}, 100.0f);
+    s.light = pointLight(c + glm::vec3(0.05f, -0.03f, 0.02f));
+    return s;
+}
+
+Shot directionalObjects() {
+    Shot s;
+    s.scene = ground();
+    s.scene.append(makeSphere(0.6f, 600, Material{}), translate({-0.8f, 0.8f, 0}));
+    s.scene.append(makeTorus(0.5f, 0.15f, 500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
+    s.scene.append(makeCylinder(0.25f, 1.2f, 200, Material{}), translate({0.2f, 0.0f, -1.0f}));
+    s.camera = lookAt({0.0f, 3.0f, 4.5f}, {0, 0.3f, 0});
+    s.light = directionalLight({3.0f, 5.0f, 2.0f});
+    return s;
+}
+
+Shot cameraInsideShadow() {
+    Shot s;
+    s.scene = ground();
+    s.scene.append(makePlane({3, 3}, 2, Material{}), translate({0, 1.5f, 0}));
+    s.scene.append(makeSphere(0.3f, 300, Material{}), translate({0.8f, 0.3f, 0.8f}));
+    s.camera = lookAt({0.2f, 0.8f, 0.3f}, {3.0f, 0.0f, 3.0f});
+    s.light = pointLight({0.3f, 5.0f, 0.2f});
+    return s;
+}
+
+Shot thousandsOfTriangles() {
+    Shot s;
+    s.scene = ground();
+    s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
+    s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
+    s.camera = lookAt({0.0f, 3.0f, 5.0f}, {0, 0.4f, 0});
+    s.light = pointLight({2.0f, 4.0f, 1.5f});
+    return s;
+}
+
+} // namespace shadowlab::test

@@ -1,0 +1,48 @@
+#pragma once
+// Scenes shared by the algorithms' GL tests. Each algorithm is checked against the reference on the
+// same shots, so a scene is defined once here and a difference between the algorithms' results
+// cannot come from two copies of it drifting apart.
+#include "framework/scene/Scene.h"
+#include "framework/view/Camera.h"
+#include "framework/view/Light.h"
+
+#include <glm/glm.hpp>
+
+namespace shadowlab::test {
+
+glm::mat4 translate(glm::vec3 t);
+glm::mat4 rotate(float deg, glm::vec3 axis);
+glm::mat4 scale(glm::vec3 s);
+
+/// A grey, opaque, square plane of side `size` at y = 0.
+Scene ground(float size = 10.0f);
+
+/// What one test frame needs: the geometry, the view and the light.
+struct Shot {
+    Scene scene;
+    Camera camera;
+    Light light;
+};
+
+/// A camera at `from` looking at `to`, with the near and far planes every test scene fits in.
+Camera lookAt(glm::vec3 from, glm::vec3 to, float fovYDeg = 60.0f);
+Light pointLight(glm::vec3 position);
+/// A directional light shining from `from` towards the origin.
+Light directionalLight(glm::vec3 from);
+
+/// Three big triangles crossing one another, one of them also piercing the ground they shadow
+/// (a cluster of them is all overlap: their bounding volumes intersect).
+Shot intersectingTriangles();
+/// A point light inside a sphere shell with six holes, inside a closed room: light escapes in every
+/// direction (floor, ceiling, four walls), so shadow volumes point every way, every side of the
+/// omni light is exercised, and some bounding volumes (the walls' big triangles) contain the light.
+/// The camera looks across several of them with a 100° field of view.
+Shot omniInsideShell();
+/// Closed objects on a plane under an oblique directional light.
+Shot directionalObjects();
+/// The camera sits under a roof, inside the roof's shadow volume, looking out at the lit ground.
+Shot cameraInsideShadow();
+/// A few thousand triangles of closed meshes (a sphere and a tilted torus) under a point light.
+Shot thousandsOfTriangles();
+
+} // namespace shadowlab::test
