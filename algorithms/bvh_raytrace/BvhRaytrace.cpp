@@ -80,8 +80,7 @@ public:
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         params_ = p;
         if (change != ParamChange::Rebuild) return;
-        compile();
-        if (scene_) setScene(*scene_);
+        compile(); // setScene() and resize() follow a Rebuild (ShadowAlgorithm.h)
     }
 
     void computeVisibility(const FrameInputs& f) override {
