@@ -15,13 +15,14 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
                           const RunOptions& options) {
     ParamValues params(info.schema());
     for (const auto& [k, v] : overrides) params.set(k, v);
+    const int res = options.resolution;
     SceneGpu gpu(shot.scene);
-    GBuffer gbuffer({kRes, kRes});
+    GBuffer gbuffer({res, res});
     gbuffer.render(gpu, shot.camera);
     std::unique_ptr<ShadowAlgorithm> algorithm = info.create(params);
     algorithm->setScene(gpu);
-    algorithm->resize({kRes, kRes});
-    GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
+    algorithm->resize({res, res});
+    GlTexture visibility = makeTexture2D(GL_R32F, res, res);
     StageTimer timer;
     AlgorithmRun o;
     o.gbuffer = gbuffer.readBack();
@@ -34,14 +35,14 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
     }
     algorithm->computeVisibility(frame);
     o.stages = timer.collect();
-    o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
+    o.visibility = readTextureR32F(visibility.id(), res, res);
     for (const Counter& c : algorithm->counters()) o.counters[c.name] = c.value;
     o.overflow = algorithm->overflowCount();
     o.memory = algorithm->memoryBytes();
     for (const DebugView& v : algorithm->debugViews())
-        if (v.name == "stack_overflow") o.overflowMask = readTextureR32F(v.texture, kRes, kRes);
+        if (v.name == "stack_overflow") o.overflowMask = readTextureR32F(v.texture, res, res);
         else if (std::find(options.debugViews.begin(), options.debugViews.end(), v.name) != options.debugViews.end())
-            o.views[v.name] = readTextureR32F(v.texture, kRes, kRes);
+            o.views[v.name] = readTextureR32F(v.texture, res, res);
     if (options.inspect) options.inspect(o);
     o.lit = litMask(o.gbuffer, shot.light);
     if (options.withReference) {

@@ -39,6 +39,8 @@ struct RunOptions {
     /// the G-buffer lazily, so neither belongs in the measured frame's stage times.
     bool warmUp = false;
     bool withReference = true;
+    /// The frame's side in pixels: kRes unless a test needs a smaller, cheaper frame.
+    int resolution = kRes;
     /// Debug views read back into AlgorithmRun::views where the algorithm offers them.
     std::vector<std::string> debugViews;
     /// Called after the frame, before the reference, while the algorithm still exists and its
@@ -46,7 +48,8 @@ struct RunOptions {
     std::function<void(const AlgorithmRun&)> inspect;
 };
 
-/// Runs the algorithm `info` with `overrides` on its schema's defaults for one frame at kRes².
+/// Runs the algorithm `info` with `overrides` on its schema's defaults for one frame of
+/// options.resolution² pixels (kRes² by default).
 AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std::map<std::string, ParamValue>& overrides,
                           const RunOptions& options = {});
 

@@ -17,49 +17,11 @@ using namespace test;
 // This file's views are a little narrower than the other algorithms' (55° instead of 60°).
 constexpr float kFovYDeg = 55.0f;
 
-// The smoke scene's objects: a sphere, a tilted torus and a thin fence on a ground plane.
-Scene objects() {
-    Scene s = makePlane({8, 8}, 4, Material{});
-    s.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
-    s.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
-    s.append(makeFence(6, 0.35f, 1.0f, 0.03f, 2, 32, Material{}), translate({0, 0, -1.2f}));
-    return s;
-}
-
-Shot pointShot() {
-    Shot s{objects(), lookAt({0, 3.0f, 5.0f}, {0, 0.4f, 0}, kFovYDeg), Light{}};
-    s.light.type = LightType::Point;
-    s.light.position = {2.0f, 4.0f, 1.5f};
-    return s;
-}
-
-Shot spotShot() {
-    Shot s = pointShot();
-    s.light.type = LightType::Spot;
-    s.light.position = {-1.5f, 3.5f, 2.0f};
-    s.light.target = {0, 0, 0};
-    s.light.coneDeg = 35.0f;
-    return s;
-}
-
-Shot directionalShot() {
-    Shot s = pointShot();
-    s.light.type = LightType::Directional;
-    s.light.position = {3.0f, 4.0f, 2.0f};
-    s.light.target = {0, 0, 0};
-    return s;
-}
-
-Shot areaShot(int samples, const char* pattern) {
-    Shot s = pointShot();
-    s.light.type = LightType::Area;
-    s.light.position = {1.5f, 3.0f, 1.5f};
-    s.light.target = {0, 0, 0};
-    s.light.size = {1.2f, 1.2f};
-    s.light.samples = samples;
-    s.light.pattern = pattern;
-    return s;
-}
+// The smoke scene and its lights (tests/ShadowTestScenes.h), 55° views.
+Shot pointShot() { return smokePointShot(); }
+Shot spotShot() { return smokeSpotShot(); }
+Shot directionalShot() { return smokeDirectionalShot(); }
+Shot areaShot(int samples, const char* pattern) { return smokeAreaShot(samples, 1.2f, pattern); }
 
 // A single triangle over the ground: the root holds a leaf and an absent child.
 Shot singleTriangle() {

@@ -5,55 +5,25 @@
 // N errs less, and the disk cache returns the same image (and rebuilds a corrupt file).
 #include "algorithms/line_space/LineSpace.h"
 #include "algorithms/line_space/LineSpaceCache.h"
-#include "algorithms/reference/EmbreeTracer.h"
-#include "framework/metrics/Accuracy.h"
 #include "framework/scene/Procedural.h"
+#include "tests/AlgorithmHarness.h"
 #include "tests/TestSupport.h"
-
-#include <glm/gtc/matrix_transform.hpp>
 
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <ostream>
 
 namespace shadowlab {
 namespace {
 
-glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
-glm::mat4 rotate(float deg, glm::vec3 axis) { return glm::rotate(glm::mat4(1.0f), glm::radians(deg), axis); }
+using namespace test;
 
-struct Shot {
-    Scene scene;
-    Camera camera;
-    Light light;
-};
-
-// The smoke scene's objects (≈ 3,800 triangles): a sphere, a tilted torus, a thin fence on a plane.
-Shot pointShot() {
-    Shot s;
-    s.scene = makePlane({8, 8}, 4, Material{});
-    s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
-    s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
-    s.scene.append(makeFence(6, 0.35f, 1.0f, 0.03f, 2, 32, Material{}), translate({0, 0, -1.2f}));
-    s.scene.updateBounds();
-    s.camera.position = {0, 3.0f, 5.0f}, s.camera.target = {0, 0.4f, 0};
-    s.camera.fovYDeg = 55.0f, s.camera.nearPlane = 0.02f, s.camera.farPlane = 50.0f;
-    s.light.type = LightType::Point;
-    s.light.position = {2.0f, 4.0f, 1.5f};
-    return s;
-}
-
-Shot areaShot(int samples = 16) {
-    Shot s = pointShot();
-    s.light.type = LightType::Area;
-    s.light.position = {1.5f, 3.0f, 1.5f};
-    s.light.target = {0, 0, 0};
-    s.light.size = {1.5f, 1.5f};
-    s.light.samples = samples;
-    return s;
-}
+// A 1.5 × 1.5 area light over the smoke scene.
+Shot areaShot(int samples = 16) { return smokeAreaShot(samples, 1.5f); }
 
 // Pebbles smaller than a last-level node scattered on the ground under an area light: a ray from the
 // ground beside a pebble meets it inside the node it starts in, which the line space skips.
@@ -70,31 +40,8 @@ Shot pebbleShot() {
     return s;
 }
 
-Shot spotShot() {
-    Shot s = pointShot();
-    s.light.type = LightType::Spot;
-    s.light.position = {-1.5f, 3.5f, 2.0f};
-    s.light.coneDeg = 35.0f;
-    return s;
-}
-
-Shot directionalShot() {
-    Shot s = pointShot();
-    s.light.type = LightType::Directional;
-    s.light.position = {3.0f, 4.0f, 2.0f};
-    return s;
-}
-
-constexpr int kRes = 64; // small: GLSL runs on the CPU here
-
-struct Outcome {
-    std::vector<float> visibility, reference;
-    std::vector<uint8_t> lit;
-    std::map<std::string, double> counters;
-    uint64_t overflow = 0;
-    size_t memory = 0;
-    Accuracy accuracy;
-};
+// Smaller than the other algorithms' frames (kRes): GLSL runs on the CPU here.
+constexpr int kLineSpaceRes = 64;
 
 class LineSpaceGLTest : public test::GLTest {
 protected:
@@ -113,38 +60,19 @@ protected:
         test::GLTest::TearDown();
     }
 
-    Outcome run(const Shot& s, const std::map<std::string, ParamValue>& overrides = {}) {
-        const AlgorithmInfo info = lineSpaceInfo();
-        ParamValues params(info.schema());
-        params.set("classify", true);
-        for (const auto& [k, v] : overrides) params.set(k, v);
-        SceneGpu gpu(s.scene);
-        GBuffer gbuffer({kRes, kRes});
-        gbuffer.render(gpu, s.camera);
-        std::unique_ptr<ShadowAlgorithm> algo = info.create(params);
-        algo->setScene(gpu);
-        algo->resize({kRes, kRes});
-        GlTexture visibility = makeTexture2D(GL_R32F, kRes, kRes);
-        StageTimer timer;
-        CpuGBuffer cpu = gbuffer.readBack();
-        algo->computeVisibility({gbuffer, [&]() -> const CpuGBuffer& { return cpu; }, s.camera, s.light, 0, visibility.id(), timer});
-        timer.collect();
-        Outcome o;
-        o.visibility = readTextureR32F(visibility.id(), kRes, kRes);
-        for (const Counter& c : algo->counters()) o.counters[c.name] = c.value;
-        o.overflow = algo->overflowCount();
-        o.memory = algo->memoryBytes();
-        o.lit = litMask(cpu, s.light);
-        EmbreeTracer tracer(s.scene);
-        tracer.traceVisibility(cpu, s.light, float(params.getFloat("ray_offset")) * s.scene.bounds.radius(), 0, o.reference);
-        o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
-        return o;
+    // `classify` on unless overridden: the error counters the tests check need every sample traced exactly.
+    AlgorithmRun run(const Shot& s, const std::map<std::string, ParamValue>& overrides = {}) {
+        std::map<std::string, ParamValue> params = {{"classify", true}};
+        for (const auto& [k, v] : overrides) params[k] = v;
+        RunOptions options;
+        options.resolution = kLineSpaceRes;
+        return runAlgorithm(lineSpaceInfo(), s, params, options);
     }
 
     std::optional<std::string> savedXdg_;
 };
 
-void print(const char* name, const Outcome& o) {
+void print(const char* name, const AlgorithmRun& o) {
     std::printf("[line_space] %-22s mismatch %6.3f%% rmse %.4f | samples over %.4f under %.4f (start node %.4f, "
                 "elsewhere %.0f) | nodes/ray %.1f shafts/ray %.1f | %0.f nodes, %.2f MB, build %.0f ms\n",
                 name, 100 * o.accuracy.mismatchRatio, o.accuracy.rmse, o.counters.at("over_occluded_share"),
@@ -160,13 +88,16 @@ struct ErrCase {
     std::map<std::string, ParamValue> params;
 };
 
+// Readable in ctest's listing (gtest would otherwise print the row's bytes).
+void PrintTo(const ErrCase& c, std::ostream* os) { printCase(*os, c.name, c.params); }
+
 const ErrCase kErrCases[] = {
-    {"point_6_3", pointShot, {}},
-    {"point_4_3", pointShot, {{"n", 4}}},
-    {"point_8_2", pointShot, {{"n", 8}, {"d", 2}}},
-    {"point_3_4", pointShot, {{"n", 3}, {"d", 4}}},
-    {"spot_6_3", spotShot, {}},
-    {"directional_6_3", directionalShot, {}},
+    {"point_6_3", smokePointShot, {}},
+    {"point_4_3", smokePointShot, {{"n", 4}}},
+    {"point_8_2", smokePointShot, {{"n", 8}, {"d", 2}}},
+    {"point_3_4", smokePointShot, {{"n", 3}, {"d", 4}}},
+    {"spot_6_3", smokeSpotShot, {}},
+    {"directional_6_3", smokeDirectionalShot, {}},
     {"area16_6_3", [] { return areaShot(16); }, {}},
     {"pebbles_6_3", pebbleShot, {}},
 };
@@ -177,7 +108,7 @@ class LineSpaceErrGLTest : public LineSpaceGLTest, public ::testing::WithParamIn
 // towards shadow (a blocker is never missed); inside it, it errs towards light.
 TEST_P(LineSpaceErrGLTest, ErrsTowardsShadowAwayFromTheStartNode) {
     const ErrCase& c = GetParam();
-    Outcome o = run(c.make(), c.params);
+    AlgorithmRun o = run(c.make(), c.params);
     print(c.name, o);
     EXPECT_EQ(o.counters["under_occluded_elsewhere"], 0.0) << "a blocker outside the start node was missed";
     EXPECT_GT(o.counters["classified_samples"], 0.0);
@@ -194,7 +125,7 @@ TEST_P(LineSpaceErrGLTest, ErrsTowardsShadowAwayFromTheStartNode) {
 // ancestors wait at once. Coarse sets: only the method's guarantees are checked.
 TEST_F(LineSpaceGLTest, ExtremeDepthsKeepTheGuarantees) {
     for (auto [n, d] : {std::pair{4, 1}, std::pair{2, 5}}) {
-        Outcome o = run(pointShot(), {{"n", n}, {"d", d}});
+        AlgorithmRun o = run(smokePointShot(), {{"n", n}, {"d", d}});
         print(("point_" + std::to_string(n) + "_" + std::to_string(d)).c_str(), o);
         EXPECT_EQ(o.counters["under_occluded_elsewhere"], 0.0) << "d = " << d;
         EXPECT_EQ(o.counters["classified_samples"], o.counters["rays"]) << "d = " << d;
@@ -204,7 +135,7 @@ TEST_F(LineSpaceGLTest, ExtremeDepthsKeepTheGuarantees) {
 
 // Small blockers inside the start node are missed: the one way the method errs towards light.
 TEST_F(LineSpaceGLTest, BlockersInsideTheStartNodeAreMissed) {
-    Outcome o = run(pebbleShot());
+    AlgorithmRun o = run(pebbleShot());
     print("pebbles (start node)", o);
     EXPECT_GT(o.counters["under_occluded_start_node_share"], 0.0);
     EXPECT_EQ(o.counters["under_occluded_start_node_share"], o.counters["under_occluded_share"]);
@@ -219,7 +150,7 @@ TEST_F(LineSpaceGLTest, SoftShadowsHideTheApproximation) {
     Shot hard = areaShot(1), soft = areaShot(25);
     hard.light.type = LightType::Point; // the area light's centre
     const std::map<std::string, ParamValue> p = {{"n", 5}, {"d", 3}};
-    Outcome h = run(hard, p), s = run(soft, p);
+    AlgorithmRun h = run(hard, p), s = run(soft, p);
     print("hard (point) 5_3", h);
     print("soft (25 samples) 5_3", s);
     // The binary mismatch barely moves (most of it is self-shadowing of lit object sides, where
@@ -230,7 +161,7 @@ TEST_F(LineSpaceGLTest, SoftShadowsHideTheApproximation) {
 // A larger N gives slimmer shafts and smaller leaves: fewer free rays are declared blocked.
 TEST_F(LineSpaceGLTest, LargerBranchingFactorOverOccludesLess) {
     Shot s = areaShot(16);
-    Outcome coarse = run(s, {{"n", 3}, {"d", 3}}), fine = run(s, {{"n", 6}, {"d", 3}});
+    AlgorithmRun coarse = run(s, {{"n", 3}, {"d", 3}}), fine = run(s, {{"n", 6}, {"d", 3}});
     print("area16_3_3", coarse);
     print("area16_6_3", fine);
     EXPECT_LT(fine.counters["over_occluded_share"], coarse.counters["over_occluded_share"]);
@@ -239,8 +170,8 @@ TEST_F(LineSpaceGLTest, LargerBranchingFactorOverOccludesLess) {
 }
 
 TEST_F(LineSpaceGLTest, MemoryIsThePools) {
-    Shot s = pointShot();
-    Outcome o = run(s, {{"n", 4}, {"d", 3}});
+    Shot s = smokePointShot();
+    AlgorithmRun o = run(s, {{"n", 4}, {"d", 3}});
     const double nodes = o.counters["subdivided_nodes"];
     EXPECT_EQ(o.counters["nodes_level_0"], 1.0);
     EXPECT_EQ(o.counters["nodes_level_0"] + o.counters["nodes_level_1"] + o.counters["nodes_level_2"], nodes);
@@ -254,9 +185,9 @@ TEST_F(LineSpaceGLTest, MemoryIsThePools) {
 // The line-space pool is split over several SSBOs when it outgrows one: same image; beyond the
 // 4 blocks the shader binds, an error naming the pools (never a wrong image).
 TEST_F(LineSpaceGLTest, LineSpacePoolSplitsOverStorageBlocks) {
-    Shot s = pointShot();
-    Outcome whole = run(s, {{"classify", false}}); // (6, 3): ~6 MB of line space
-    Outcome split = run(s, {{"classify", false}, {"max_block_mib", 2}});
+    Shot s = smokePointShot();
+    AlgorithmRun whole = run(s, {{"classify", false}}); // (6, 3): ~6 MB of line space
+    AlgorithmRun split = run(s, {{"classify", false}, {"max_block_mib", 2}});
     EXPECT_GT(split.counters["line_space_pool_bytes"], 2.0 * (2 << 20)) << "the pool must need three blocks";
     EXPECT_EQ(split.visibility, whole.visibility);
     EXPECT_EQ(split.memory, whole.memory);
@@ -270,14 +201,14 @@ TEST_F(LineSpaceGLTest, LineSpacePoolSplitsOverStorageBlocks) {
 }
 
 TEST_F(LineSpaceGLTest, DiskCacheGivesTheSameImageAndRebuildsCorruptFiles) {
-    Shot s = pointShot();
+    Shot s = smokePointShot();
     const std::map<std::string, ParamValue> p = {{"n", 3}, {"d", 3}, {"classify", false}};
     const std::string file = ls::cacheFile(ls::cacheDirectory(), s.scene.contentHash(), 3, 3);
     std::filesystem::remove(file);
-    Outcome built = run(s, p);
+    AlgorithmRun built = run(s, p);
     EXPECT_EQ(built.counters["cache_hit"], 0.0);
     ASSERT_TRUE(std::filesystem::exists(file));
-    Outcome cached = run(s, p);
+    AlgorithmRun cached = run(s, p);
     EXPECT_EQ(cached.counters["cache_hit"], 1.0);
     EXPECT_EQ(cached.visibility, built.visibility);
     EXPECT_EQ(cached.counters["build_ms"], built.counters["build_ms"]) << "the cache keeps the original build time";
@@ -286,7 +217,7 @@ TEST_F(LineSpaceGLTest, DiskCacheGivesTheSameImageAndRebuildsCorruptFiles) {
         f.seekp(std::streamoff(std::filesystem::file_size(file) / 2));
         f.put('\x7f').put('\x01');
     }
-    Outcome rebuilt = run(s, p);
+    AlgorithmRun rebuilt = run(s, p);
     EXPECT_EQ(rebuilt.counters["cache_hit"], 0.0) << "a corrupt file must not be used";
     EXPECT_EQ(rebuilt.visibility, built.visibility);
     EXPECT_EQ(run(s, p).counters["cache_hit"], 1.0) << "the rebuilt tree replaced the corrupt file";

@@ -109,4 +109,41 @@ Shot thousandsOfTriangles() {
     return s;
 }
 
+Shot smokePointShot() {
+    Shot s;
+    s.scene = makePlane({8, 8}, 4, Material{});
+    s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
+    s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
+    s.scene.append(makeFence(6, 0.35f, 1.0f, 0.03f, 2, 32, Material{}), translate({0, 0, -1.2f}));
+    s.camera = lookAt({0, 3.0f, 5.0f}, {0, 0.4f, 0}, 55.0f);
+    s.light = pointLight({2.0f, 4.0f, 1.5f});
+    return s;
+}
+
+Shot smokeSpotShot() {
+    Shot s = smokePointShot();
+    s.light.type = LightType::Spot;
+    s.light.position = {-1.5f, 3.5f, 2.0f};
+    s.light.target = {0, 0, 0};
+    s.light.coneDeg = 35.0f;
+    return s;
+}
+
+Shot smokeDirectionalShot() {
+    Shot s = smokePointShot();
+    s.light = directionalLight({3.0f, 4.0f, 2.0f});
+    return s;
+}
+
+Shot smokeAreaShot(int samples, float side, const char* pattern) {
+    Shot s = smokePointShot();
+    s.light.type = LightType::Area;
+    s.light.position = {1.5f, 3.0f, 1.5f};
+    s.light.target = {0, 0, 0};
+    s.light.size = {side, side};
+    s.light.samples = samples;
+    s.light.pattern = pattern;
+    return s;
+}
+
 } // namespace shadowlab::test

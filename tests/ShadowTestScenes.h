@@ -45,4 +45,16 @@ Shot cameraInsideShadow();
 /// A few thousand triangles of closed meshes (a sphere and a tilted torus) under a point light.
 Shot thousandsOfTriangles();
 
+/// The smoke scene's objects (≈ 3,800 triangles): a sphere, a tilted torus and a thin fence on an
+/// 8 × 8 plane; with the camera the ray-tracing algorithms' tests look at it from (55°, a little
+/// narrower than the other shots) and a point light.
+Shot smokePointShot();
+/// smokePointShot() under a 35° spot light aimed at the origin.
+Shot smokeSpotShot();
+/// smokePointShot() under a directional light shining towards the origin.
+Shot smokeDirectionalShot();
+/// smokePointShot() under a square area light of side `side` facing the origin, with `samples`
+/// samples in `pattern`.
+Shot smokeAreaShot(int samples, float side, const char* pattern = "stratified");
+
 } // namespace shadowlab::test
