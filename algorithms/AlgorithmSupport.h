@@ -2,6 +2,9 @@
 // What several algorithm plugins share besides the interface: their registry entry, and the
 // binding convention of per-pixel compute passes.
 #include "algorithms/ShadowAlgorithm.h"
+#include "framework/gl/Shader.h"
+
+#include <initializer_list>
 
 #include <memory>
 #include <string>
@@ -42,6 +45,18 @@ inline void bindDebugImage(GLuint unit, const GlTexture& image) {
 inline void finishPixelPass() {
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
                     GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+/// A whole per-pixel pass: the inputs above, the debug images on units 1, 2, ... in order, the
+/// program in 8×8 groups over the image (its local size), then the barrier.
+inline void runPixelPass(const FrameInputs& f, const ShaderProgram& program,
+                         std::initializer_list<const GlTexture*> debugImages) {
+    bindPixelPassInputs(f);
+    GLuint unit = 1;
+    for (const GlTexture* image : debugImages) bindDebugImage(unit++, *image);
+    const glm::ivec2 r = f.gbuffer.resolution();
+    program.dispatch2D(r.x, r.y, 8, 8);
+    finishPixelPass();
 }
 
 } // namespace shadowlab

@@ -106,11 +106,7 @@ public:
         indices_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_INDEX_BINDING);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
-        bindPixelPassInputs(f);
-        bindDebugImage(1, nodesVisited_);
-        bindDebugImage(2, overflow_);
-        trace_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        finishPixelPass();
+        runPixelPass(f, trace_, {&nodesVisited_, &overflow_});
         f.timer.end();
         counters_.markStale();
     }

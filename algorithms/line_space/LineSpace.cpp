@@ -144,10 +144,7 @@ public:
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_COUNTER_BINDING);
         if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
-        bindPixelPassInputs(f);
-        bindDebugImage(1, nodesVisited_);
-        p.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        finishPixelPass();
+        runPixelPass(f, p, {&nodesVisited_});
         f.timer.end();
         counters_.markStale();
         classes_.reset();

@@ -60,7 +60,6 @@ const ParamSchema& metricTreeSchema() {
 }
 
 constexpr GLuint kGroup = 64;        ///< local_size_x of prepare.comp and insert.comp
-constexpr GLuint kMaxGroups = 65535; ///< GL's minimum max work group count per dimension
 /// Light-space margin of a point light, in radians: above the ~1e-7 rad rounding of the angles and
 /// the up to 5e-5 rad error of a short arc's great circle (see prepare.comp).
 constexpr float kAngularEps = 1e-4f;
@@ -138,13 +137,7 @@ public:
         f.timer.end();
 
         f.timer.begin("traverse");
-        bindPixelPassInputs(f);
-        bindDebugImage(1, nodesVisited_);
-        bindDebugImage(2, triangleTests_);
-        bindDebugImage(3, fruitless_);
-        bindDebugImage(4, overflow_);
-        query_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        finishPixelPass();
+        runPixelPass(f, query_, {&nodesVisited_, &triangleTests_, &fruitless_, &overflow_});
         f.timer.end();
         counters_.markStale();
     }
@@ -284,13 +277,7 @@ private:
     }
 
     /// One invocation per cluster, as a 2D grid when the clusters need more than 65535 groups.
-    void dispatchPerCluster(const ShaderProgram& p) const {
-        const GLuint groups = GLuint((clusterCount_ + kGroup - 1) / kGroup);
-        const GLuint gx = std::min(groups, kMaxGroups), gy = (groups + gx - 1) / gx;
-        p.set("uInvocationsPerRow", unsigned(gx * kGroup));
-        p.use();
-        glDispatchCompute(gx, gy, 1);
-    }
+    void dispatchPerCluster(const ShaderProgram& p) const { p.dispatchLinear(clusterCount_, kGroup); }
 
     /// The Table 2 reference: the nodes prepare.comp wrote, linked on the CPU, uploaded back.
     void buildOnCpu(const Light& light) {

@@ -43,7 +43,6 @@ const ParamSchema& psvSchema() {
 }
 
 constexpr GLuint kBuildGroup = 64;  ///< local_size_x of frusta.comp and build.comp
-constexpr GLuint kMaxGroups = 65535; ///< GL's minimum max work group count per dimension
 
 class Psv final : public ShadowAlgorithm {
 public:
@@ -100,11 +99,7 @@ public:
         // scene, so a light-view frustum culls nothing for the lights psv supports (a spot light
         // would cull the triangles outside its cone).
         f.timer.begin("traverse");
-        bindPixelPassInputs(f);
-        bindDebugImage(1, nodesVisited_);
-        bindDebugImage(2, overflow_);
-        query_.dispatch2D(resolution_.x, resolution_.y, 8, 8);
-        finishPixelPass();
+        runPixelPass(f, query_, {&nodesVisited_, &overflow_});
         f.timer.end();
         counters_.markStale();
     }
@@ -180,13 +175,7 @@ private:
     }
 
     /// One invocation per triangle, as a 2D grid when n needs more than 65535 groups of 64.
-    void dispatchPerTriangle(const ShaderProgram& p) const {
-        const GLuint groups = GLuint((scene_->triangleCount() + kBuildGroup - 1) / kBuildGroup);
-        const GLuint gx = std::min(groups, kMaxGroups), gy = (groups + gx - 1) / gx;
-        p.set("uInvocationsPerRow", unsigned(gx * kBuildGroup));
-        p.use();
-        glDispatchCompute(gx, gy, 1);
-    }
+    void dispatchPerTriangle(const ShaderProgram& p) const { p.dispatchLinear(scene_->triangleCount(), kBuildGroup); }
 
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;

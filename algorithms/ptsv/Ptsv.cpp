@@ -389,13 +389,7 @@ private:
     }
 
     /// One invocation per item, as a 2D grid when the count needs more than 65535 groups of 64.
-    static void dispatchLinear(const ShaderProgram& p, size_t count) {
-        const GLuint groups = GLuint((count + kSetupGroup - 1) / kSetupGroup);
-        const GLuint gx = std::min(groups, kMaxGroups), gy = (groups + gx - 1) / gx;
-        p.set("uInvocationsPerRow", unsigned(gx * kSetupGroup));
-        p.use();
-        glDispatchCompute(gx, gy, 1);
-    }
+    static void dispatchLinear(const ShaderProgram& p, size_t count) { p.dispatchLinear(count, kSetupGroup); }
 
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;

@@ -2,6 +2,7 @@
 
 #include "framework/core/Error.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -110,6 +111,15 @@ ShaderProgram ShaderProgram::graphics(const std::string& vert, const std::string
 void ShaderProgram::dispatch2D(int width, int height, int localX, int localY) const {
     use();
     glDispatchCompute(GLuint((width + localX - 1) / localX), GLuint((height + localY - 1) / localY), 1);
+}
+
+void ShaderProgram::dispatchLinear(size_t count, unsigned localSize) const {
+    constexpr size_t kMaxGroups = 65535;
+    const size_t groups = (count + localSize - 1) / localSize;
+    const size_t gx = std::min(groups, kMaxGroups), gy = gx ? (groups + gx - 1) / gx : 0;
+    set("uInvocationsPerRow", unsigned(gx * localSize));
+    use();
+    glDispatchCompute(GLuint(gx), GLuint(gy), 1);
 }
 
 bool hasExtension(const char* name) {

@@ -43,6 +43,10 @@ public:
 
     /// Dispatches enough work groups of (localX × localY) to cover width × height.
     void dispatch2D(int width, int height, int localX, int localY) const;
+    /// One invocation per item (triangle, cluster, ...) in groups of `localSize`, laid out as a 2D
+    /// grid when the count needs more than 65535 groups (GL's minimum limit per dimension); the
+    /// shader's `uniform uint uInvocationsPerRow` turns gl_GlobalInvocationID back into the item.
+    void dispatchLinear(size_t count, unsigned localSize) const;
 
 private:
     GlProgramName program_;
