@@ -53,13 +53,16 @@ void drawMeasurementsPanel(GuiState& s) {
     const Viewer& v = *s.viewer;
     ImGui::Text("%d x %d px, %s", v.resolution().x, v.resolution().y, v.active().label.c_str());
     plot("##frame", m.frameMs(), "frame");
-    plot("##gpu", m.algorithmGpuMs(), "GPU");
+    const bool wall = v.wallClockStages();
+    if (!wall) plot("##gpu", m.algorithmGpuMs(), "GPU");
     plot("##wall", m.algorithmWallMs(), "wall");
     for (const StageSeries& st : m.stages()) {
         ImGui::PushID(st.name.c_str());
-        // CPU-only stages (the reference) have no GPU time: plot their CPU time instead.
+        // CPU-only stages (the reference) have no GPU time: plot their CPU time instead. On a CPU
+        // rasteriser every stage is timed by its wall clock (Viewer::wallClockStages()).
         bool cpuOnly = st.gpuMs.max() <= 0.0f && st.cpuMs.max() > 0.0f;
-        plot("##stage", cpuOnly ? st.cpuMs : st.gpuMs, (st.name + (cpuOnly ? " cpu" : " gpu")).c_str());
+        const char* label = wall ? " wall" : cpuOnly ? " cpu" : " gpu";
+        plot("##stage", wall || cpuOnly ? st.cpuMs : st.gpuMs, (st.name + label).c_str());
         ImGui::PopID();
     }
     if (!m.counters().empty() && ImGui::BeginTable("counters", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingStretchProp)) {

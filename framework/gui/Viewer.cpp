@@ -1,6 +1,7 @@
 #include "framework/gui/Viewer.h"
 
 #include "framework/core/Error.h"
+#include "framework/gl/GlContext.h"
 
 #include <chrono>
 
@@ -10,6 +11,9 @@ Viewer::Viewer(ExperimentConfig config, Json source) : config_(std::move(config)
     camera = config_.camera;
     light = config_.light;
     sceneGpu_ = std::make_unique<SceneGpu>(*config_.scene);
+    // As in the runner: a CPU rasteriser's timer queries misattribute compute work, so its stages
+    // are timed by their wall clock, each run to completion.
+    timer_.setSynchronous(isSoftwareRenderer(glRendererString()));
 
     choices_ = algorithmChoices(config_);
     applyPlayback();

@@ -83,6 +83,8 @@ public:
     /// Stages of the last frame (GPU and CPU ms), as StageTimer::collect() returned them.
     const std::vector<StageTime>& lastStages() const { return lastStages_; }
     double lastAlgorithmWallMs() const { return lastWallMs_; }
+    /// True where stage times come from the wall clock instead of GL timer queries (CPU rasterisers).
+    bool wallClockStages() const { return timer_.synchronous(); }
     int renderedFrames() const { return renderedFrames_; }
 
 private:
