@@ -53,7 +53,7 @@ void PrintTo(const AccuracyCase& c, std::ostream* os) {
     *os << c.name << " mismatch ≤ " << c.maxMismatch << ", rmse ≤ " << c.maxRmse;
 }
 
-// The bound for hard shadows is 0.1 % of lit pixels (≈ 5 of the ~5000 lit pixels at 96²):
+// The required bound for hard shadows is 0.1 % of lit pixels (≈ 5 of the ~5000 lit pixels at 96²):
 // the rays are the reference's, and the watertight test matches Embree's robust mode, so only a
 // ray grazing an edge within float rounding of the two tracers may differ. Soft shadows use the
 // same samples, so the RMSE stays at that level too.

@@ -59,16 +59,16 @@ const AccuracyCase kAccuracy[] = {
     {"tests/data/lights_spot.json", "shadow_map", 0.01},
     {"tests/data/lights_directional.json", "shadow_map", 0.01},
     {kDemoSmall, "sm_2k", 0.01},
-    // psv is exact up to float rounding in the plane tests of grazing pixels: the bound of
+    // psv is exact up to float rounding in the plane tests of grazing pixels: the required bound of
     // 0.1 % of lit pixels (measured: 0 on every smoke frame).
     {"configs/smoke.json", "psv", 0.001},
     {kDemoSmall, "psv", 0.001},
     // bvh_raytrace traces the reference's own rays (same origin offset, watertight triangle test like
-    // Embree's robust mode): the bound of 0.1 % of lit pixels, for hard and soft shadows
+    // Embree's robust mode): the required bound of 0.1 % of lit pixels, for hard and soft shadows
     // (measured: 0 on every frame of both configs).
     {"configs/smoke.json", "bvh_raytrace", 0.001},
     // ptsv tests the reference's own shadow-ray origins against exact per-triangle volumes; node
-    // culling only ever sends work deeper: the bound of 0.1 % of lit pixels (measured: 0
+    // culling only ever sends work deeper: the required bound of 0.1 % of lit pixels (measured: 0
     // on every smoke frame).
     {"configs/smoke.json", "ptsv", 0.001},
     {kDemoSmall, "ptsv", 0.001},
