@@ -114,7 +114,6 @@ class PtsvAccuracyGLTest : public PtsvGLTest, public ::testing::WithParamInterfa
 
 TEST_P(PtsvAccuracyGLTest, MatchesReference) {
     const AccuracyCase& c = GetParam();
-    if (c.make == engine && !std::filesystem::exists(test::kEngineGlb)) GTEST_SKIP() << test::kEngineGlb << " missing";
     Outcome o = run(c.make(), c.params);
     std::printf("[ptsv] %-30s lit %5zu mismatch %.5f%% (false lit %.5f%%) test-and-set %.0f node tests %.0f "
                 "iterations max %.0f/%.0f accepted %.0f\n",
@@ -211,6 +210,8 @@ TEST_F(PtsvGLTest, VotePathsAgree) {
     Outcome autoVote = run(s, {}, false);
     EXPECT_EQ(autoVote.counters["vote_path"], ballotUsable ? 1.0 : 0.0);
     EXPECT_EQ(autoVote.counters["subgroup_size"], double(width));
+    // Only a driver without ARB_shader_ballot (or with a width that does not divide 32) has no
+    // ballot path to compare; llvmpipe, NVIDIA and AMD all have one.
     if (!ballotUsable) GTEST_SKIP() << "no usable ARB_shader_ballot (subgroup " << width << ")";
     Outcome ballot = run(s, {{"vote", std::string("ballot")}}, false);
     EXPECT_EQ(ballot.counters["vote_path"], 1.0);
