@@ -47,6 +47,17 @@ inline void finishPixelPass() {
                     GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
+/// Uploads the light's sample points (Light::samplePoints(), the reference's samples) as vec4s into
+/// `buffer`, growing it when needed; returns how many there are.
+inline int uploadLightSamples(GlBuffer& buffer, const Light& light) {
+    std::vector<glm::vec4> samples;
+    for (glm::vec3 s : light.samplePoints()) samples.emplace_back(s, 1.0f);
+    const size_t bytes = samples.size() * sizeof(glm::vec4);
+    if (bytes > buffer.size()) buffer = GlBuffer(bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    buffer.upload(samples.data(), bytes);
+    return int(samples.size());
+}
+
 /// A whole per-pixel pass: the inputs above, the debug images on units 1, 2, ... in order, the
 /// program in 8×8 groups over the image (its local size), then the barrier.
 inline void runPixelPass(const FrameInputs& f, const ShaderProgram& program,

@@ -12,9 +12,8 @@ namespace shadowlab::bvh {
 
 struct BuildOptions {
     int maxLeafSize = 4; ///< a leaf holds at most this many triangles (unless they cannot be split)
-    int bins = 32;       ///< SAH bins per axis
-    /// SAH cost of one node traversal relative to one ray–triangle test (Aila & Laine's GPU ratio
-    /// is near 1: a node fetch costs about what a triangle fetch does).
+    int bins = 32;       ///< SAH bins per axis (schema: sah_bins)
+    /// SAH cost of one node traversal relative to one ray–triangle test (schema: traversal_cost).
     float traversalCost = 1.0f;
 };
 

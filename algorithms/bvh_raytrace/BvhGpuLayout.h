@@ -22,10 +22,6 @@ struct NodeGpu {
 };
 static_assert(sizeof(NodeGpu) == BVH_NODE_BYTES, "BvhNode is 64 bytes in std430");
 
-constexpr size_t kCounterBytes = BVH_COUNTER_WORDS * sizeof(uint32_t);
-
-/// GL_MAX_SHADER_STORAGE_BLOCK_SIZE of the current context, in bytes.
-size_t maxStorageBlockBytes();
 /// Throws RuntimeError naming `what` when a buffer of `bytes` exceeds `limit`
 /// (an SSBO larger than the limit cannot be addressed whole: the image would silently be wrong).
 void checkStorageBlock(const char* what, size_t bytes, size_t limit);

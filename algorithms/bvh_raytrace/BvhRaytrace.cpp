@@ -14,12 +14,6 @@ namespace shadowlab {
 
 namespace bvh {
 
-size_t maxStorageBlockBytes() {
-    GLint64 v = 0;
-    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
-    return size_t(v);
-}
-
 void checkStorageBlock(const char* what, size_t bytes, size_t limit) {
     if (bytes <= limit) return;
     auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20); };
@@ -38,6 +32,10 @@ const ParamSchema& bvhSchema() {
         .integer("stack_size", 64, 1, 256, "nodes",
                  "traversal stack; a ray that overflows it counts as blocked and is reported", ParamChange::Rebuild)
         .integer("leaf_size", 4, 1, 16, "triangles", "most triangles per BVH leaf", ParamChange::Rebuild)
+        .integer("sah_bins", 32, 4, 256, "bins", "SAH candidate split planes per axis in the CPU build", ParamChange::Rebuild)
+        // Aila & Laine's GPU ratio is near 1: a node fetch costs about what a triangle fetch does.
+        .real("traversal_cost", 1.0, 0.1, 10.0, "× triangle test",
+              "SAH cost of visiting a node, relative to one ray-triangle test", ParamChange::Rebuild)
         // Same key, default and unit as the reference's: the rays are the reference's rays.
         .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
               "shadow ray origin offset along the surface normal, against self-intersection", ParamChange::Update);
@@ -56,9 +54,11 @@ public:
         auto t0 = Clock::now();
         bvh::BuildOptions opt;
         opt.maxLeafSize = params_.getInt("leaf_size");
+        opt.bins = params_.getInt("sah_bins");
+        opt.traversalCost = float(params_.getFloat("traversal_cost"));
         bvh::Bvh tree = bvh::buildBvh(scene.cpu(), opt);
         buildMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-        const size_t limit = bvh::maxStorageBlockBytes();
+        const size_t limit = maxShaderStorageBlockBytes();
         bvh::checkStorageBlock("the BVH nodes", tree.nodes.size() * sizeof(bvh::NodeGpu), limit);
         bvh::checkStorageBlock("the triangle indices", tree.triIndices.size() * sizeof(uint32_t), limit);
         bvh::checkStorageBlock("the scene positions", scene.positions().size(), limit);
@@ -86,21 +86,14 @@ public:
     void computeVisibility(const FrameInputs& f) override {
         if (!scene_) throw RuntimeError("bvh_raytrace: computeVisibility() before setScene()");
         if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
-        const std::vector<glm::vec3> points = f.light.samplePoints();
-        std::vector<glm::vec4> samples;
-        for (glm::vec3 s : points) samples.emplace_back(s, 1.0f);
-        if (samples.size() > sampleCapacity_) { // grows only: the light's sample count is fixed per run
-            samples_ = GlBuffer(samples.size() * sizeof(glm::vec4), nullptr, GL_DYNAMIC_STORAGE_BIT);
-            sampleCapacity_ = samples.size();
-        }
-        samples_.upload(samples.data(), samples.size() * sizeof(glm::vec4));
+        const int sampleCount = uploadLightSamples(samples_, f.light);
 
         f.timer.begin("trace");
         counters_.clear();
         setLightUniforms(trace_, f.light);
         const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
         trace_.set("uRayOffset", float(params_.getFloat("ray_offset")) * radius);
-        trace_.set("uSampleCount", int(samples.size()));
+        trace_.set("uSampleCount", sampleCount);
         scene_->bindStorage();
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_NODE_BINDING);
         indices_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_INDEX_BINDING);
@@ -113,7 +106,7 @@ public:
 
     std::vector<Counter> counters() const override {
         const auto& c = counters_.read();
-        auto wide = [&](int lo) { return double((uint64_t(c[size_t(lo) + 1]) << 32) | c[size_t(lo)]); };
+        auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(BVH_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
         return {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
@@ -150,17 +143,19 @@ public:
 
 private:
     void compile() {
-        trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp",
-                                        {{"BVH_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}});
+        const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
+        if (defines == compiledDefines_) return; // leaf_size only rebuilds the tree
+        compiledDefines_ = defines;
+        trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp", defines);
     }
 
     ParamValues params_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     ShaderProgram trace_;
+    ShaderDefines compiledDefines_;
     GlBuffer nodes_, indices_, samples_;
     GpuCounters<BVH_COUNTER_WORDS> counters_;
-    size_t sampleCapacity_ = 0;
     GlTexture nodesVisited_, overflow_;
     size_t nodeCount_ = 0, leaves_ = 0;
     int depth_ = 0;

@@ -44,12 +44,6 @@ const ParamSchema& lineSpaceSchema() {
     return s;
 }
 
-size_t maxStorageBlockBytes() {
-    GLint64 v = 0;
-    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
-    return size_t(v);
-}
-
 class LineSpace final : public ShadowAlgorithm {
 public:
     explicit LineSpace(const ParamValues& p) : params_(p) { compile(); }
@@ -61,7 +55,7 @@ public:
         for (GlBuffer& b : bitsBuf_) b = GlBuffer();
         const int n = params_.getInt("n"), d = params_.getInt("d");
         const size_t cap = size_t(params_.getInt("max_block_mib")) << 20;
-        const size_t limit = cap > 0 ? std::min(cap, maxStorageBlockBytes()) : maxStorageBlockBytes();
+        const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
         tree_ = obtainTree(scene.cpu(), n, d, limit);
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
                       tree_.bits.size() * sizeof(uint32_t)};
@@ -110,21 +104,16 @@ public:
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         params_ = p;
-        if (change != ParamChange::Rebuild) return;
-        compile(); // setScene() and resize() follow a Rebuild (ShadowAlgorithm.h)
+        // setScene() follows a Rebuild (ShadowAlgorithm.h) and compiles for the new tree's block count.
+        if (change == ParamChange::Rebuild) bitChunks_ = 0;
     }
 
     void computeVisibility(const FrameInputs& f) override {
         if (!scene_) throw RuntimeError("line_space: computeVisibility() before setScene()");
         if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
         const bool classify = params_.getBool("classify");
-        const std::vector<glm::vec3> points = f.light.samplePoints();
-        std::vector<glm::vec4> samples;
-        for (glm::vec3 s : points) samples.emplace_back(s, 1.0f);
-        if (samples.size() * sizeof(glm::vec4) > samples_.size())
-            samples_ = GlBuffer(samples.size() * sizeof(glm::vec4), nullptr, GL_DYNAMIC_STORAGE_BIT);
-        samples_.upload(samples.data(), samples.size() * sizeof(glm::vec4));
-        const size_t classifyBytes = size_t(resolution_.x) * size_t(resolution_.y) * ls::classifyStride(samples.size()) * 4;
+        const int sampleCount = uploadLightSamples(samples_, f.light);
+        const size_t classifyBytes = size_t(resolution_.x) * size_t(resolution_.y) * ls::classifyStride(size_t(sampleCount)) * 4;
         if (classify && classifyBytes > classifyBuf_.size()) classifyBuf_ = GlBuffer(classifyBytes, nullptr, 0);
         if (classify && !classifyProgram_)
             classifyProgram_ = ShaderProgram::compute("line_space/trace.comp", defines(true));
@@ -134,7 +123,7 @@ public:
         counters_.clear();
         setLightUniforms(p, f.light);
         p.set("uRayOffset", rayOffset());
-        p.set("uSampleCount", int(samples.size()));
+        p.set("uSampleCount", sampleCount);
         p.set("uNodeCount", unsigned(tree_.nodes.size()));
         p.set("uNodesPerChunk", unsigned(nodesPerChunk_));
         nodesBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_NODE_BINDING);
@@ -156,7 +145,7 @@ public:
 
     std::vector<Counter> counters() const override {
         const auto& c = counters_.read();
-        auto wide = [&](int lo) { return double((uint64_t(c[size_t(lo) + 1]) << 32) | c[size_t(lo)]); };
+        auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(LS_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
         std::vector<Counter> out = {{"nodes_visited_mean", perRay(wide(LS_C_VISITED_LO))},

@@ -17,7 +17,7 @@ constexpr char kMagic[8] = {'S', 'L', 'M', 'T', 'C', 'L', 'U', '\0'};
 /// Fixed-size header, raw bytes (the cache is machine-local, like ~/.cache itself).
 struct Header {
     char magic[8];
-    uint32_t version, clusterSize, capsules, randomOrder, seed, reserved;
+    uint32_t version, clusterSize, capsules, randomOrder, seed, chunkTriangles, kmeansIterations, reserved;
     uint64_t sceneHash, triangles, clusters, capsuleCount;
     uint64_t payloadChecksum;
     uint64_t headerChecksum; ///< of every byte above
@@ -36,8 +36,9 @@ std::string cacheDirectory() { return diskcache::directory("metric_tree"); }
 
 std::string cacheFile(const std::string& dir, uint64_t sceneHash, const ClusteringOptions& o) {
     char name[96];
-    std::snprintf(name, sizeof name, "%016llx_s%d_c%d_r%d_%u_v%u.bin", (unsigned long long)sceneHash, o.clusterSize,
-                  int(o.capsules), int(o.randomOrder), o.seed, kCacheVersion);
+    std::snprintf(name, sizeof name, "%016llx_s%d_c%d_r%d_%u_k%d_i%d_v%u.bin", (unsigned long long)sceneHash,
+                  o.clusterSize, int(o.capsules), int(o.randomOrder), o.seed, o.chunkTriangles, o.kmeansIterations,
+                  kCacheVersion);
     return dir + "/" + name;
 }
 
@@ -47,6 +48,7 @@ bool saveCache(const std::string& path, uint64_t sceneHash, const ClusteringOpti
     std::memcpy(h.magic, kMagic, sizeof kMagic);
     h.version = kCacheVersion;
     h.clusterSize = uint32_t(o.clusterSize), h.capsules = o.capsules, h.randomOrder = o.randomOrder, h.seed = o.seed;
+    h.chunkTriangles = uint32_t(o.chunkTriangles), h.kmeansIterations = uint32_t(o.kmeansIterations);
     h.sceneHash = sceneHash, h.triangles = triangles, h.clusters = c.clusters.size(), h.capsuleCount = c.capsules;
     h.payloadChecksum = payloadChecksum(c);
     h.headerChecksum = checksum(&h, offsetof(Header, headerChecksum));
@@ -72,7 +74,8 @@ std::optional<Clustering> loadCache(const std::string& path, uint64_t sceneHash,
     if (h.headerChecksum != checksum(&h, offsetof(Header, headerChecksum))) return bad("header checksum mismatch");
     if (h.version != kCacheVersion) return bad("cache version " + std::to_string(h.version));
     if (h.sceneHash != sceneHash || h.triangles != triangles || h.clusterSize != uint32_t(o.clusterSize) ||
-        h.capsules != uint32_t(o.capsules) || h.randomOrder != uint32_t(o.randomOrder) || h.seed != o.seed)
+        h.capsules != uint32_t(o.capsules) || h.randomOrder != uint32_t(o.randomOrder) || h.seed != o.seed ||
+        h.chunkTriangles != uint32_t(o.chunkTriangles) || h.kmeansIterations != uint32_t(o.kmeansIterations))
         return bad("the file is for another scene or other clustering options");
     std::error_code ec;
     if (fs::file_size(path, ec) != sizeof h + h.clusters * sizeof(ClusterGpu) + h.triangles * sizeof(uint32_t))

@@ -10,7 +10,7 @@
 namespace shadowlab::mt {
 
 /// Bumped whenever the clustering's output changes: old files then miss.
-constexpr uint32_t kCacheVersion = 1;
+constexpr uint32_t kCacheVersion = 2; ///< 2: chunk size and k-means iterations in the key
 
 /// $XDG_CACHE_HOME/shadowlab/metric_tree, else $HOME/.cache/shadowlab/metric_tree, else "" (no cache).
 std::string cacheDirectory();

@@ -151,12 +151,11 @@ float kmeansDistance(const Element& e, glm::vec3 centre) {
 }
 
 constexpr int kMaxK = 4;           ///< children per k-means level (the hierarchy's branching)
-constexpr int kKmeansIterations = 8;
 constexpr int kSeedCandidates = 4; ///< k-means++ draws this many candidates and keeps the farthest
 
 /// Splits `ids` (indices into `elems`) recursively until each part has at most `maxSize`
 /// elements; appends the parts to `out`.
-void splitRecursive(const std::vector<Element>& elems, std::vector<uint32_t> ids, size_t maxSize, std::mt19937& rng,
+void splitRecursive(const std::vector<Element>& elems, std::vector<uint32_t> ids, size_t maxSize, int iterations, std::mt19937& rng,
                     std::vector<std::vector<uint32_t>>& out) {
     if (ids.size() <= maxSize) {
         out.push_back(std::move(ids));
@@ -191,7 +190,7 @@ void splitRecursive(const std::vector<Element>& elems, std::vector<uint32_t> ids
         centres.push_back(elems[ids[best]].centroid);
     }
     std::vector<int> assign(ids.size(), 0);
-    for (int it = 0; it < kKmeansIterations; ++it) {
+    for (int it = 0; it < iterations; ++it) {
         bool changed = false;
         for (size_t i = 0; i < ids.size(); ++i) {
             int best = 0;
@@ -221,7 +220,7 @@ void splitRecursive(const std::vector<Element>& elems, std::vector<uint32_t> ids
         parts[1].assign(ids.begin() + ids.size() / 2, ids.end());
     }
     for (auto& p : parts)
-        if (!p.empty()) splitRecursive(elems, std::move(p), maxSize, rng, out);
+        if (!p.empty()) splitRecursive(elems, std::move(p), maxSize, iterations, rng, out);
 }
 
 uint32_t spreadBits(uint32_t x) { // 10 bits -> every third bit
@@ -387,15 +386,16 @@ Clustering clusterScene(const Scene& scene, const ClusteringOptions& options) {
 
     // Chunks are independent: k-means runs on a few threads, each chunk with its own seeded RNG
     // so the result does not depend on the thread count.
-    const size_t chunks = (n + kChunkTriangles - 1) / kChunkTriangles;
+    const size_t chunk = size_t(std::max(1, options.chunkTriangles));
+    const size_t chunks = (n + chunk - 1) / chunk;
     std::vector<std::vector<std::vector<uint32_t>>> parts(chunks);
     const unsigned threads = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
     auto work = [&](unsigned id) {
         for (size_t c = id; c < chunks; c += threads) {
             std::vector<uint32_t> ids;
-            for (size_t i = c * kChunkTriangles; i < std::min(n, (c + 1) * kChunkTriangles); ++i) ids.push_back(keyed[i].second);
+            for (size_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i) ids.push_back(keyed[i].second);
             std::mt19937 rng(uint32_t(c * 2654435761u) ^ options.seed);
-            splitRecursive(elems, std::move(ids), size_t(options.clusterSize), rng, parts[c]);
+            splitRecursive(elems, std::move(ids), size_t(options.clusterSize), options.kmeansIterations, rng, parts[c]);
         }
     };
     std::vector<std::thread> pool;

@@ -19,6 +19,8 @@ struct ClusteringOptions {
     bool capsules = true;   ///< capsules for elongated clusters (else spheres only)
     bool randomOrder = true; ///< shuffle the clusters: their order is the insertion (pivot) order
     uint32_t seed = 1;
+    int chunkTriangles = 512; ///< triangles per Morton chunk before k-means (the paper's 512)
+    int kmeansIterations = 8; ///< Lloyd iterations per k-means split
 };
 
 struct Clustering {
@@ -26,9 +28,6 @@ struct Clustering {
     std::vector<uint32_t> order; ///< scene triangle index of each triangle in cluster order
     size_t capsules = 0;         ///< clusters bounded by a capsule
 };
-
-/// Triangles per Morton chunk before k-means (the paper's 512).
-constexpr size_t kChunkTriangles = 512;
 
 Clustering clusterScene(const Scene& scene, const ClusteringOptions& options);
 

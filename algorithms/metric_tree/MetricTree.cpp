@@ -25,6 +25,10 @@ const ParamSchema& metricTreeSchema() {
         .integer("cluster_size", 16, 2, 64, "triangles",
                  "most triangles per cluster (paper: 16 to 32); fewer clusters build faster, more triangles are tested",
                  ParamChange::Rebuild)
+        .integer("chunk_triangles", 512, 16, 65536, "triangles",
+                 "triangles per Morton-curve chunk clustered independently by k-means (paper: 512)", ParamChange::Rebuild)
+        .integer("kmeans_iterations", 8, 1, 100, "iterations", "Lloyd iterations of each k-means split",
+                 ParamChange::Rebuild)
         .boolean("capsules", true,
                  "bound elongated clusters (OBB longest extent >= 2x the others) by capsules, else spheres only",
                  ParamChange::Rebuild)
@@ -144,7 +148,7 @@ public:
 
     std::vector<Counter> counters() const override {
         const auto& c = counters_.read();
-        auto wide = [&](int lo) { return double((uint64_t(c[lo + 1]) << 32) | c[lo]); };
+        auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double px = c[MT_C_TRAVERSED];
         auto perPixel = [&](int lo) { return px > 0 ? wide(lo) / px : 0.0; };
         const double n = double(clusterCount_);
@@ -182,7 +186,7 @@ public:
     /// Clusters and nodes (64 bytes each: 128 per cluster, the paper's figure) plus the 128-byte
     /// counter block. Not counted, as in the paper: the triangles themselves, which metric_tree
     /// keeps in cluster order (counter geometry_bytes), and the per-pixel debug images.
-    size_t memoryBytes() const override { return mt::structureBytes(clusterCount_) + mt::kCounterBytes; }
+    size_t memoryBytes() const override { return mt::structureBytes(clusterCount_) + counters_.size(); }
 
     /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
     uint64_t overflowCount() const override {
@@ -198,6 +202,9 @@ private:
                                        {"MT_DEPTH_SKIP", flag("depth_skip")},
                                        {"MT_NORMAL_CONE_CULLING", flag("normal_cone_culling")},
                                        {"MT_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
+        // Rebuild-only parameters (scene structures, buffers) leave the programs as they are.
+        if (defines == compiledDefines_) return;
+        compiledDefines_ = defines;
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
         insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
@@ -208,6 +215,8 @@ private:
         const auto start = std::chrono::steady_clock::now();
         mt::ClusteringOptions o;
         o.clusterSize = params_.getInt("cluster_size");
+        o.chunkTriangles = params_.getInt("chunk_triangles");
+        o.kmeansIterations = params_.getInt("kmeans_iterations");
         o.capsules = params_.getBool("capsules");
         o.randomOrder = params_.getBool("random_order");
         o.seed = uint32_t(params_.getInt("seed"));
@@ -300,6 +309,7 @@ private:
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     ShaderProgram prepare_, insert_, query_;
+    ShaderDefines compiledDefines_; ///< what the programs were built with
     GlBuffer clusters_, nodes_;
     GpuCounters<MT_COUNTER_WORDS> counters_;
     std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;

@@ -22,7 +22,7 @@ const ParamSchema& psvSchema() {
         .boolean("random_order", true,
                  "merge triangles in a seeded pseudo-random order (paper 3.3) instead of scene order",
                  ParamChange::Rebuild)
-        .integer("seed", 1, 0, INT_MAX, "", "seed of the insertion order (with random_order)", ParamChange::Rebuild)
+        .integer("seed", 1, 0, INT_MAX, "", "seed of the insertion order (with random_order)", ParamChange::Update)
         // Off by default: it is exact only for closed, consistently wound meshes (a ground plane
         // facing the light is dropped, fine; an open mesh would leak light through its back).
         .boolean("front_face_culling", false,
@@ -67,8 +67,9 @@ public:
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         params_ = p;
-        if (change != ParamChange::Rebuild) return;
-        compile(); // setScene() follows a Rebuild (ShadowAlgorithm.h) and picks up the new seed
+        // The seed only keys the insertion order's bijection, passed as uniforms each frame.
+        if (scene_) permutation_ = psv::makePermutation(uint32_t(scene_->triangleCount()), uint32_t(p.getInt("seed")));
+        if (change == ParamChange::Rebuild) compile(); // setScene() follows a Rebuild (ShadowAlgorithm.h)
     }
 
     void computeVisibility(const FrameInputs& f) override {
@@ -106,7 +107,8 @@ public:
 
     std::vector<Counter> counters() const override {
         const auto& c = counters_.read();
-        const double visited = double((uint64_t(c[PSV_C_VISITED_HI]) << 32) | c[PSV_C_VISITED_LO]);
+        static_assert(PSV_C_VISITED_HI == PSV_C_VISITED_LO + 1);
+        const double visited = double(counters_.wide(PSV_C_VISITED_LO));
         const double traversed = c[PSV_C_TRAVERSED];
         return {{"nodes_visited_mean", traversed > 0 ? visited / traversed : 0.0},
                 {"nodes_visited_max", double(c[PSV_C_VISITED_MAX])},
@@ -144,6 +146,9 @@ private:
                                        {"PSV_DEPTH_SKIP", flag("depth_skip")},
                                        {"PSV_TRANSPARENCY", flag("transparency")},
                                        {"PSV_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
+        // Rebuild-only parameters (scene structures, buffers) leave the programs as they are.
+        if (defines == compiledDefines_) return;
+        compiledDefines_ = defines;
         frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
         build_ = ShaderProgram::compute("psv/build.comp", defines);
         query_ = ShaderProgram::compute("psv/query.comp", defines);
@@ -181,6 +186,7 @@ private:
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     ShaderProgram frusta_, build_, query_;
+    ShaderDefines compiledDefines_; ///< what the programs were built with
     GlBuffer nodes_;
     GpuCounters<PSV_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;

@@ -86,7 +86,7 @@ public:
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
         const size_t n = scene.triangleCount();
-        if (n * PTSV_PLANES_PER_TRIANGLE * 16 > maxBlockBytes())
+        if (n * PTSV_PLANES_PER_TRIANGLE * 16 > maxShaderStorageBlockBytes())
             throw RuntimeError("ptsv: " + std::to_string(n) + " triangles exceed the largest storage block");
         planes_ = GlBuffer(std::max<size_t>(n, 1) * PTSV_PLANES_PER_TRIANGLE * 16, nullptr, 0);
         counters_.allocate();
@@ -177,11 +177,12 @@ public:
 
     std::vector<Counter> counters() const override {
         const auto& c = counters_.read();
-        auto wide = [&](int lo, int hi) { return double((uint64_t(c[size_t(hi)]) << 32) | c[size_t(lo)]); };
+        static_assert(PTSV_C_TESTS_HI == PTSV_C_TESTS_LO + 1 && PTSV_C_NODE_TESTS_HI == PTSV_C_NODE_TESTS_LO + 1);
+        auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double jobs1 = c[PTSV_C_JOBS_1];
         const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(params_.getInt("job_capacity")));
-        std::vector<Counter> out = {{"test_and_set", wide(PTSV_C_TESTS_LO, PTSV_C_TESTS_HI)},
-                {"node_tests", wide(PTSV_C_NODE_TESTS_LO, PTSV_C_NODE_TESTS_HI)},
+        std::vector<Counter> out = {{"test_and_set", wide(PTSV_C_TESTS_LO)},
+                {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
                 {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
                 {"iterations_mean_pass1", jobs1 > 0 ? c[PTSV_C_ITER_SUM_1] / jobs1 : 0.0},
                 {"iterations_max_pass2", double(c[PTSV_C_ITER_MAX_2])},
@@ -246,12 +247,6 @@ public:
     }
 
 private:
-    static size_t maxBlockBytes() {
-        GLint64 v = 0;
-        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
-        return size_t(v);
-    }
-
     int splitDepth() const {
         const int l = params_.getInt("split_level");
         return l == 0 ? std::max(1, layout_.levels - 1) : std::min(l, layout_.levels);
@@ -279,6 +274,9 @@ private:
                                  {"PTSV_BALLOT", flag(vote_ == kVoteBallot)},
                                  {"PTSV_LANES", std::to_string(lanes_)},
                                  {"PTSV_JOBS_PER_GROUP", std::to_string(params_.getInt("jobs_per_workgroup"))}};
+        // Rebuild-only parameters (scene structures, buffers) leave the programs as they are.
+        if (defines == compiledDefines_) return;
+        compiledDefines_ = defines;
         hierarchy_ = ShaderProgram::compute("ptsv/hierarchy.comp", defines);
         reduce_ = ShaderProgram::compute("ptsv/reduce.comp", defines);
         setup_ = ShaderProgram::compute("ptsv/setup.comp", defines);
@@ -303,7 +301,7 @@ private:
                                       params_.getInt("max_key_bits"));
         const bool explicitBounds = params_.getEnum("bounds") == "explicit";
         const size_t boundsBytes = explicitBounds ? layout_.boundsNodes * 6 * sizeof(float) : 4;
-        if (boundsBytes > maxBlockBytes())
+        if (boundsBytes > maxShaderStorageBlockBytes())
             throw RuntimeError("ptsv: explicit bounds of a full tree with " + std::to_string(layout_.keyBits) +
                                "-bit keys need " + std::to_string(boundsBytes >> 20) +
                                " MiB, over this context's storage block limit: use bounds = implicit, a larger "
@@ -401,6 +399,7 @@ private:
     std::array<float, 6> layoutKey_{};
     bool warnedSplit_ = false;
     ShaderProgram hierarchy_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
+    ShaderDefines compiledDefines_; ///< what the programs were built with
     GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
     GpuCounters<PTSV_COUNTER_WORDS> counters_;
     GlTexture heat_;

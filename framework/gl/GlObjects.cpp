@@ -59,4 +59,10 @@ std::vector<unsigned char> readTextureRGBA8(GLuint texture, int width, int heigh
     return out;
 }
 
+size_t maxShaderStorageBlockBytes() {
+    GLint64 v = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
+    return size_t(v);
+}
+
 } // namespace shadowlab

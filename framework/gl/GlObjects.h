@@ -76,6 +76,9 @@ private:
     size_t size_ = 0;
 };
 
+/// GL_MAX_SHADER_STORAGE_BLOCK_SIZE of the current context, in bytes.
+size_t maxShaderStorageBlockBytes();
+
 /// A 2D texture with immutable storage.
 GlTexture makeTexture2D(GLenum internalFormat, int width, int height, GLenum filter = GL_NEAREST);
 

@@ -144,7 +144,7 @@ int runGui(const GuiOptions& opts) {
         ImGui::GetBackgroundDrawList()->AddImage(ImTextureID(intptr_t(image)), ImVec2(viewportMin.x, viewportMin.y),
                                                  ImVec2(viewportMax.x, viewportMax.y), ImVec2(0, 1), ImVec2(1, 0));
         drawViewLegend(s, viewportMin, viewportMax);
-        report.add(v);
+        if (!opts.report.empty()) report.add(v); // frames are kept only to be written
         v.stepPlayback();
 
         ImGui::Render();

@@ -165,12 +165,6 @@ Scene makeFence(int posts, float spacing, float height, float radius, int rails,
     Scene post = makeCylinder(radius, height, trianglesPerCylinder, m);
     Scene rail = rails ? makeCylinder(radius, length, trianglesPerCylinder, m) : Scene{};
     Scene scene;
-    // Reserve everything up front: Scene::append reserves exactly what each call needs, which
-    // would reallocate (and copy the whole fence so far) on every post.
-    size_t total = size_t(posts) * post.triangleCount() + size_t(rails) * rail.triangleCount();
-    scene.positions.reserve(3 * total);
-    scene.normals.reserve(total);
-    scene.materialIds.reserve(total);
     for (int i = 0; i < posts; ++i) scene.append(post, glm::translate(glm::mat4(1.0f), {firstX + float(i) * spacing, 0, 0}));
     // A cylinder along +Y turned −90° about Z lies along +X, starting at the first post.
     glm::mat4 toX = glm::rotate(glm::mat4(1.0f), -0.5f * kPi, glm::vec3(0, 0, 1));

@@ -1,5 +1,6 @@
 #include "framework/scene/Scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -26,7 +27,13 @@ void Scene::append(const Scene& other, const glm::mat4& m) {
     materials.insert(materials.end(), other.materials.begin(), other.materials.end());
     // A mirroring transform flips the winding; keep normals consistent with the winding.
     bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;
-    positions.reserve(positions.size() + other.positions.size());
+    // Grow geometrically (at least doubling): appending many objects one by one stays linear.
+    if (positions.capacity() < positions.size() + other.positions.size()) {
+        const size_t want = std::max(positions.size() + other.positions.size(), 2 * positions.capacity());
+        positions.reserve(want);
+        normals.reserve(want / 3);
+        materialIds.reserve(want / 3);
+    }
     for (size_t t = 0; t < other.triangleCount(); ++t) {
         glm::vec3 v[3];
         for (int k = 0; k < 3; ++k) v[k] = glm::vec3(m * glm::vec4(other.positions[3 * t + k], 1.0f));

@@ -241,9 +241,6 @@ Scene buildScene(JsonNode sceneNode) {
             scene = std::move(s);
             continue;
         }
-        // Grow geometrically: Scene::append reserves exactly, which is quadratic over many objects.
-        size_t need = 3 * (scene.triangleCount() + s.triangleCount());
-        if (scene.positions.capacity() < need) scene.positions.reserve(std::max(need, 2 * scene.positions.capacity()));
         scene.append(s, glm::mat4(1.0f));
     }
     scene.updateBounds();
