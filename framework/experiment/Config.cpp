@@ -17,7 +17,7 @@ LightType lightTypeFromString(const std::string& s) {
 }
 
 void parseCamera(JsonNode node, ExperimentConfig& c) {
-    c.camera.fovYDeg = float(node.getFloat("fov_y_deg", 60.0, 1.0, 179.0));
+    c.camera.fovYDeg = float(node.getFloat("fov_y_deg", 60.0, configlimits::kFovMinDeg, configlimits::kFovMaxDeg));
     c.camera.nearPlane = float(node.getFloat("near", 0.05, 1e-6, 1e6));
     c.camera.farPlane = float(node.getFloat("far", 100.0, 1e-6, 1e9));
     if (c.camera.farPlane <= c.camera.nearPlane) node.fail("far", "must be greater than near");
@@ -32,11 +32,11 @@ void parseLight(JsonNode node, ExperimentConfig& c) {
     l.type = lightTypeFromString(node.getEnum("type", "point", kLightTypes));
     l.position = node.getVec3("position", {2, 4, 2});
     l.target = node.getVec3("target", {0, 0, 0});
-    if (l.type == LightType::Spot) l.coneDeg = float(node.getFloat("cone_deg", 45.0, 0.1, 89.0));
+    if (l.type == LightType::Spot) l.coneDeg = float(node.getFloat("cone_deg", 45.0, configlimits::kConeMinDeg, configlimits::kConeMaxDeg));
     if (l.type == LightType::Area) {
         l.size = node.getVec2("size", {1, 1});
         if (l.size.x <= 0 || l.size.y <= 0) node.fail("size", "both sides must be positive");
-        l.samples = node.getInt("samples", 16, 1, 1024);
+        l.samples = node.getInt("samples", 16, configlimits::kAreaSamplesMin, configlimits::kAreaSamplesMax);
         l.pattern = node.getEnum("pattern", "stratified", {"stratified", "grid", "random"});
         l.seed = uint32_t(node.getInt("seed", 1, 0, INT32_MAX));
     }

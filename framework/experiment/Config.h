@@ -48,6 +48,14 @@ struct ExperimentConfig {
     Light lightAt(int frame) const;
 };
 
+/// Limits of camera and light values, shared by the parser and the GUI's widgets (so whatever the
+/// widgets allow can be saved as a config).
+namespace configlimits {
+constexpr float kFovMinDeg = 1.0f, kFovMaxDeg = 179.0f;
+constexpr float kConeMinDeg = 0.1f, kConeMaxDeg = 89.0f;
+constexpr int kAreaSamplesMin = 1, kAreaSamplesMax = 1024;
+} // namespace configlimits
+
 /// Reads and validates a config file (and loads its scene unless `loadScene` is false).
 /// `overrides` are "dotted.path=VALUE" assignments applied before validation (applyOverride).
 ExperimentConfig loadConfig(const std::string& file, bool loadScene = true,

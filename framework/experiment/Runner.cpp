@@ -168,8 +168,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         glFinish();
         const CpuGBuffer& g = getCpuG();
         std::vector<uint8_t> lit = litMask(g, light);
-        std::vector<uint8_t> covered(size_t(res.x) * res.y);
-        for (size_t i = 0; i < covered.size(); ++i) covered[i] = g.covered(i);
+        std::vector<uint8_t> covered = coveredMask(g);
         bool saveImages = opt.writeOutputs &&
                           std::find(cfg.imagesAtFrames.begin(), cfg.imagesAtFrames.end(), frame) != cfg.imagesAtFrames.end();
         std::vector<float> reference;

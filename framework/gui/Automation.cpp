@@ -56,7 +56,7 @@ AutomationPlan planAutomation(const GuiOptions& opts, const ExperimentConfig& co
 void applyAutomation(GuiState& s, const GuiOptions& opts, const AutomationPlan& plan) {
     Viewer& v = *s.viewer;
     v.selectAlgorithm(plan.choice);
-    for (const auto& [key, value] : plan.sets) applyParamChange(v, key, value);
+    applyParamChanges(v, plan.sets); // one rebuild at most, whatever the number of --set
 
     if (opts.view == "visibility") s.views.mode = ViewMode::Visibility;
     if (opts.view == "heat") s.views.mode = ViewMode::Heat;

@@ -138,7 +138,7 @@ int runGui(const GuiOptions& opts) {
         auto now = Clock::now();
         s.lastFrameMs = std::chrono::duration<double, std::milli>(now - last).count();
         last = now;
-        s.measurements.record(v.lastStages(), v.lastAlgorithmWallMs(), s.lastFrameMs, v.algorithm());
+        s.measurements.record(v.lastStages(), v.lastAlgorithmWallMs(), s.lastFrameMs);
         GLuint image = s.views.update(v);
         // GL textures are bottom-up: flip v so the image is upright.
         ImGui::GetBackgroundDrawList()->AddImage(ImTextureID(intptr_t(image)), ImVec2(viewportMin.x, viewportMin.y),

@@ -18,8 +18,7 @@ float RollingSeries::mean() const {
 
 float RollingSeries::max() const { return values_.empty() ? 0.0f : *std::max_element(values_.begin(), values_.end()); }
 
-void Measurements::record(const std::vector<StageTime>& stages, double algorithmWallMs, double frameMs,
-                          const ShadowAlgorithm* algorithm) {
+void Measurements::record(const std::vector<StageTime>& stages, double algorithmWallMs, double frameMs) {
     double gpuSum = 0;
     for (const StageTime& s : stages) {
         auto it = std::find_if(stages_.begin(), stages_.end(), [&](const StageSeries& x) { return x.name == s.name; });
@@ -31,11 +30,6 @@ void Measurements::record(const std::vector<StageTime>& stages, double algorithm
     algorithmGpuMs_.push(float(gpuSum));
     algorithmWallMs_.push(float(algorithmWallMs));
     frameMs_.push(float(frameMs));
-    if (algorithm) {
-        counters_ = algorithm->counters();
-        memoryBytes_ = algorithm->memoryBytes();
-        overflow_ = algorithm->overflowCount();
-    }
 }
 
 void Measurements::clear() { *this = Measurements(); }

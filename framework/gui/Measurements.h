@@ -34,7 +34,9 @@ struct StageSeries {
 class Measurements {
 public:
     /// Records one rendered frame: the algorithm's stages, its wall time and the whole frame's time.
-    void record(const std::vector<StageTime>& stages, double algorithmWallMs, double frameMs, const ShadowAlgorithm* algorithm);
+    /// (Counters, memory and overflow are read from the algorithm by the panel, only while it is
+    /// open: reading them may download a buffer or, for line_space's classify, trace on the CPU.)
+    void record(const std::vector<StageTime>& stages, double algorithmWallMs, double frameMs);
     /// Forgets the series (after switching algorithm: its stages differ).
     void clear();
 
@@ -42,16 +44,10 @@ public:
     const RollingSeries& frameMs() const { return frameMs_; }
     const RollingSeries& algorithmGpuMs() const { return algorithmGpuMs_; }
     const RollingSeries& algorithmWallMs() const { return algorithmWallMs_; }
-    const std::vector<Counter>& counters() const { return counters_; }
-    size_t memoryBytes() const { return memoryBytes_; }
-    uint64_t overflow() const { return overflow_; }
 
 private:
     std::vector<StageSeries> stages_;
     RollingSeries frameMs_, algorithmGpuMs_, algorithmWallMs_;
-    std::vector<Counter> counters_;
-    size_t memoryBytes_ = 0;
-    uint64_t overflow_ = 0;
 };
 
 } // namespace shadowlab

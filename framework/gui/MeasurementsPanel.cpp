@@ -65,8 +65,12 @@ void drawMeasurementsPanel(GuiState& s) {
         plot("##stage", wall || cpuOnly ? st.cpuMs : st.gpuMs, (st.name + label).c_str());
         ImGui::PopID();
     }
-    if (!m.counters().empty() && ImGui::BeginTable("counters", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingStretchProp)) {
-        for (const Counter& c : m.counters()) {
+    // Read only while this panel is open (see Measurements::record()).
+    const ShadowAlgorithm* algorithm = v.algorithm();
+    if (!algorithm) return;
+    const std::vector<Counter> counters = algorithm->counters();
+    if (!counters.empty() && ImGui::BeginTable("counters", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_SizingStretchProp)) {
+        for (const Counter& c : counters) {
             ImGui::TableNextRow();
             ImGui::TableNextColumn();
             ImGui::TextUnformatted(c.name.c_str());
@@ -75,10 +79,10 @@ void drawMeasurementsPanel(GuiState& s) {
         }
         ImGui::EndTable();
     }
-    ImGui::Text("memory %s", formatBytes(m.memoryBytes()).c_str());
-    if (m.overflow() > 0) {
+    ImGui::Text("memory %s", formatBytes(algorithm->memoryBytes()).c_str());
+    if (const uint64_t overflow = algorithm->overflowCount(); overflow > 0) {
         ImGui::SameLine();
-        ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "overflow %llu: image not trustworthy", (unsigned long long)m.overflow());
+        ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "overflow %llu: image not trustworthy", (unsigned long long)overflow);
     }
 }
 

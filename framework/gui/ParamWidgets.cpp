@@ -137,8 +137,16 @@ void ParamWidgets::draw(Viewer& viewer) {
     }
     ImGui::PopID();
     if (ImGui::Button("Defaults")) {
+        // Only the keys that differ, in one change: at most one rebuild.
+        std::vector<std::pair<std::string, ParamValue>> changes;
         for (const ParamSpec& spec : schema.specs())
-            if (choice.params.get(spec.key) != spec.def) apply(viewer, spec.key, spec.def); // spare needless rebuilds
+            if (choice.params.get(spec.key) != spec.def) changes.emplace_back(spec.key, spec.def);
+        try {
+            applyParamChanges(viewer, changes);
+            error_.clear();
+        } catch (const InputError& e) {
+            error_ = e.what();
+        }
     }
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("Every parameter back to its schema default");
     if (!error_.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error_.c_str());

@@ -1,7 +1,7 @@
 #pragma once
 // Parameter widgets generated from an algorithm's ParamSchema: bool → checkbox, int/float → slider
 // over the schema's range (unit beside it, doc as tooltip), enum → combo. No parameter name, range
-// or default is written here; every change goes through applyParamChange().
+// or default is written here; every change goes through applyParamChanges().
 #include "framework/core/Params.h"
 
 #include <map>

@@ -12,11 +12,11 @@ namespace {
 
 constexpr LightType kLightTypes[] = {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area};
 
-// Camera and light limits mirror the checks of Config.cpp's parser, so anything set here can be
-// saved as a config; saveRecordedConfig() re-validates with parseConfig before writing anyway.
-constexpr float kFovMin = 1.0f, kFovMax = 179.0f;
-constexpr float kConeMin = 0.1f, kConeMax = 89.0f;
-constexpr int kSamplesMin = 1, kSamplesMax = 1024;
+// The parser's limits (Config.h), so anything set here can be saved as a config;
+// saveRecordedConfig() re-validates with parseConfig before writing anyway.
+constexpr float kFovMin = configlimits::kFovMinDeg, kFovMax = configlimits::kFovMaxDeg;
+constexpr float kConeMin = configlimits::kConeMinDeg, kConeMax = configlimits::kConeMaxDeg;
+constexpr int kSamplesMin = configlimits::kAreaSamplesMin, kSamplesMax = configlimits::kAreaSamplesMax;
 
 std::string choiceLabel(const AlgorithmChoice& c) {
     return c.label + (c.fromConfig ? "  (config)" : "  (defaults)");

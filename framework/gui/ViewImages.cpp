@@ -81,13 +81,9 @@ GLuint ViewImages::update(Viewer& viewer) {
     }
     const glm::ivec2 res = viewer.resolution();
     if (mode == ViewMode::Shaded || res.x <= 0) return viewer.shadedTexture();
-    std::vector<float> vis = readTextureR32F(viewer.visibilityTexture(), res.x, res.y);
-
     if (mode == ViewMode::Visibility) {
-        const CpuGBuffer& g = viewer.cpuGBuffer();
-        std::vector<uint8_t> covered(vis.size());
-        for (size_t i = 0; i < covered.size(); ++i) covered[i] = g.covered(i);
-        upload(visibilityImage(vis, covered), res);
+        upload(visibilityImage(readTextureR32F(viewer.visibilityTexture(), res.x, res.y), coveredMask(viewer.cpuGBuffer())),
+               res);
         return display_.id();
     }
     if (mode == ViewMode::Heat) {
@@ -109,6 +105,7 @@ GLuint ViewImages::update(Viewer& viewer) {
                                : "no reference yet: compute it (CPU ray tracing)";
         return viewer.shadedTexture();
     }
+    const std::vector<float> vis = readTextureR32F(viewer.visibilityTexture(), res.x, res.y);
     accuracy_ = compareVisibility(vis, refValues_, lit_);
     upload(differenceImage(vis, refValues_, lit_), res);
     return display_.id();

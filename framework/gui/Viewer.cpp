@@ -130,17 +130,25 @@ void Viewer::renderFrame() {
     ++renderedFrames_;
 }
 
-void applyParamChange(Viewer& viewer, const std::string& key, const ParamValue& value) {
+void applyParamChanges(Viewer& viewer, const std::vector<std::pair<std::string, ParamValue>>& changes) {
+    if (changes.empty()) return;
     AlgorithmChoice& choice = viewer.choices_[size_t(viewer.active_)];
-    const ParamSpec* spec = choice.info->schema().find(key);
     ParamValues next = choice.params;
-    next.set(key, value); // throws InputError on an unknown key or an invalid value; nothing changed yet
+    ParamChange change = ParamChange::Update;
+    for (const auto& [key, value] : changes) {
+        next.set(key, value); // throws InputError on an unknown key or an invalid value; nothing changed yet
+        if (choice.info->schema().find(key)->change == ParamChange::Rebuild) change = ParamChange::Rebuild;
+    }
     choice.params = next;
-    viewer.algorithm_->paramsChanged(choice.params, spec->change);
-    if (spec->change == ParamChange::Rebuild) {
+    viewer.algorithm_->paramsChanged(choice.params, change);
+    if (change == ParamChange::Rebuild) {
         viewer.algorithm_->setScene(*viewer.sceneGpu_);
         if (viewer.resolution_.x > 0) viewer.algorithm_->resize(viewer.resolution_);
     }
+}
+
+void applyParamChange(Viewer& viewer, const std::string& key, const ParamValue& value) {
+    applyParamChanges(viewer, {{key, value}});
 }
 
 } // namespace shadowlab

@@ -88,7 +88,7 @@ public:
     int renderedFrames() const { return renderedFrames_; }
 
 private:
-    friend void applyParamChange(Viewer& viewer, const std::string& key, const ParamValue& value);
+    friend void applyParamChanges(Viewer& viewer, const std::vector<std::pair<std::string, ParamValue>>& changes);
     void instantiate();
 
     ExperimentConfig config_;
@@ -109,9 +109,11 @@ private:
     int renderedFrames_ = 0;
 };
 
-/// The one way a parameter changes, shared by the widgets and the automation (--set): validates
-/// through ParamValues::set (InputError when unknown or out of range, leaving the old value),
-/// then paramsChanged(params, spec.change) and, for Rebuild, setScene() + resize() again.
+/// The one way parameters change, shared by the widgets and the automation (--set): validates
+/// every value through ParamValues::set (InputError when unknown or out of range, leaving all the
+/// old values), then one paramsChanged() and, if any key is a Rebuild one, one setScene() + resize().
+void applyParamChanges(Viewer& viewer, const std::vector<std::pair<std::string, ParamValue>>& changes);
+/// One parameter: applyParamChanges() with a single change.
 void applyParamChange(Viewer& viewer, const std::string& key, const ParamValue& value);
 
 } // namespace shadowlab

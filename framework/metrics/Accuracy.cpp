@@ -15,6 +15,12 @@ std::vector<uint8_t> litMask(const CpuGBuffer& g, const Light& light) {
     return mask;
 }
 
+std::vector<uint8_t> coveredMask(const CpuGBuffer& g) {
+    std::vector<uint8_t> mask(size_t(g.width) * g.height);
+    for (size_t i = 0; i < mask.size(); ++i) mask[i] = g.covered(i);
+    return mask;
+}
+
 Accuracy compareVisibility(const std::vector<float>& vis, const std::vector<float>& ref, const std::vector<uint8_t>& lit) {
     Accuracy a;
     size_t falseLit = 0, falseShadowed = 0;

@@ -11,6 +11,8 @@ namespace shadowlab {
 /// Pixels that receive direct light before occlusion: covered, facing the light (N·L > 0) and
 /// inside the light's reach (spot cone, front of an area light). Metrics are over these pixels.
 std::vector<uint8_t> litMask(const CpuGBuffer& g, const Light& light);
+/// 1 where the G-buffer pixel holds geometry (the visibility image's "no geometry" is the rest).
+std::vector<uint8_t> coveredMask(const CpuGBuffer& g);
 
 struct Accuracy {
     size_t litPixels = 0;
