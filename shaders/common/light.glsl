@@ -8,6 +8,8 @@ uniform vec3 uLightPosition;  // point, spot, area centre
 uniform vec3 uLightDirection; // unit, direction the light travels (spot, directional, area normal)
 uniform float uLightCosCone;  // spot: cos(half angle)
 
+bool lightIsDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
+
 // Unit vector from p towards the light.
 vec3 toLight(vec3 p) {
     return uLightType == LIGHT_DIRECTIONAL ? -uLightDirection : normalize(uLightPosition - p);

@@ -20,7 +20,7 @@ bool facesLight(MtCluster c) {
     float radius = 0.5 * length(c.b.xyz - c.a.xyz) + c.a.w;
     vec3 toL;
     float spread = 0.0;
-    if (mtDirectional()) {
+    if (lightIsDirectional()) {
         toL = -uLightDirection;
     } else {
         vec3 d = uLightPosition - centre;
@@ -49,7 +49,7 @@ void main() {
     // Front faces of closed meshes cast nothing the back faces do not (exact for closed meshes only).
     if (facesLight(c)) n.flags |= MT_NODE_CULLED;
 #endif
-    if (mtDirectional()) {
+    if (lightIsDirectional()) {
         n.a = vec4(mtToLightSpace(A), r);
         n.b = vec4(mtToLightSpace(B), 0.0);
         if (A == B) n.b.xyz = n.a.xyz; // exactly equal: the distances take the sphere path

@@ -72,8 +72,8 @@ struct Result {
 Result query(vec3 q) {
     Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
     // The shadow ray: to the light (t in (0, 1)), or towards it forever for a directional light.
-    vec3 dir = mtDirectional() ? -uLightDirection : uLightPosition - q;
-    float tMax = mtDirectional() ? kMtInf : 1.0;
+    vec3 dir = lightIsDirectional() ? -uLightDirection : uLightPosition - q;
+    float tMax = lightIsDirectional() ? kMtInf : 1.0;
     vec3 p = mtToLightSpace(q);
 #if MT_DEPTH_SKIP
     float depth = mtLightDepth(q);

@@ -46,16 +46,14 @@ uniform vec3 uLightU;   // directional light: orthonormal basis of the plane ort
 uniform vec3 uLightV;
 uniform vec3 uDepthOrigin; // directional light: depth is measured along its direction from here
 
-bool mtDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
-
 // Distance from the light along which shadow rays travel: an occluder of q is strictly nearer.
 float mtLightDepth(vec3 x) {
-    return mtDirectional() ? dot(x - uDepthOrigin, uLightDirection) : length(x - uLightPosition);
+    return lightIsDirectional() ? dot(x - uDepthOrigin, uLightDirection) : length(x - uLightPosition);
 }
 
 // World point -> light space.
 vec3 mtToLightSpace(vec3 x) {
-    if (mtDirectional()) return vec3(dot(x, uLightU), dot(x, uLightV), 0.0);
+    if (lightIsDirectional()) return vec3(dot(x, uLightU), dot(x, uLightV), 0.0);
     return normalize(x - uLightPosition);
 }
 
@@ -120,21 +118,21 @@ float mtSegSeg(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
 
 // Distance from a light-space point to an element's centre.
 float mtPointDist(vec3 p, vec3 a, vec3 b) {
-    if (a == b) return mtDirectional() ? length(p - a) : mtAngle(p, a);
-    return mtDirectional() ? mtPointSeg(p, a, b) : mtPointArc(p, a, b);
+    if (a == b) return lightIsDirectional() ? length(p - a) : mtAngle(p, a);
+    return lightIsDirectional() ? mtPointSeg(p, a, b) : mtPointArc(p, a, b);
 }
 
 // Smallest distance between two elements' centres.
 float mtMinDist(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
     if (a1 == b1) return mtPointDist(a1, a2, b2);
     if (a2 == b2) return mtPointDist(a2, a1, b1);
-    return mtDirectional() ? mtSegSeg(a1, b1, a2, b2) : mtArcArc(a1, b1, a2, b2);
+    return lightIsDirectional() ? mtSegSeg(a1, b1, a2, b2) : mtArcArc(a1, b1, a2, b2);
 }
 
 // Largest distance between two elements' centres: Euclidean, at a pair of ends (convexity);
 // angular, pi minus the smallest distance from the antipodal element.
 float mtMaxDist(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
-    if (mtDirectional())
+    if (lightIsDirectional())
         return max(max(length(a1 - a2), length(a1 - b2)), max(length(b1 - a2), length(b1 - b2)));
     return kMtPi - mtMinDist(-a1, -b1, a2, b2);
 }

@@ -2,6 +2,7 @@
 // shadow frustum, and the geometric predicates shared by the build and the query.
 // Needs common/scene.glsl and common/light.glsl included before it.
 #include "psv/layout.glsl"
+#include "common/shadow_volume.glsl"
 
 // 32 bytes (std430), mirrored by PsvNodeGpu in algorithms/psv/PsvGpuLayout.h.
 struct PsvNode {
@@ -23,8 +24,6 @@ layout(std430, binding = PSV_COUNTER_BINDING) coherent buffer PsvCounters { uint
 uniform uint uTriangleCount;
 uniform float uTolerance;   // world units: vertices this close to a plane count as touching it
 uniform vec3 uDepthOrigin;  // directional light: depth is measured along the light from here
-
-bool psvDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
 
 // ---- Insertion order: a keyed bijection on [0, n) ------------------------------------------------
 // A 4-round Feistel network on 2h bits (the smallest even width covering n) with cycle walking, so
@@ -71,31 +70,6 @@ struct PsvFrustum {
 #define PSV_CASTER_EDGE_ON 1
 #define PSV_CASTER_FACING 2
 
-// Lexicographic order of two points: makes an edge's plane independent of which triangle asks.
-bool psvLexLess(vec3 a, vec3 b) {
-    return a.x != b.x ? a.x < b.x : (a.y != b.y ? a.y < b.y : a.z < b.z);
-}
-
-// Plane through the light and edge a→b (a, b in the triangle's winding order). Both triangles that
-// share an edge evaluate the same expression on the same (lexicographically ordered) operands, so
-// their planes are bit-identical up to an exact negation: no crack along the edge can let light
-// through a closed mesh. cross(b - a, a - light) has the triangle on its negative side when the
-// light is on the negative side of the winding normal (flip = 1); swapping a and b negates it.
-vec4 psvShadowPlane(vec3 a, vec3 b, float flip) {
-    bool swapped = psvLexLess(b, a);
-    vec3 lo = swapped ? b : a, hi = swapped ? a : b;
-    // `precise`: no contraction into fma at one call site and not at another (this is inlined three
-    // times, and a shared edge can be (v0, v1) in one triangle and (v2, v0) in the other).
-    precise vec3 n = psvDirectional() ? cross(hi - lo, uLightDirection) : cross(hi - lo, lo - uLightPosition);
-    precise float len = length(n);
-    if (!(len > 0.0)) return vec4(0.0);
-    n /= len;
-    precise float w = psvDirectional() ? -dot(n, lo) : -dot(n, uLightPosition);
-    vec4 p = vec4(n, w);
-    // Negation is exact, so the two triangles of an edge still hold opposite copies of one plane.
-    return (swapped ? -flip : flip) > 0.0 ? p : -p;
-}
-
 PsvFrustum psvFrustum(vec3 v0, vec3 v1, vec3 v2) {
     PsvFrustum f;
     f.status = PSV_CASTER_OK;
@@ -103,7 +77,7 @@ PsvFrustum psvFrustum(vec3 v0, vec3 v1, vec3 v2) {
     float len = length(n);
     n = len > 0.0 ? n / len : vec3(0.0);
     // Signed distance of the light to the triangle's plane (directional: cosine to the light).
-    vec3 toLight = psvDirectional() ? -uLightDirection : uLightPosition - v0;
+    vec3 toLight = lightIsDirectional() ? -uLightDirection : uLightPosition - v0;
     float side = dot(n, toLight);
     // Light (almost) in the triangle's plane: the frustum is (nearly) empty, a sliver under 1e-6
     // rad wide, and the planes' orientation would rest on rounding.
@@ -112,9 +86,9 @@ PsvFrustum psvFrustum(vec3 v0, vec3 v1, vec3 v2) {
     if (side > 0.0) { f.status = PSV_CASTER_FACING; return f; }
 #endif
     float flip = side < 0.0 ? 1.0 : -1.0;
-    f.planes[0] = psvShadowPlane(v0, v1, flip);
-    f.planes[1] = psvShadowPlane(v1, v2, flip);
-    f.planes[2] = psvShadowPlane(v2, v0, flip);
+    f.planes[0] = svEdgePlane(v0, v1, flip);
+    f.planes[1] = svEdgePlane(v1, v2, flip);
+    f.planes[2] = svEdgePlane(v2, v0, flip);
     if (f.planes[0].xyz == vec3(0.0) || f.planes[1].xyz == vec3(0.0) || f.planes[2].xyz == vec3(0.0)) {
         f.status = PSV_CASTER_EDGE_ON;
         return f;
@@ -145,7 +119,7 @@ int psvClassify(vec4 plane, vec3 v0, vec3 v1, vec3 v2) {
 // Depth from the light: distance for a point light, distance along the light for a directional
 // one (measured from uDepthOrigin, behind the scene, so it is positive and its float bits order).
 float psvDepth(vec3 x) {
-    return psvDirectional() ? dot(x - uDepthOrigin, uLightDirection) : length(x - uLightPosition);
+    return lightIsDirectional() ? dot(x - uDepthOrigin, uLightDirection) : length(x - uLightPosition);
 }
 
 // Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
@@ -172,7 +146,7 @@ vec3 psvClosestPoint(vec3 p, vec3 a, vec3 b, vec3 c) {
 // Smallest depth of any point of the triangle, lowered by a relative margin so that rounding can
 // only make the depth skip more conservative.
 float psvTriangleMinDepth(vec3 v0, vec3 v1, vec3 v2) {
-    float d = psvDirectional() ? min(psvDepth(v0), min(psvDepth(v1), psvDepth(v2)))
+    float d = lightIsDirectional() ? min(psvDepth(v0), min(psvDepth(v1), psvDepth(v2)))
                                : length(psvClosestPoint(uLightPosition, v0, v1, v2) - uLightPosition);
     return max(0.0, d * (1.0 - 1e-5) - uTolerance);
 }
@@ -232,7 +206,7 @@ PsvWedgeTriangle psvWedgeTriangle(vec3 v0, vec3 v1, vec3 v2) {
 // direction, so the distance to the plane is constant along a shadow ray and the wedge is the
 // largest |distance| of the vertices (exact, the distance being linear over the triangle).
 float psvWedge(vec4 plane, PsvWedgeTriangle t) {
-    if (psvDirectional())
+    if (lightIsDirectional())
         return max(abs(psvSigned(plane, t.v0)), max(abs(psvSigned(plane, t.v1)), abs(psvSigned(plane, t.v2)))) + uTolerance;
     vec3 n = plane.xyz;
     float m = max(abs(dot(n, t.a)), max(abs(dot(n, t.b)), abs(dot(n, t.c))));
@@ -245,13 +219,13 @@ float psvWedge(vec4 plane, PsvWedgeTriangle t) {
 // node's value: |sin| of the angle to the plane is 1-Lipschitz on the sphere, so
 // |n·u| <= |n·a| + arc(a, u) for every point u of the triangle.
 float psvWedgeBound(vec4 plane, PsvWedgeTriangle t) {
-    if (psvDirectional()) return psvWedge(plane, t); // exact and cheap already
+    if (lightIsDirectional()) return psvWedge(plane, t); // exact and cheap already
     float m = max(abs(dot(plane.xyz, t.a)), max(abs(dot(plane.xyz, t.b)), abs(dot(plane.xyz, t.c))));
     return min(1.0, (m + t.arc) * (1.0 + 1e-5) + 2e-6);
 }
 
 // Whether a query point is inside a node's intersection wedge (same units as psvWedge).
 bool psvInWedge(float s, vec3 q, float wedge) {
-    float scale = psvDirectional() ? 1.0 : length(q - uLightPosition);
+    float scale = lightIsDirectional() ? 1.0 : length(q - uLightPosition);
     return abs(s) <= wedge * scale + uTolerance;
 }

@@ -30,8 +30,6 @@ uniform mat4 uView;
 uniform float uNear;
 uniform vec2 uTanHalf;
 
-bool ptsvDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
-
 // ---- Cluster keys ------------------------------------------------------------------------------
 // The loops run to the constant PTSV_MAX_KEY_BITS so the compiler can unroll them: llvmpipe counts
 // every iteration of a non-unrolled loop against its per-invocation cap (see traverse.comp).

@@ -6,39 +6,19 @@
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "ptsv/ptsv.glsl"
+#include "common/shadow_volume.glsl"
 layout(local_size_x = 64) in;
 
 uniform uint uTriangleCount;
 uniform uint uInvocationsPerRow; // 2D dispatch past 65535 groups
 uniform float uPlaneBias;        // world units the triangle plane moves away from the light
 
-// Lexicographic order of two points: makes an edge's plane independent of which triangle asks.
-bool ptsvLexLess(vec3 a, vec3 b) {
-    return a.x != b.x ? a.x < b.x : (a.y != b.y ? a.y < b.y : a.z < b.z);
-}
-
-// Plane through the light and edge a→b (winding order). Both triangles sharing an edge evaluate the
-// same expression on the same (lexicographically ordered) operands, so their planes are exact
-// negations of each other: no crack along a closed mesh's edge lets light through.
-vec4 ptsvEdgePlane(vec3 a, vec3 b, float flip) {
-    bool swapped = ptsvLexLess(b, a);
-    vec3 lo = swapped ? b : a, hi = swapped ? a : b;
-    // `precise`: no fma contraction at one inlined call site and not at another.
-    precise vec3 n = ptsvDirectional() ? cross(hi - lo, uLightDirection) : cross(hi - lo, lo - uLightPosition);
-    precise float len = length(n);
-    if (!(len > 0.0)) return vec4(0.0);
-    n /= len;
-    precise float w = ptsvDirectional() ? -dot(n, lo) : -dot(n, uLightPosition);
-    vec4 p = vec4(n, w);
-    return (swapped ? -flip : flip) > 0.0 ? p : -p;
-}
-
 // Additional culling plane at vertex v between edge planes a and b (both contain v and the light):
 // the half vector of their normals, made orthogonal to the direction towards the light, is the
 // normal of a plane through the light and v that has the whole wedge, hence the whole volume, on
 // its negative side. Unstable for slivers (normals nearly opposite): then a null plane, never culling.
 vec4 ptsvCullingPlane(vec4 a, vec4 b, vec3 v) {
-    vec3 toL = ptsvDirectional() ? -uLightDirection : uLightPosition - v;
+    vec3 toL = lightIsDirectional() ? -uLightDirection : uLightPosition - v;
     float tl = length(toL);
     vec3 h = a.xyz + b.xyz;
     if (!(tl > 0.0) || length(h) < 1e-3) return vec4(0.0);
@@ -58,7 +38,7 @@ void main() {
     vec3 n = cross(v1 - v0, v2 - v0);
     float len = length(n);
     n = len > 0.0 ? n / len : vec3(0.0);
-    vec3 toL = ptsvDirectional() ? -uLightDirection : uLightPosition - v0;
+    vec3 toL = lightIsDirectional() ? -uLightDirection : uLightPosition - v0;
     float side = dot(n, toL);
     uint status = PTSV_CASTER_OK;
     // Light (almost) in the triangle's plane: the volume is a sliver under 1e-6 rad wide, and the
@@ -70,9 +50,9 @@ void main() {
     vec4 e0 = vec4(0.0), e1 = vec4(0.0), e2 = vec4(0.0), cap = vec4(0.0);
     if (status == PTSV_CASTER_OK) {
         float flip = side < 0.0 ? 1.0 : -1.0;
-        e0 = ptsvEdgePlane(v0, v1, flip);
-        e1 = ptsvEdgePlane(v1, v2, flip);
-        e2 = ptsvEdgePlane(v2, v0, flip);
+        e0 = svEdgePlane(v0, v1, flip);
+        e1 = svEdgePlane(v1, v2, flip);
+        e2 = svEdgePlane(v2, v0, flip);
         if (e0.xyz == vec3(0.0) || e1.xyz == vec3(0.0) || e2.xyz == vec3(0.0)) status = PTSV_CASTER_EDGE_ON;
         vec3 nc = side > 0.0 ? n : -n; // the light side of the triangle plane is positive
         cap = vec4(nc, -dot(nc, v0));
