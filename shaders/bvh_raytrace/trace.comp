@@ -4,6 +4,7 @@
 // on the CPU, with a fixed stack and any-hit early exit. Visibility = fraction of unblocked samples.
 #include "common/light.glsl"
 #include "common/scene.glsl"
+#include "common/counters.glsl"
 #include "bvh_raytrace/layout.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -132,18 +133,9 @@ Trace trace(Ray r) {
     return res;
 }
 
-bool illuminated(vec3 p) {
-    if (uLightType == LIGHT_SPOT) return dot(normalize(p - uLightPosition), uLightDirection) > uLightCosCone;
-    if (uLightType == LIGHT_AREA) return dot(p - uLightPosition, uLightDirection) > 0.0;
-    return true;
-}
-
 shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels;
 
-void addWide(int lo, uint value) { // 64-bit counter split over words lo, lo + 1
-    uint old = atomicAdd(bvhCounters[lo], value);
-    if (old + value < old) atomicAdd(bvhCounters[lo + 1], 1u);
-}
+void addWide(int lo, uint value) COUNTER_ADD_WIDE(bvhCounters, lo, value)
 
 void main() {
     if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = 0u;
@@ -156,7 +148,7 @@ void main() {
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
-            if (illuminated(p) && dot(n, toLight(p)) > 0.0) {
+            if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
                 vec3 o = p + n * uRayOffset; // the same (unnormalised) normal as the reference
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
                 int count = directional ? 1 : uSampleCount;

@@ -10,6 +10,14 @@ uniform float uLightCosCone;  // spot: cos(half angle)
 
 bool lightIsDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
 
+// The light reaches p at all (GLSL twin of Light::illuminates): inside a spot's cone, in front of
+// an area light; point and directional lights reach everywhere.
+bool lightIlluminates(vec3 p) {
+    if (uLightType == LIGHT_SPOT) return dot(normalize(p - uLightPosition), uLightDirection) > uLightCosCone;
+    if (uLightType == LIGHT_AREA) return dot(p - uLightPosition, uLightDirection) > 0.0;
+    return true;
+}
+
 // Unit vector from p towards the light.
 vec3 toLight(vec3 p) {
     return uLightType == LIGHT_DIRECTIONAL ? -uLightDirection : normalize(uLightPosition - p);

@@ -11,6 +11,7 @@
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
 // LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans).
 #include "common/light.glsl"
+#include "common/counters.glsl"
 #include "line_space/layout.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -184,18 +185,9 @@ int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
 #define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
 #endif
 
-bool illuminated(vec3 p) {
-    if (uLightType == LIGHT_SPOT) return dot(normalize(p - uLightPosition), uLightDirection) > uLightCosCone;
-    if (uLightType == LIGHT_AREA) return dot(p - uLightPosition, uLightDirection) > 0.0;
-    return true;
-}
-
 shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow;
 
-void addWide(int lo, uint value) { // 64-bit counter split over words lo, lo + 1
-    uint old = atomicAdd(lsCounters[lo], value);
-    if (old + value < old) atomicAdd(lsCounters[lo + 1], 1u);
-}
+void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 
 void main() {
     if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = 0u;
@@ -215,7 +207,7 @@ void main() {
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
-            if (illuminated(p) && dot(n, toLight(p)) > 0.0) {
+            if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
                 vec3 o = p + n * uRayOffset;
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
                 int count = directional ? 1 : uSampleCount;

@@ -7,6 +7,7 @@
 // (MT_OVERLAP_INTERVAL). Writes 1 lit, 0 shadowed.
 #define MT_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
 #include "common/light.glsl"
+#include "common/counters.glsl"
 #include "metric_tree/tree.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -145,8 +146,7 @@ shared uint sVisited, sTriangles, sFruitless, sConeHits, sSlabRejects, sDepthSki
 
 void addWide(uint lo, uint value) {
     if (value == 0u) return;
-    uint old = atomicAdd(mtCounters[lo], value);
-    if (old + value < old) atomicAdd(mtCounters[lo + 1], 1u); // carry into the high word
+    COUNTER_ADD_WIDE(mtCounters, lo, value)
 }
 
 void main() {

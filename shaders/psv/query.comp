@@ -5,6 +5,7 @@
 #define PSV_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
 #include "common/light.glsl"
 #include "common/scene.glsl"
+#include "common/counters.glsl"
 #include "psv/tree.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -114,8 +115,7 @@ void main() {
     barrier();
     if (gl_LocalInvocationIndex == 0u && sTraversed != 0u) {
         atomicAdd(psvCounters[PSV_C_TRAVERSED], sTraversed);
-        uint old = atomicAdd(psvCounters[PSV_C_VISITED_LO], sVisited);
-        if (old + sVisited < old) atomicAdd(psvCounters[PSV_C_VISITED_HI], 1u); // carry
+        COUNTER_ADD_WIDE(psvCounters, PSV_C_VISITED_LO, sVisited)
         atomicMax(psvCounters[PSV_C_VISITED_MAX], sVisitedMax);
         if (sOverflow != 0u) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], sOverflow);
     }

@@ -25,6 +25,7 @@
 #endif
 #include "common/light.glsl"
 #include "common/scene.glsl"
+#include "common/counters.glsl"
 #include "ptsv/ptsv.glsl"
 layout(local_size_x = PTSV_LANES) in;
 #define lane gl_LocalInvocationIndex
@@ -254,14 +255,8 @@ void main() {
         finishJob(job);
     }
     // Totals (no barrier: one atomic per invocation that has something to add).
-    if (gTests != 0u) {
-        uint old = atomicAdd(ptsvCounters[PTSV_C_TESTS_LO], gTests);
-        if (old + gTests < old) atomicAdd(ptsvCounters[PTSV_C_TESTS_HI], 1u); // carry
-    }
-    if (gNodeTests != 0u) {
-        uint old = atomicAdd(ptsvCounters[PTSV_C_NODE_TESTS_LO], gNodeTests);
-        if (old + gNodeTests < old) atomicAdd(ptsvCounters[PTSV_C_NODE_TESTS_HI], 1u);
-    }
+    if (gTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_TESTS_LO, gTests)
+    if (gNodeTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_NODE_TESTS_LO, gNodeTests)
     if (gTruncated) atomicAdd(ptsvCounters[PTSV_C_TRUNCATED], 1u);
     if (lane == 0u) {
         if (gAccepted != 0u) atomicAdd(ptsvCounters[PTSV_C_ACCEPTED], gAccepted);
