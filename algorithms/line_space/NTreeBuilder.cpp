@@ -5,6 +5,7 @@
 
 #include "algorithms/line_space/ShaftFill.h"
 #include "framework/core/Error.h"
+#include "framework/core/Parallel.h"
 
 #include <algorithm>
 #include <atomic>
@@ -76,19 +77,6 @@ private:
     int n_;
     float margin_;
 };
-
-/// Runs job(i) for i in [0, count) on `threads` threads (dynamic scheduling: node costs vary a lot).
-template <class Job>
-void parallelFor(size_t count, int threads, Job job) {
-    std::atomic<size_t> next{0};
-    auto worker = [&] {
-        for (size_t i = next.fetch_add(1); i < count; i = next.fetch_add(1)) job(i);
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads && size_t(t) < count; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
-}
 
 } // namespace
 

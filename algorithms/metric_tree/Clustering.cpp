@@ -1,5 +1,7 @@
 #include "algorithms/metric_tree/Clustering.h"
 
+#include "framework/core/Parallel.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -49,7 +51,7 @@ Sphere sphereOf4(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d) {
     return best;
 }
 
-Sphere trivialSphere(const glm::dvec3* r, int nr) {
+Sphere trivialBall(const glm::dvec3* r, int nr) {
     switch (nr) {
     case 0: return {glm::dvec3(0.0), -1.0};
     case 1: return {r[0], 0.0};
@@ -57,14 +59,6 @@ Sphere trivialSphere(const glm::dvec3* r, int nr) {
     case 3: return sphereOf3(r[0], r[1], r[2]);
     default: return sphereOf4(r[0], r[1], r[2], r[3]);
     }
-}
-
-Sphere welzl(const std::vector<glm::dvec3>& p, size_t n, std::array<glm::dvec3, 4>& r, int nr) {
-    if (n == 0 || nr == 4) return trivialSphere(r.data(), nr);
-    Sphere s = welzl(p, n - 1, r, nr);
-    if (s.radius >= 0 && contains(s, p[n - 1])) return s;
-    r[nr] = p[n - 1];
-    return welzl(p, n - 1, r, nr + 1);
 }
 
 Circle circleOf2(glm::dvec2 a, glm::dvec2 b) { return {0.5 * (a + b), 0.5 * glm::length(b - a)}; }
@@ -85,19 +79,37 @@ Circle circleOf3(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) {
 
 bool contains(const Circle& s, glm::dvec2 p) { return glm::length(p - s.centre) <= s.radius * (1.0 + 1e-9) + 1e-12; }
 
-Circle welzl2(const std::vector<glm::dvec2>& p, size_t n, std::array<glm::dvec2, 3>& r, int nr) {
-    if (n == 0 || nr == 3) {
-        switch (nr) {
-        case 0: return {glm::dvec2(0.0), -1.0};
-        case 1: return {r[0], 0.0};
-        case 2: return circleOf2(r[0], r[1]);
-        default: return circleOf3(r[0], r[1], r[2]);
-        }
+Circle trivialBall(const glm::dvec2* r, int nr) {
+    switch (nr) {
+    case 0: return {glm::dvec2(0.0), -1.0};
+    case 1: return {r[0], 0.0};
+    case 2: return circleOf2(r[0], r[1]);
+    default: return circleOf3(r[0], r[1], r[2]);
     }
-    Circle s = welzl2(p, n - 1, r, nr);
+}
+
+/// Welzl's recursion in any dimension: `K` support points at most (4 in 3D, 3 in 2D).
+template <class Ball, class Vec, size_t K>
+Ball welzl(const std::vector<Vec>& p, size_t n, std::array<Vec, K>& r, int nr) {
+    if (n == 0 || nr == int(K)) return trivialBall(r.data(), nr);
+    Ball s = welzl<Ball>(p, n - 1, r, nr);
     if (s.radius >= 0 && contains(s, p[n - 1])) return s;
-    r[nr] = p[n - 1];
-    return welzl2(p, n - 1, r, nr + 1);
+    r[size_t(nr)] = p[n - 1];
+    return welzl<Ball>(p, n - 1, r, nr + 1);
+}
+
+/// Smallest ball around `points`; the radius is then raised to the largest distance measured.
+template <class Ball, class Vec, size_t K>
+Ball smallestEnclosingBall(std::vector<Vec> points) {
+    if (points.empty()) return {};
+    std::mt19937 rng(12345);
+    std::shuffle(points.begin(), points.end(), rng); // Welzl's expected linear time needs a random order
+    std::array<Vec, K> support{};
+    Ball s = welzl<Ball>(points, points.size(), support, 0);
+    double r = 0;
+    for (const Vec& p : points) r = std::max(r, glm::length(p - s.centre));
+    s.radius = r;
+    return s;
 }
 
 // ---- Covariance OBB axes: Jacobi eigenvectors of a symmetric 3x3 matrix ----
@@ -283,27 +295,11 @@ ClusterGpu makeCluster(const Scene& scene, const std::vector<uint32_t>& tris, bo
 } // namespace
 
 Sphere smallestEnclosingSphere(std::vector<glm::dvec3> points) {
-    if (points.empty()) return {};
-    std::mt19937 rng(12345);
-    std::shuffle(points.begin(), points.end(), rng); // Welzl's expected linear time needs a random order
-    std::array<glm::dvec3, 4> support{};
-    Sphere s = welzl(points, points.size(), support, 0);
-    double r = 0;
-    for (const glm::dvec3& p : points) r = std::max(r, glm::length(p - s.centre));
-    s.radius = r;
-    return s;
+    return smallestEnclosingBall<Sphere, glm::dvec3, 4>(std::move(points));
 }
 
 Circle smallestEnclosingCircle(std::vector<glm::dvec2> points) {
-    if (points.empty()) return {};
-    std::mt19937 rng(12345);
-    std::shuffle(points.begin(), points.end(), rng);
-    std::array<glm::dvec2, 3> support{};
-    Circle s = welzl2(points, points.size(), support, 0);
-    double r = 0;
-    for (const glm::dvec2& p : points) r = std::max(r, glm::length(p - s.centre));
-    s.radius = r;
-    return s;
+    return smallestEnclosingBall<Circle, glm::dvec2, 3>(std::move(points));
 }
 
 BoundingVolume boundingVolume(const std::vector<glm::dvec3>& vertices, bool capsules) {
@@ -389,19 +385,13 @@ Clustering clusterScene(const Scene& scene, const ClusteringOptions& options) {
     const size_t chunk = size_t(std::max(1, options.chunkTriangles));
     const size_t chunks = (n + chunk - 1) / chunk;
     std::vector<std::vector<std::vector<uint32_t>>> parts(chunks);
-    const unsigned threads = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-    auto work = [&](unsigned id) {
-        for (size_t c = id; c < chunks; c += threads) {
-            std::vector<uint32_t> ids;
-            for (size_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i) ids.push_back(keyed[i].second);
-            std::mt19937 rng(uint32_t(c * 2654435761u) ^ options.seed);
-            splitRecursive(elems, std::move(ids), size_t(options.clusterSize), options.kmeansIterations, rng, parts[c]);
-        }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned id = 1; id < threads; ++id) pool.emplace_back(work, id);
-    work(0);
-    for (auto& th : pool) th.join();
+    const int threads = int(std::max(1u, std::min(4u, std::thread::hardware_concurrency())));
+    parallelFor(chunks, threads, [&](size_t c) {
+        std::vector<uint32_t> ids;
+        for (size_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i) ids.push_back(keyed[i].second);
+        std::mt19937 rng(uint32_t(c * 2654435761u) ^ options.seed);
+        splitRecursive(elems, std::move(ids), size_t(options.clusterSize), options.kmeansIterations, rng, parts[c]);
+    });
 
     std::vector<std::vector<uint32_t>> all;
     for (auto& chunk : parts)
@@ -413,16 +403,10 @@ Clustering clusterScene(const Scene& scene, const ClusteringOptions& options) {
         at += all[i].size();
         for (uint32_t t : all[i]) result.order.push_back(t);
     }
-    auto build = [&](unsigned id) {
-        for (size_t i = id; i < all.size(); i += threads) {
-            result.clusters[i] = makeCluster(scene, all[i], options.capsules);
-            result.clusters[i].first = first[i];
-        }
-    };
-    pool.clear();
-    for (unsigned id = 1; id < threads; ++id) pool.emplace_back(build, id);
-    build(0);
-    for (auto& th : pool) th.join();
+    parallelFor(all.size(), threads, [&](size_t i) {
+        result.clusters[i] = makeCluster(scene, all[i], options.capsules);
+        result.clusters[i].first = first[i];
+    });
     for (const ClusterGpu& c : result.clusters) result.capsules += (c.flags & MT_FLAG_CAPSULE) != 0;
     // The cluster order is the insertion order, hence the order pivots are taken in. Morton order
     // would make neighbours pivots of one another all the way down; shuffled, the first pivots are
