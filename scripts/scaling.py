@@ -11,7 +11,10 @@ A config holds one scene, so a scaling study is a list of configs that differ in
   scaling.png    log-log plot of each stage's mean time against n, one panel per stage
 
 Usage: scaling.py --out DIR [--binary build/shadowlab] [--reuse] [--stages build,traverse,total]
-                  [--counters nodes_visited_mean] CONFIG...
+                  [--counters nodes_visited_mean] [--ratio psv/metric_tree] CONFIG...
+
+--ratio A/B adds, per scene, the total frame time of id A over that of id B in the same run (the
+metric-tree paper's "who wins at which size" comparison).
 """
 import argparse
 import csv
@@ -64,6 +67,7 @@ def main():
     ap.add_argument("--reuse", action="store_true", help="keep runs whose summary.json exists")
     ap.add_argument("--stages", default="", help="comma-separated stages to tabulate (default: all)")
     ap.add_argument("--counters", default="", help="comma-separated counters to tabulate (mean)")
+    ap.add_argument("--ratio", action="append", default=[], help="A/B: total time of id A over id B, per scene")
     ap.add_argument("configs", nargs="+")
     a = ap.parse_args()
 
@@ -125,6 +129,15 @@ def main():
             if fit:
                 ratios = nlogn_ratio([p[0] for p in pts], [p[1] for p in pts])
                 lines.append(f"| {aid} | {st} | {fit[0]:.2f} | " + ", ".join(f"{x:.2f}" for x in ratios) + " |")
+    for ratio in a.ratio:
+        num, _, den = ratio.partition("/")
+        lines += ["", f"## {num} / {den}: total time per frame, same run", "", "| scene | triangles | ratio |",
+                  "|---|---:|---:|"]
+        for scene in dict.fromkeys(r["scene"] for r in rows):
+            t = {r["id"]: r for r in rows if r["scene"] == scene}
+            if num in t and den in t and t[den]["times"].get("total"):
+                lines.append(f"| {scene} | {t[num]['triangles']:,} | "
+                             f"{t[num]['times']['total'] / t[den]['times']['total']:.2f} |")
     with open(os.path.join(a.out, "scaling.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))
