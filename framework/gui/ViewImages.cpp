@@ -8,10 +8,7 @@
 namespace shadowlab {
 
 ViewImages::FrameKey ViewImages::keyOf(const Viewer& v) {
-    const Camera& c = v.camera;
-    const Light& l = v.light;
-    return {c.position, c.target, l.position, l.target, l.size, c.fovYDeg, c.nearPlane, c.farPlane, l.coneDeg,
-            int(l.type), l.samples, l.seed, l.pattern, v.resolution()};
+    return {v.camera, v.light, v.resolution()};
 }
 
 bool ViewImages::referenceStale(const Viewer& viewer) const { return !hasReference() || !(refKey_ == keyOf(viewer)); }

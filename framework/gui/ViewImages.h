@@ -51,14 +51,11 @@ public:
     const std::string& note() const { return note_; }
 
 private:
+    /// What the reference was traced for: any field of the camera or light, or the resolution.
     struct FrameKey {
-        glm::vec3 cameraPosition, cameraTarget, lightPosition, lightTarget;
-        glm::vec2 lightSize;
-        float fov, nearPlane, farPlane, cone;
-        int lightType, samples;
-        uint32_t seed;
-        std::string pattern;
-        glm::ivec2 resolution;
+        Camera camera;
+        Light light;
+        glm::ivec2 resolution{0, 0};
         bool operator==(const FrameKey&) const = default;
     };
     static FrameKey keyOf(const Viewer& viewer);

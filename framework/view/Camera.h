@@ -13,6 +13,8 @@ struct Camera {
     float nearPlane = 0.05f; ///< world units
     float farPlane = 100.0f; ///< world units
 
+    bool operator==(const Camera&) const = default;
+
     glm::mat4 view() const {
         glm::vec3 dir = glm::normalize(target - position);
         // Looking straight up or down makes `up` degenerate; pick another reference axis.

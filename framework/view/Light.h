@@ -23,6 +23,8 @@ struct Light {
     std::string pattern = "stratified"; ///< area: sample pattern (stratified | grid | random)
     uint32_t seed = 1;            ///< area: seed of the jittered patterns
 
+    bool operator==(const Light&) const = default;
+
     /// Unit direction in which the light travels (position → target).
     glm::vec3 direction() const { return glm::normalize(target - position); }
     /// Orthonormal frame of the area light: (u along width, v along height, n facing target).
