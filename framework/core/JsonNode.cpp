@@ -29,6 +29,11 @@ JsonNode::JsonNode(std::string file, const Json* value, std::string path, Json* 
     if (resolved_ && !resolved_->is_object()) *resolved_ = Json::object();
 }
 
+Json parseJsonOrString(const std::string& text) {
+    Json value = Json::parse(text, nullptr, false);
+    return value.is_discarded() ? Json(text) : value;
+}
+
 Json JsonNode::parseFile(const std::string& file) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, "", "cannot open file");

@@ -19,6 +19,10 @@ namespace shadowlab {
 
 using Json = nlohmann::json;
 
+/// A command-line value ("[64,64]", "3", "true", "\"x\"", or bare text): JSON when it parses as
+/// JSON, else the text as a JSON string. Shared by every --set, so they all accept the same input.
+Json parseJsonOrString(const std::string& text);
+
 class JsonNode {
 public:
     /// `file` names the source in errors and anchors relative paths; `resolved` receives the values used.

@@ -112,10 +112,12 @@ int ParamValues::getInt(const std::string& key) const { return std::get<int>(get
 double ParamValues::getFloat(const std::string& key) const { return std::get<double>(get(key)); }
 const std::string& ParamValues::getEnum(const std::string& key) const { return std::get<std::string>(get(key)); }
 
-void ParamValues::set(const std::string& key, const ParamValue& value) {
+void ParamValues::set(const std::string& key, const ParamValue& value) { setJson(key, valueToJson(value)); }
+
+void ParamValues::setJson(const std::string& key, const Json& value) {
     const ParamSpec& s = spec(key);
     // Validate through the same path as a config file, so the UI and configs agree on what is legal.
-    Json obj = {{key, valueToJson(value)}};
+    Json obj = {{key, value}};
     Json resolved;
     JsonNode node("<parameter>", &obj, "", &resolved);
     ParamValue v;

@@ -64,6 +64,8 @@ public:
 
     /// Sets one value; throws InputError when the key is unknown or the value invalid for its spec.
     void set(const std::string& key, const ParamValue& value);
+    /// The same from a JSON value, validated exactly as in a config file (type, range, choices).
+    void setJson(const std::string& key, const Json& value);
     const ParamValue& get(const std::string& key) const;
 
     Json toJson() const;

@@ -148,8 +148,7 @@ void applyOverride(Json& config, const std::string& assignment) {
     if (eq == std::string::npos || eq == 0)
         throw InputError("--set", assignment, "expected PATH=VALUE, e.g. resolution=[64,64] or algorithms.0.params.pcf=0");
     const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
-    Json value = Json::parse(text, nullptr, false);
-    if (value.is_discarded()) value = text; // not JSON: a plain string (e.g. light.type=directional)
+    const Json value = parseJsonOrString(text); // e.g. resolution=[64,64], light.type=directional
     Json* node = &config;
     std::string walked;
     size_t start = 0;

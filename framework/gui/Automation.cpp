@@ -39,13 +39,13 @@ AutomationPlan planAutomation(const GuiOptions& opts, const ExperimentConfig& co
             for (const auto& sp : choice.info->schema().specs()) keys.push_back(sp.key);
             throw InputError("--set", key, "unknown parameter of " + choice.info->name + "; accepted: " + joined(keys));
         }
-        ParamValue value = parseParamText(*spec, text);
         try {
-            trial.set(key, value); // the range check of configs and widgets, on a copy
+            // Read like shadowlab's --set (JSON, else a string) and checked like a config, on a copy.
+            trial.setJson(key, parseJsonOrString(text));
         } catch (const InputError& e) {
             throw InputError("--set", key, e.cause());
         }
-        plan.sets.push_back({key, value});
+        plan.sets.push_back({key, trial.get(key)});
     }
     if (opts.startFrame >= config.frames)
         throw InputError("--frame", "", "frame " + std::to_string(opts.startFrame) + " is outside [0, " +

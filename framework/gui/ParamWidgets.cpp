@@ -44,31 +44,6 @@ std::string sliderFormat(const ParamSpec& spec, const char* number) {
 
 } // namespace
 
-ParamValue parseParamText(const ParamSpec& spec, const std::string& text) {
-    auto bad = [&](const char* what) -> InputError {
-        return InputError("--set", spec.key, "expected " + std::string(what) + ", got \"" + text + "\"");
-    };
-    char* end = nullptr;
-    switch (spec.type) {
-    case ParamType::Bool:
-        if (text == "true" || text == "1") return true;
-        if (text == "false" || text == "0") return false;
-        throw bad("true or false");
-    case ParamType::Int: {
-        long v = std::strtol(text.c_str(), &end, 10);
-        if (text.empty() || *end || v < INT32_MIN || v > INT32_MAX) throw bad("an integer");
-        return int(v);
-    }
-    case ParamType::Float: {
-        double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || *end || !std::isfinite(v)) throw bad("a number");
-        return v;
-    }
-    case ParamType::Enum: return text; // ParamValues::set lists the accepted choices
-    }
-    throw bad("a value");
-}
-
 void ParamWidgets::apply(Viewer& viewer, const std::string& key, const ParamValue& value) {
     try {
         applyParamChange(viewer, key, value);

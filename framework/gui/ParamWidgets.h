@@ -11,10 +11,6 @@ namespace shadowlab {
 
 class Viewer;
 
-/// Parses `text` as a value of `spec`'s type ("true"/"false", integers, numbers, enum choices);
-/// the range is checked later by ParamValues::set. Throws InputError naming the key.
-ParamValue parseParamText(const ParamSpec& spec, const std::string& text);
-
 class ParamWidgets {
 public:
     /// Draws one widget per parameter of the active algorithm and applies the edits.
