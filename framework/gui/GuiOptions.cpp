@@ -16,7 +16,7 @@ Usage:
 
 Automation (tests, docs; each acts through the same code as the widgets):
   --algorithm ID            start with this config entry id or registered algorithm
-  --set KEY=VALUE           set a parameter of that algorithm (repeatable)
+  --set KEY=VALUE           set a parameter of that algorithm (repeatable); VALUE as JSON or a bare string, as in shadowlab run
   --view MODE               shaded | visibility | heat | difference
   --reference               trace the CPU reference after the first frame (for the difference view)
   --play                    play the fly-through;  --frame N  start at frame N
