@@ -4,6 +4,7 @@
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "algorithms/line_space/NTree.h"
 #include "algorithms/line_space/SampleClassifier.h"
+#include "framework/core/DiskCache.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
@@ -208,23 +209,13 @@ private:
 
     /// The tree from the disk cache when allowed and valid, else built (and cached).
     ls::NTree obtainTree(const Scene& scene, int n, int d, size_t blockLimit) {
-        cacheHit_ = false;
         const std::string dir = params_.getBool("cache") ? ls::cacheDirectory() : std::string();
-        std::string path, why;
-        const uint64_t hash = scene.contentHash();
-        if (!dir.empty()) {
-            path = ls::cacheFile(dir, hash, n, d);
-            if (std::optional<ls::NTree> t = ls::loadCache(path, hash, n, d, &why)) {
-                cacheHit_ = true;
-                return std::move(*t);
-            }
-            if (why.rfind("no cache file", 0) != 0)
-                std::fprintf(stderr, "line_space: ignoring cache file %s (%s); rebuilding\n", path.c_str(), why.c_str());
-        }
-        ls::NTree t = ls::buildNTree(scene, n, d, 0, blockLimit);
-        if (!dir.empty() && !ls::saveCache(path, hash, t, &why))
-            std::fprintf(stderr, "line_space: cannot write the cache (%s); continuing without it\n", why.c_str());
-        return t;
+        const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
+        const std::string path = dir.empty() ? std::string() : ls::cacheFile(dir, hash, n, d);
+        return diskcache::loadOrBuild(
+            "line_space", path, [&](std::string* why) { return ls::loadCache(path, hash, n, d, why); },
+            [&] { return ls::buildNTree(scene, n, d, 0, blockLimit); },
+            [&](const ls::NTree& t, std::string* why) { return ls::saveCache(path, hash, t, why); }, &cacheHit_);
     }
 
     const ls::SampleClasses& classify() const {

@@ -6,6 +6,7 @@
 #include "algorithms/metric_tree/CpuTree.h"
 #include "algorithms/metric_tree/MetricTreeGpuLayout.h"
 #include "algorithms/metric_tree/MetricTreeMath.h"
+#include "framework/core/DiskCache.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
@@ -220,23 +221,15 @@ private:
         o.capsules = params_.getBool("capsules");
         o.randomOrder = params_.getBool("random_order");
         o.seed = uint32_t(params_.getInt("seed"));
-        cacheHit_ = false;
         const std::string dir = params_.getBool("cache") ? mt::cacheDirectory() : std::string();
-        std::string path, why;
         const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
-        if (!dir.empty()) {
-            path = mt::cacheFile(dir, hash, o);
-            if (std::optional<mt::Clustering> c = mt::loadCache(path, hash, o, scene.triangleCount(), &why)) {
-                cacheHit_ = true;
-                clusteringMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-                return std::move(*c);
-            }
-            if (why.rfind("no cache file", 0) != 0)
-                std::fprintf(stderr, "metric_tree: ignoring cache file %s (%s); reclustering\n", path.c_str(), why.c_str());
-        }
-        mt::Clustering c = mt::clusterScene(scene, o);
-        if (!dir.empty() && !mt::saveCache(path, hash, o, scene.triangleCount(), c, &why))
-            std::fprintf(stderr, "metric_tree: cannot write the cache (%s); continuing without it\n", why.c_str());
+        const std::string path = dir.empty() ? std::string() : mt::cacheFile(dir, hash, o);
+        const size_t n = scene.triangleCount();
+        mt::Clustering c = diskcache::loadOrBuild(
+            "metric_tree", path, [&](std::string* why) { return mt::loadCache(path, hash, o, n, why); },
+            [&] { return mt::clusterScene(scene, o); },
+            [&](const mt::Clustering& value, std::string* why) { return mt::saveCache(path, hash, o, n, value, why); },
+            &cacheHit_);
         clusteringMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         return c;
     }

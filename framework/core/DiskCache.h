@@ -4,7 +4,10 @@
 // never sees half of it. Each cache keeps its own header and validation.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <filesystem>
 #include <initializer_list>
+#include <optional>
 #include <string>
 
 namespace shadowlab::diskcache {
@@ -25,5 +28,26 @@ struct Part {
 /// a reader never sees half a file, and two processes writing the same key each replace it whole.
 /// Creates the folder. On failure returns false with the reason in `why` and leaves no temporary.
 bool writeAtomically(const std::string& path, std::initializer_list<Part> parts, std::string* why);
+
+/// The value cached at `path` when `load(&why)` accepts it, else `build()`'s, then written back with
+/// `save(value, &why)`. `path` "" means no cache. A missing file is the normal first run (silent); a
+/// file that fails validation is reported on stderr and replaced; a failed write is reported and
+/// ignored. `hit` tells which happened.
+template <class Load, class Build, class Save>
+auto loadOrBuild(const char* owner, const std::string& path, Load load, Build build, Save save, bool* hit) {
+    std::string why;
+    if (!path.empty() && std::filesystem::exists(path)) {
+        if (auto cached = load(&why)) {
+            if (hit) *hit = true;
+            return std::move(*cached);
+        }
+        std::fprintf(stderr, "%s: ignoring cache file %s (%s); recomputing\n", owner, path.c_str(), why.c_str());
+    }
+    if (hit) *hit = false;
+    auto value = build();
+    if (!path.empty() && !save(value, &why))
+        std::fprintf(stderr, "%s: cannot write the cache (%s); continuing without it\n", owner, why.c_str());
+    return value;
+}
 
 } // namespace shadowlab::diskcache
