@@ -175,17 +175,13 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
 
         for (auto& inst : instances) {
             progress.step(inst.entry->id + " frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
-            glFinish();
-            auto t = Clock::now();
-            inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, frame, inst.visibility.id(), timer});
-            glFinish();
-            double wall = msSince(t);
+            TimedWork timed = timeWork(timer, [&] {
+                inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, frame, inst.visibility.id(), timer});
+            });
             FrameRecord rec;
             rec.frame = frame;
-            rec.stages = timer.collect();
-            double gpuSum = 0;
-            for (const auto& s : rec.stages) gpuSum += std::max(0.0, s.gpuMs);
-            rec.stages.push_back({"total", gpuSum, wall});
+            rec.stages = std::move(timed.stages);
+            rec.stages.push_back({"total", sumGpuMs(rec.stages), timed.wallMs});
             for (const auto& c : inst.algorithm->counters()) rec.counters[c.name] = c.value;
             rec.overflow = inst.algorithm->overflowCount();
             inst.results.memoryBytes = std::max(inst.results.memoryBytes, inst.algorithm->memoryBytes());

@@ -2,12 +2,31 @@
 
 #include "framework/core/Error.h"
 
+#include <algorithm>
+
 namespace shadowlab {
 
 bool isSoftwareRenderer(const std::string& renderer) {
     for (const char* name : {"llvmpipe", "softpipe", "swrast", "SwiftShader"})
         if (renderer.find(name) != std::string::npos) return true;
     return false;
+}
+
+double sumGpuMs(const std::vector<StageTime>& stages) {
+    double sum = 0;
+    for (const StageTime& s : stages) sum += std::max(0.0, s.gpuMs);
+    return sum;
+}
+
+TimedWork timeWork(StageTimer& timer, const std::function<void()>& work) {
+    TimedWork out;
+    glFinish();
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    glFinish();
+    out.wallMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    out.stages = timer.collect();
+    return out;
 }
 
 StageTimer::StageTimer() = default;

@@ -4,6 +4,7 @@
 #include "framework/gl/GlObjects.h"
 
 #include <chrono>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -45,5 +46,16 @@ private:
     bool synchronous_ = false;
     std::chrono::steady_clock::time_point start_;
 };
+
+/// Sum of the stages' GPU times (CPU-only stages, gpuMs < 0, add nothing).
+double sumGpuMs(const std::vector<StageTime>& stages);
+
+struct TimedWork {
+    std::vector<StageTime> stages; ///< what `work` timed through the timer
+    double wallMs = 0;             ///< wall time of `work`, the GL finished on both sides
+};
+/// Runs `work` (an algorithm's frame) bracketed by glFinish, so the wall time is its own, and
+/// collects the stages it timed. The runner and the GUI measure frames this one way.
+TimedWork timeWork(StageTimer& timer, const std::function<void()>& work);
 
 } // namespace shadowlab

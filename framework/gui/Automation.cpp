@@ -78,11 +78,8 @@ void applyAutomation(GuiState& s, const GuiOptions& opts, const AutomationPlan& 
 
 void FrameReport::add(const Viewer& v) {
     Json stages = Json::object();
-    double gpu = 0;
-    for (const StageTime& st : v.lastStages()) {
-        stages[st.name] = {{"gpu_ms", st.gpuMs}, {"cpu_ms", st.cpuMs}};
-        gpu += std::max(0.0, st.gpuMs);
-    }
+    for (const StageTime& st : v.lastStages()) stages[st.name] = {{"gpu_ms", st.gpuMs}, {"cpu_ms", st.cpuMs}};
+    const double gpu = sumGpuMs(v.lastStages());
     frames_.push_back({{"path_frame", v.playback.frame},
                        {"camera", {{"position", vec(v.camera.position)}, {"target", vec(v.camera.target)}}},
                        {"light", {{"position", vec(v.light.position)}, {"target", vec(v.light.target)}}},

@@ -19,15 +19,13 @@ float RollingSeries::mean() const {
 float RollingSeries::max() const { return values_.empty() ? 0.0f : *std::max_element(values_.begin(), values_.end()); }
 
 void Measurements::record(const std::vector<StageTime>& stages, double algorithmWallMs, double frameMs) {
-    double gpuSum = 0;
     for (const StageTime& s : stages) {
         auto it = std::find_if(stages_.begin(), stages_.end(), [&](const StageSeries& x) { return x.name == s.name; });
         if (it == stages_.end()) it = stages_.insert(stages_.end(), StageSeries{s.name, {}, {}});
         it->gpuMs.push(float(std::max(0.0, s.gpuMs)));
         it->cpuMs.push(float(s.cpuMs));
-        gpuSum += std::max(0.0, s.gpuMs); // CPU-only stages report -1: they add nothing, as in the runner's total
     }
-    algorithmGpuMs_.push(float(gpuSum));
+    algorithmGpuMs_.push(float(sumGpuMs(stages))); // as in the runner's total
     algorithmWallMs_.push(float(algorithmWallMs));
     frameMs_.push(float(frameMs));
 }

@@ -113,13 +113,10 @@ void Viewer::renderFrame() {
     cpuG_.reset();
     lastStages_.clear();
     if (unsupportedReason().empty()) {
-        // Same bracketing as the runner: glFinish on both sides so the wall time is the algorithm's.
-        glFinish();
-        auto t = std::chrono::steady_clock::now();
-        runOn(*algorithm_, visibility_.id(), timer_);
-        glFinish();
-        lastWallMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-        lastStages_ = timer_.collect();
+        // Measured as the runner measures a frame (timeWork).
+        TimedWork timed = timeWork(timer_, [&] { runOn(*algorithm_, visibility_.id(), timer_); });
+        lastWallMs_ = timed.wallMs;
+        lastStages_ = std::move(timed.stages);
     } else {
         // Shown unshadowed rather than with stale visibility; the panel says why.
         const float one = 1.0f;
