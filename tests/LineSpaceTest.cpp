@@ -7,6 +7,7 @@
 #include "framework/core/Error.h"
 #include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
+#include "tests/ShadowTestScenes.h"
 #include "tests/TestSupport.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -25,7 +26,7 @@ namespace {
 
 using ls::DBox;
 
-glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
+using test::translate;
 
 /// A small scene of closed objects on a plane (≈ 1,700 triangles).
 Scene smallScene() {

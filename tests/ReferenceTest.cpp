@@ -3,6 +3,7 @@
 // No GL: the tracer is GL-free, and the algorithm entry is only inspected, never run.
 #include "algorithms/reference/EmbreeTracer.h"
 #include "algorithms/reference/Reference.h"
+#include "tests/ShadowTestScenes.h"
 
 #include <gtest/gtest.h>
 
@@ -62,12 +63,7 @@ CpuGBuffer groundGrid(int n, float half, glm::vec3 normal = {0, 1, 0}, int holeE
     return g;
 }
 
-Light pointLight(glm::vec3 pos) {
-    Light l;
-    l.type = LightType::Point;
-    l.position = pos;
-    return l;
-}
+using test::pointLight;
 
 Light directionalLight(glm::vec3 dir) {
     Light l;
