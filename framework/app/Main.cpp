@@ -1,6 +1,7 @@
 // shadowlab: the headless command line. One binary per GL back end (OSMesa, EGL) links this file.
 #include "algorithms/ShadowAlgorithm.h"
 #include "framework/core/Error.h"
+#include "framework/core/Interrupt.h"
 #include "framework/experiment/Config.h"
 #include "framework/experiment/Runner.h"
 #include "framework/gl/GlContext.h"
@@ -93,14 +94,23 @@ int run(const std::vector<std::string>& args) {
         }
     }
     if (config.empty()) usageError("run needs a config file");
-    ExperimentConfig cfg = loadConfig(config, true, overrides);
+    installInterruptHandlers();
+    // The output place is checked and locked before the scene is loaded and anything rendered, so a
+    // run that could not save its results fails at once instead of after the work.
+    ExperimentConfig cfg = loadConfig(config, false, overrides);
+    std::vector<std::string> notes;
+    OutputPlace place = OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes);
+    for (const auto& n : notes) std::fprintf(stderr, "shadowlab: %s\n", n.c_str());
+    opt.place = &place;
+    cfg = loadConfig(config, true, overrides);
+    throwIfInterrupted();
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
     std::fprintf(stderr, "shadowlab: %s, %zu triangles, %d×%d, %d frames on %s (%s)\n", cfg.name.c_str(),
                  cfg.scene->triangleCount(), cfg.resolution.x, cfg.resolution.y, cfg.frames, glRendererString().c_str(),
                  context->backend().c_str());
     ExperimentResults r = runExperiment(cfg, opt, context->backend());
-    std::string dir = opt.outputDir.empty() ? cfg.outputDir : opt.outputDir;
+    const std::string& dir = place.finalDir();
     std::fprintf(stderr, "shadowlab: wrote %s (report.md, summary.json) in %.1f s\n", dir.c_str(),
                  r.meta["wall_time_s"].get<double>());
     if (glErrorCount() > 0) {
@@ -147,6 +157,9 @@ int main(int argc, char** argv) {
     } catch (const InputError& e) {
         std::fprintf(stderr, "shadowlab: error: %s\n", e.what());
         return 2;
+    } catch (const Interrupted& e) {
+        std::fprintf(stderr, "shadowlab: %s; no results written, any previous ones kept\n", e.what());
+        return 128 + e.signal();
     } catch (const std::exception& e) {
         std::fprintf(stderr, "shadowlab: failed: %s\n", e.what());
         return 1;

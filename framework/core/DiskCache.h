@@ -36,7 +36,15 @@ bool writeAtomically(const std::string& path, std::initializer_list<Part> parts,
 template <class Load, class Build, class Save>
 auto loadOrBuild(const char* owner, const std::string& path, Load load, Build build, Save save, bool* hit) {
     std::string why;
-    if (!path.empty() && std::filesystem::exists(path)) {
+    std::error_code ec;
+    auto status = path.empty() ? std::filesystem::file_status{} : std::filesystem::status(path, ec);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+        // A FIFO or device would block or stream forever on open; a directory cannot be read.
+        std::fprintf(stderr, "%s: cache path %s is not a regular file; running without the cache\n", owner, path.c_str());
+        if (hit) *hit = false;
+        return build();
+    }
+    if (std::filesystem::exists(status)) {
         if (auto cached = load(&why)) {
             if (hit) *hit = true;
             return std::move(*cached);

@@ -19,8 +19,18 @@ public:
 private:
     static std::string format(const std::string& file, const std::string& path, const std::string& cause) {
         std::string s = file.empty() ? std::string("<input>") : file;
-        if (!path.empty()) s += ": at " + path;
-        return s + ": " + cause;
+        if (!path.empty()) s += ": at " + cut(path, 200);
+        return s + ": " + cut(cause, 300);
+    }
+    /// One short line whatever the input echoed into it: newlines become "; ", long text is cut.
+    static std::string cut(const std::string& text, size_t maxChars) {
+        std::string out;
+        for (char c : text) {
+            if (out.size() >= maxChars) return out + "...";
+            if (c == '\n') out += "; ";
+            else if (c != '\r') out += c;
+        }
+        return out;
     }
     std::string file_, path_, cause_;
 };

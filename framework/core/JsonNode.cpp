@@ -1,5 +1,7 @@
 #include "framework/core/JsonNode.h"
 
+#include "framework/core/JsonParse.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -30,23 +32,22 @@ JsonNode::JsonNode(std::string file, const Json* value, std::string path, Json* 
 }
 
 Json parseJsonOrString(const std::string& text) {
-    Json value = Json::parse(text, nullptr, false);
-    return value.is_discarded() ? Json(text) : value;
+    try {
+        return parseJson(text, "--set");
+    } catch (const InputError&) {
+        return Json(text);  // bare text; whatever reads it checks its type
+    }
 }
 
 Json JsonNode::parseFile(const std::string& file) {
+    std::error_code ec;
+    if (fs::is_directory(file, ec)) throw InputError(file, "", "is a directory, not a JSON file");
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, "", "cannot open file");
     std::stringstream ss;
     ss << in.rdbuf();
-    try {
-        return Json::parse(ss.str());
-    } catch (const Json::parse_error& e) {
-        // nlohmann's message starts with "[json.exception.parse_error.101] "; keep the useful part.
-        std::string msg = e.what();
-        auto pos = msg.find("] ");
-        throw InputError(file, "", "invalid JSON: " + (pos == std::string::npos ? msg : msg.substr(pos + 2)));
-    }
+    if (!in && !in.eof()) throw InputError(file, "", "cannot read file");
+    return parseJson(ss.str(), file);
 }
 
 bool JsonNode::has(const std::string& key) const { return value_->contains(key); }
@@ -80,7 +81,7 @@ bool JsonNode::getBool(const std::string& key, bool def) {
     const Json* v = lookup(key);
     bool out = def;
     if (v) {
-        if (!v->is_boolean()) fail(key, "expected true or false, got " + v->dump());
+        if (!v->is_boolean()) fail(key, "expected true or false, got " + shortDump(*v));
         out = v->get<bool>();
     }
     record(key, out);
@@ -92,10 +93,10 @@ int JsonNode::getInt(const std::string& key, int def, int minValue, int maxValue
     int out = def;
     if (v) {
         if (!v->is_number_integer() && !(v->is_number_float() && std::floor(v->get<double>()) == v->get<double>()))
-            fail(key, "expected an integer, got " + v->dump());
+            fail(key, "expected an integer, got " + shortDump(*v));
         double d = v->get<double>();
         if (d < minValue || d > maxValue)
-            fail(key, "value " + v->dump() + " is out of range [" + std::to_string(minValue) + ", " +
+            fail(key, "value " + shortDump(*v) + " is out of range [" + std::to_string(minValue) + ", " +
                           std::to_string(maxValue) + "]");
         out = static_cast<int>(d);
     }
@@ -107,11 +108,11 @@ double JsonNode::getFloat(const std::string& key, double def, double minValue, d
     const Json* v = lookup(key);
     double out = def;
     if (v) {
-        if (!v->is_number()) fail(key, "expected a number, got " + v->dump());
+        if (!v->is_number()) fail(key, "expected a number, got " + shortDump(*v));
         out = v->get<double>();
         if (!std::isfinite(out) || out < minValue || out > maxValue) {
             std::ostringstream os;
-            os << "value " << v->dump() << " is out of range [" << minValue << ", " << maxValue << "]";
+            os << "value " << shortDump(*v) << " is out of range [" << minValue << ", " << maxValue << "]";
             fail(key, os.str());
         }
     }
@@ -123,7 +124,7 @@ std::string JsonNode::getString(const std::string& key, const std::string& def) 
     const Json* v = lookup(key);
     std::string out = def;
     if (v) {
-        if (!v->is_string()) fail(key, "expected a string, got " + v->dump());
+        if (!v->is_string()) fail(key, "expected a string, got " + shortDump(*v));
         out = v->get<std::string>();
     }
     record(key, out);
@@ -154,13 +155,15 @@ std::vector<T> JsonNode::numberArray(const std::string& key, size_t n, bool inte
     const Json* v = lookup(key);
     if (!v) return {};
     if (!v->is_array() || (n && v->size() != n))
-        fail(key, "expected an array of " + (n ? std::to_string(n) + " " : std::string()) + "numbers, got " + v->dump());
+        fail(key, "expected an array of " + (n ? std::to_string(n) + " " : std::string()) + "numbers, got " + shortDump(*v));
     std::vector<T> out;
     for (const auto& e : *v) {
         if (!e.is_number() || (integral && !e.is_number_integer()))
-            fail(key, std::string("expected ") + (integral ? "integers" : "numbers") + ", got " + v->dump());
+            fail(key, std::string("expected ") + (integral ? "integers" : "numbers") + ", got " + shortDump(*v));
         double d = e.get<double>();
-        if (!std::isfinite(d)) fail(key, "non-finite number in " + v->dump());
+        if (!std::isfinite(d)) fail(key, "non-finite number in " + shortDump(*v));
+        if (!integral && std::abs(d) > kFloatMax) fail(key, "number too large for a float in " + shortDump(*v));
+        if (integral && (d < INT32_MIN || d > INT32_MAX)) fail(key, "integer out of the 32-bit range in " + shortDump(*v));
         out.push_back(static_cast<T>(d));
     }
     return out;
@@ -171,6 +174,15 @@ glm::vec3 JsonNode::getVec3(const std::string& key, glm::vec3 def) {
     glm::vec3 out = a.empty() ? def : glm::vec3(a[0], a[1], a[2]);
     record(key, Json::array({out.x, out.y, out.z}));
     return out;
+}
+
+glm::vec3 JsonNode::getPoint(const std::string& key, glm::vec3 def) {
+    glm::vec3 p = getVec3(key, def);
+    for (int i = 0; i < 3; ++i)
+        if (std::abs(double(p[i])) > kMaxCoordinate)
+            fail(key, "coordinates must lie within ±1e15 (squared distances must stay finite as floats), got " +
+                          shortDump(Json::array({p.x, p.y, p.z})));
+    return p;
 }
 
 glm::vec2 JsonNode::getVec2(const std::string& key, glm::vec2 def) {

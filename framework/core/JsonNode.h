@@ -23,6 +23,12 @@ using Json = nlohmann::json;
 /// JSON, else the text as a JSON string. Shared by every --set, so they all accept the same input.
 Json parseJsonOrString(const std::string& text);
 
+/// The largest finite float.
+constexpr double kFloatMax = 3.4028234663852886e38;
+/// The largest coordinate a position may have: squared distances (3·1e30) must stay finite in the
+/// float arithmetic of the shaders and of Embree; anything farther is a typo, not a scene.
+constexpr double kMaxCoordinate = 1e15;
+
 class JsonNode {
 public:
     /// `file` names the source in errors and anchors relative paths; `resolved` receives the values used.
@@ -40,10 +46,14 @@ public:
     // Typed reads. get() returns `def` when the key is absent; require() fails when absent.
     bool getBool(const std::string& key, bool def);
     int getInt(const std::string& key, int def, int minValue = INT32_MIN, int maxValue = INT32_MAX);
-    double getFloat(const std::string& key, double def, double minValue = -1e300, double maxValue = 1e300);
+    /// Every number read here may reach the GPU as a float, so the default range is the float's.
+    double getFloat(const std::string& key, double def, double minValue = -kFloatMax, double maxValue = kFloatMax);
     std::string getString(const std::string& key, const std::string& def);
     std::string getEnum(const std::string& key, const std::string& def, const std::vector<std::string>& choices);
+    /// Each component must be finite as a float (1e39 is a finite double but an infinite float).
     glm::vec3 getVec3(const std::string& key, glm::vec3 def);
+    /// A position in world units: a vec3 whose components lie within ±kMaxCoordinate.
+    glm::vec3 getPoint(const std::string& key, glm::vec3 def);
     glm::vec2 getVec2(const std::string& key, glm::vec2 def);
     glm::ivec2 getIVec2(const std::string& key, glm::ivec2 def, int minValue, int maxValue);
     glm::ivec3 getIVec3(const std::string& key, glm::ivec3 def, int minValue, int maxValue);

@@ -2,6 +2,7 @@
 
 #include "framework/scene/SceneConfig.h"
 
+#include <cmath>
 #include <set>
 
 namespace shadowlab {
@@ -21,8 +22,8 @@ void parseCamera(JsonNode node, ExperimentConfig& c) {
     c.camera.nearPlane = float(node.getFloat("near", 0.05, 1e-6, 1e6));
     c.camera.farPlane = float(node.getFloat("far", 100.0, 1e-6, 1e9));
     if (c.camera.farPlane <= c.camera.nearPlane) node.fail("far", "must be greater than near");
-    c.camera.position = node.getVec3("position", {0, 2, 6});
-    c.camera.target = node.getVec3("target", {0, 0, 0});
+    c.camera.position = node.getPoint("position", {0, 2, 6});
+    c.camera.target = node.getPoint("target", {0, 0, 0});
     if (node.has("path")) c.cameraPath = Path::parse(node.child("path"));
     node.finish();
 }
@@ -30,8 +31,8 @@ void parseCamera(JsonNode node, ExperimentConfig& c) {
 void parseLight(JsonNode node, ExperimentConfig& c) {
     Light& l = c.light;
     l.type = lightTypeFromString(node.getEnum("type", "point", kLightTypes));
-    l.position = node.getVec3("position", {2, 4, 2});
-    l.target = node.getVec3("target", {0, 0, 0});
+    l.position = node.getPoint("position", {2, 4, 2});
+    l.target = node.getPoint("target", {0, 0, 0});
     if (l.type == LightType::Spot) l.coneDeg = float(node.getFloat("cone_deg", 45.0, configlimits::kConeMinDeg, configlimits::kConeMaxDeg));
     if (l.type == LightType::Area) {
         l.size = node.getVec2("size", {1, 1});
@@ -41,9 +42,34 @@ void parseLight(JsonNode node, ExperimentConfig& c) {
         l.seed = uint32_t(node.getInt("seed", 1, 0, INT32_MAX));
     }
     if (node.has("path")) c.lightPath = Path::parse(node.child("path"));
-    if (c.lightPath.empty() && l.type != LightType::Point && glm::length(l.target - l.position) <= 0.0f)
-        node.fail("target", "must differ from position (it sets the light's direction)");
     node.finish();
+}
+
+/// A view needs a direction on every frame: a camera at its target, or a spot, area or directional
+/// light whose target meets its position, gives NaN matrices and rays (and Embree asserts on them).
+/// Paths are checked at the frames the experiment samples, where interpolation can also degenerate.
+void checkViews(const ExperimentConfig& c, JsonNode& camera, JsonNode& light) {
+    auto degenerate = [](glm::vec3 from, glm::vec3 to) {
+        glm::vec3 d = to - from;
+        float len = glm::length(d);
+        return !(len > 0.0f) || !std::isfinite(len) || !std::isfinite(glm::length(d / len));
+    };
+    auto where = [&](const Path& path, int frame) {
+        return path.empty() ? std::string() : " at frame " + std::to_string(frame) + " of its path";
+    };
+    for (int f = 0; f < c.frames; ++f) {
+        Camera cam = c.cameraAt(f);
+        if (degenerate(cam.position, cam.target))
+            (c.cameraPath.empty() ? camera.fail("target", "the camera's target equals its position")
+                                  : camera.fail("path", "the camera's target equals its position" + where(c.cameraPath, f)));
+        Light l = c.lightAt(f);
+        if (l.type != LightType::Point && degenerate(l.position, l.target))
+            (c.lightPath.empty()
+                 ? light.fail("target", "must differ from position (it sets the light's direction)")
+                 : light.fail("path", "the light's target equals its position" + where(c.lightPath, f) +
+                                          " (it sets the light's direction)"));
+        if (c.cameraPath.empty() && c.lightPath.empty()) break;  // every frame is the same
+    }
 }
 
 AlgorithmEntry parseEntry(JsonNode node, const std::string& defaultName) {
@@ -58,6 +84,10 @@ AlgorithmEntry parseEntry(JsonNode node, const std::string& defaultName) {
             node.fail("algorithm", "unknown algorithm \"" + name + "\"; registered: " + list);
         }
         e.id = node.getString("id", name);
+        // Ids name result files (images/ID_f0000_shaded.png) and columns: no separators or spaces.
+        if (e.id.empty() || e.id.size() > 64 || e.id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") != std::string::npos || e.id[0] == '.')
+            node.fail("id", "an id is 1 to 64 letters, digits, '_', '-' or '.' (not first), got \"" +
+                                (e.id.size() > 40 ? e.id.substr(0, 37) + "..." : e.id) + "\"");
     } else {
         e.info = findAlgorithm(name);
         e.id = name;
@@ -104,8 +134,10 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     if (loadScene) c.scene = std::make_shared<Scene>(buildScene(sceneNode));
     else root.markRead("scene");
 
-    parseCamera(root.child("camera"), c);
-    parseLight(root.child("light"), c);
+    JsonNode cameraNode = root.child("camera"), lightNode = root.child("light");
+    parseCamera(cameraNode, c);
+    parseLight(lightNode, c);
+    checkViews(c, cameraNode, lightNode);
 
     // "reference": true | false | {"params": {...}}
     if (root.has("reference") && root.raw()["reference"].is_object()) {
@@ -132,6 +164,8 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     if (c.algorithms.empty() && !c.reference) root.fail("algorithms", "nothing to run: no algorithms and no reference");
 
     JsonNode out = root.child("output");
+    if (out.has("dir") && out.raw()["dir"].is_string() && out.raw()["dir"].get<std::string>().empty())
+        out.fail("dir", "must not be empty (it names the output directory)");
     c.outputDir = out.getPath("dir", "results/" + c.name);
     c.imagesAtFrames = out.getIntList("images_at_frames", {0});
     for (int f : c.imagesAtFrames)

@@ -114,13 +114,14 @@ Json ExperimentResults::summary() const {
         if (!mismatch.empty()) {
             Stats m = computeStats(mismatch);
             j["accuracy"] = {{"mismatch_ratio", m.mean},
+                             {"frames_measured", mismatch.size()},
                              {"mismatch_ratio_max", m.max},
                              {"false_lit", computeStats(falseLit).mean},
                              {"false_shadowed", computeStats(falseShadowed).mean},
                              {"rmse", computeStats(rmse).mean},
                              {"per_frame_mismatch", mismatch}};
         } else {
-            j["accuracy"] = nullptr;
+            j["accuracy"] = nullptr;  // no reference, or no frame with a lit pixel to compare
         }
         Json cj = Json::object();
         for (const auto& [k, v] : counters) cj[k] = computeStats(v).toJson();
@@ -141,7 +142,10 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
     os << "- renderer: " << s.value("renderer", std::string()) << " (" << s.value("backend", std::string()) << ")\n";
     os << "- resolution: " << s["resolution"][0] << "×" << s["resolution"][1] << ", frames: " << s["frames"]
        << ", triangles: " << s["triangles"] << "\n";
-    os << "- wall time: " << std::setprecision(1) << s.value("wall_time_s", 0.0) << " s\n\n";
+    os << "- wall time: " << std::setprecision(1) << s.value("wall_time_s", 0.0) << " s\n";
+    if (s.contains("warnings"))
+        for (const auto& w : s["warnings"]) os << "- **warning**: " << w.get<std::string>() << "\n";
+    os << "\n";
 
     if (s.value("stage_time_source", std::string("gpu")) == "gpu")
         os << "## Time per frame (ms; GPU timer queries where the stage runs on the GPU, CPU time otherwise)\n\n";

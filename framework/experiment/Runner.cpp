@@ -1,6 +1,8 @@
 #include "framework/experiment/Runner.h"
 
 #include "framework/core/Error.h"
+#include "framework/core/Interrupt.h"
+#include "framework/experiment/OutputPlace.h"
 #include "framework/experiment/Progress.h"
 #include "framework/gl/GlContext.h"
 #include "framework/gl/Shader.h"
@@ -12,7 +14,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
-#include <unistd.h>
 
 namespace shadowlab {
 
@@ -45,50 +46,31 @@ void writeImages(const std::string& dir, const std::string& id, int frame, glm::
     }
 }
 
-std::string prepareOutput(const std::string& finalDir, bool force) {
-    if (fs::exists(finalDir) && !force)
-        throw InputError(finalDir, "", "output directory already exists; pass --force to replace it once the new run completes, or --out DIR");
-    std::string partial = finalDir + ".partial-" + std::to_string(::getpid());
-    fs::remove_all(partial);
-    fs::create_directories(partial + "/images");
-    return partial;
-}
-
-void commitOutput(const std::string& partial, const std::string& finalDir) {
-    std::string old = finalDir + ".old-" + std::to_string(::getpid());
-    bool hadOld = fs::exists(finalDir);
-    if (hadOld) fs::rename(finalDir, old);
-    fs::rename(partial, finalDir);
-    if (hadOld) fs::remove_all(old);
-}
-
-/// Removes the partial directory unless the run committed it (an exception or early return).
-struct PartialGuard {
-    std::string dir;
-    bool committed = false;
-    ~PartialGuard() {
-        std::error_code ec;
-        if (!committed && !dir.empty()) fs::remove_all(dir, ec);
-    }
-};
-
 void runPlots(const std::string& dir, const std::string& finalDir) {
+    // SHADOWLAB_PYTHON picks another interpreter (one with matplotlib) than the one found at build time.
+    const char* python = std::getenv("SHADOWLAB_PYTHON");
     std::string script = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/plot_results.py";
-    std::string cmd = std::string(SHADOWLAB_PLOT_PYTHON) + " '" + script + "' '" + dir + "' > '" + dir + "/plots.log' 2>&1";
-    if (std::system(cmd.c_str()) != 0)
+    std::string log = dir + "/plots.log";
+    if (runChildProcess({python && *python ? python : SHADOWLAB_PLOT_PYTHON, script, dir}, log) != 0)
         std::fprintf(stderr, "warning: plotting failed (see %s/plots.log); tables and images are complete\n", finalDir.c_str());
     else
-        std::filesystem::remove(dir + "/plots.log");
+        std::filesystem::remove(log);
 }
 
 } // namespace
 
 ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& opt, const std::string& backend) {
     auto wallStart = Clock::now();
-    const std::string finalDir = opt.outputDir.empty() ? cfg.outputDir : opt.outputDir;
-    std::string dir;
-    if (opt.writeOutputs) dir = prepareOutput(finalDir, opt.force);
-    PartialGuard guard{dir};
+    std::optional<OutputPlace> ownPlace;
+    OutputPlace* place = opt.place;
+    if (opt.writeOutputs && !place) {
+        std::vector<std::string> notes;
+        ownPlace.emplace(OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes));
+        for (const auto& n : notes) std::fprintf(stderr, "shadowlab: %s\n", n.c_str());
+        place = &*ownPlace;
+    }
+    const std::string dir = place ? place->partialDir() : std::string();
+    const std::string finalDir = place ? place->finalDir() : std::string();
 
     const glm::ivec2 res = cfg.resolution;
     SceneGpu sceneGpu(*cfg.scene);
@@ -134,6 +116,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"light", toString(cfg.light.type)},
                     {"reference", cfg.reference}};
 
+    std::vector<int> framesWithoutLit;  // accuracy is measured over lit pixels: none, nothing to measure
     Progress progress(opt.progress, size_t(cfg.frames + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
     std::optional<CpuGBuffer> cpuG;
     auto renderFrame = [&](int frame, const Camera& cam) {
@@ -152,6 +135,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         Light light = cfg.lightAt(0);
         renderFrame(0, cam);
         for (auto& inst : instances) {
+            throwIfInterrupted();
             progress.step("warm-up " + inst.entry->id);
             for (int w = 0; w < cfg.warmupFrames; ++w) {
                 inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, 0, inst.visibility.id(), timer});
@@ -173,7 +157,10 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                           std::find(cfg.imagesAtFrames.begin(), cfg.imagesAtFrames.end(), frame) != cfg.imagesAtFrames.end();
         std::vector<float> reference;
 
+        if (!std::any_of(lit.begin(), lit.end(), [](uint8_t v) { return v != 0; })) framesWithoutLit.push_back(frame);
+
         for (auto& inst : instances) {
+            throwIfInterrupted();
             progress.step(inst.entry->id + " frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
             TimedWork timed = timeWork(timer, [&] {
                 inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, frame, inst.visibility.id(), timer});
@@ -189,7 +176,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             std::vector<float> vis = readTextureR32F(inst.visibility.id(), res.x, res.y);
             bool isReference = cfg.reference && inst.entry == &cfg.referenceEntry;
             if (isReference) reference = vis;
-            if (cfg.reference) {
+            if (cfg.reference && (framesWithoutLit.empty() || framesWithoutLit.back() != frame)) {
                 rec.hasAccuracy = true;
                 rec.accuracy = compareVisibility(vis, reference, lit);
             }
@@ -205,7 +192,18 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
 
     for (auto& inst : instances) results.algorithms.push_back(std::move(inst.results));
     results.meta["wall_time_s"] = msSince(wallStart) / 1000.0;
+    results.meta["frames_without_lit_pixels"] = framesWithoutLit;
+    results.meta["warnings"] = Json::array();
+    if (cfg.reference && !framesWithoutLit.empty()) {
+        std::string w = std::to_string(framesWithoutLit.size()) + " of " + std::to_string(cfg.frames) +
+                        " frames have no lit pixel (none covered, facing the light and inside its reach): accuracy "
+                        "is not measured on them" +
+                        (int(framesWithoutLit.size()) == cfg.frames ? ", so it is not measured at all" : "");
+        results.meta["warnings"].push_back(w);
+        std::fprintf(stderr, "shadowlab: warning: %s\n", w.c_str());
+    }
     if (!opt.writeOutputs) return results;
+    throwIfInterrupted();
 
     // Order matters: the resolved config and tables first, plots next, summary.json last; the
     // rename that follows makes the whole directory appear at once.
@@ -214,9 +212,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     Json summary = results.summary();
     results.writeReport(dir + "/report.md", summary);
     if (cfg.plots) runPlots(dir, finalDir);
+    throwIfInterrupted();
     writeFileAtomic(dir + "/summary.json", summary.dump(2) + "\n");
-    commitOutput(dir, finalDir);
-    guard.committed = true;
+    place->commit();
     return results;
 }
 

@@ -1,9 +1,11 @@
 #include "framework/scene/GltfLoader.h"
 
 #include "framework/core/JsonNode.h"
+#include "framework/core/JsonParse.h"
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -90,11 +92,6 @@ std::string escapeKey(const std::string& key) {
     std::string out;
     for (char c : key) out += c == '~' ? std::string("~0") : c == '/' ? std::string("~1") : std::string(1, c);
     return out;
-}
-
-std::string shortDump(const Json& v) {
-    std::string s = v.dump();
-    return s.size() > 60 ? s.substr(0, 57) + "..." : s;
 }
 
 /// A non-negative integer up to `max` (2.0 counts: it is an integer in JSON Schema's sense).
@@ -215,11 +212,23 @@ bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int
 // ---------------------------------------------------------------------------------------------
 // Stage 3: validation and geometry extraction.
 
-constexpr size_t kMaxUnbackedCount = size_t(1) << 27;  // accessors without a bufferView are zero-filled
+// Accessors without a bufferView are zero-filled (a base for sparse values): they cost memory that no
+// byte of the file backs, so they are capped in bytes (16 M vec4 floats), not left to a declared count.
+constexpr size_t kMaxUnbackedBytes = size_t(256) << 20;
+
+// Extensions that may be required without changing what shadowlab reads (geometry, base colour
+// factor, alpha mode): texture and shading extensions. Any other required extension is rejected, as
+// the glTF spec asks of a loader that does not implement it.
+const char* const kHarmlessExtensions[] = {
+    "KHR_materials_unlit",    "KHR_texture_transform",  "KHR_texture_basisu",     "EXT_texture_webp",
+    "KHR_materials_emissive_strength", "KHR_materials_clearcoat", "KHR_materials_sheen",
+    "KHR_materials_specular", "KHR_materials_ior",      "KHR_materials_variants", "KHR_materials_iridescence",
+    "KHR_materials_anisotropy", "KHR_lights_punctual"};
 
 class Loader {
 public:
-    Loader(const std::string& file, const tinygltf::Model& model) : file_(file), m_(model) {}
+    Loader(const std::string& file, const tinygltf::Model& model, size_t maxTriangles)
+        : file_(file), m_(model), maxTriangles_(maxTriangles) {}
 
     Scene run(GltfStats* stats);
 
@@ -252,6 +261,8 @@ private:
 
     const std::string& file_;
     const tinygltf::Model& m_;
+    size_t maxTriangles_;
+    size_t instanced_ = 0;  // triangle instances emitted so far, against maxTriangles_
     std::vector<int> parent_;
     std::map<int, std::vector<glm::vec3>> positionCache_;
     size_t skipped_ = 0;  // primitive instances without triangles (points, lines, no POSITION)
@@ -263,6 +274,13 @@ void Loader::validateStructure() {
         if (ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression" || ext == "KHR_mesh_quantization" ||
             ext == "EXT_mesh_gpu_instancing")
             fail("/extensionsRequired", "requires extension " + ext + ", which changes geometry and is not supported");
+    for (size_t i = 0; i < m_.extensionsRequired.size(); ++i) {
+        const std::string& ext = m_.extensionsRequired[i];
+        if (std::find(std::begin(kHarmlessExtensions), std::end(kHarmlessExtensions), ext) == std::end(kHarmlessExtensions))
+            fail("/extensionsRequired/" + std::to_string(i),
+                 "requires extension \"" + (ext.size() > 60 ? ext.substr(0, 57) + "..." : ext) +
+                     "\", which shadowlab does not implement (a loader must reject what it cannot read)");
+    }
     for (size_t i = 0; i < m_.bufferViews.size(); ++i) {
         const auto& bv = m_.bufferViews[i];
         checkIndex(bv.buffer, m_.buffers, at("bufferViews", i) + "/buffer", "buffer");
@@ -318,8 +336,9 @@ void Loader::validateAccessor(size_t i) {
         fail(path, "unknown componentType " + std::to_string(a.componentType) + " or type " + std::to_string(a.type));
     size_t elem = elementSize(a);
     if (a.bufferView == -1) {
-        if (a.count > kMaxUnbackedCount)
-            fail(path + "/count", "count " + std::to_string(a.count) + " is too large for an accessor without bufferView");
+        if (a.count > kMaxUnbackedBytes / elem)
+            fail(path + "/count", "count " + std::to_string(a.count) + " is too large for an accessor without bufferView (at most " +
+                                      std::to_string(kMaxUnbackedBytes >> 20) + " MiB of zeros)");
     } else {
         checkIndex(a.bufferView, m_.bufferViews, path + "/bufferView", "bufferView");
         const auto& bv = m_.bufferViews[size_t(a.bufferView)];
@@ -520,6 +539,10 @@ size_t Loader::emitPrimitive(Scene& scene, size_t mi, size_t pi, const glm::mat4
 
     // Triangle k as three positions in seq; strips alternate winding and fans pivot on vertex 0 (glTF 2.0 spec, 3.7.2.1).
     size_t triCount = mode == TINYGLTF_MODE_TRIANGLES ? seq.size() / 3 : seq.size() >= 3 ? seq.size() - 2 : 0;
+    instanced_ += triCount;
+    if (instanced_ > maxTriangles_)
+        fail(path, "the file's node instances reach " + std::to_string(instanced_) + " triangles, more than the scene's limit (" +
+                       std::to_string(maxTriangles_) + ", max_triangles)");
     auto corner = [&](size_t k, int c) -> uint32_t {
         if (mode == TINYGLTF_MODE_TRIANGLES) return seq[3 * k + size_t(c)];
         if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) return seq[k + (c == 0 ? 0 : c == 1 ? 1 + k % 2 : 2 - k % 2)];
@@ -595,7 +618,7 @@ Scene Loader::run(GltfStats* stats) {
 
 Scene loadGltf(const std::string& file) { return loadGltf(file, nullptr); }
 
-Scene loadGltf(const std::string& file, GltfStats* stats) {
+Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, "", "cannot open file");
     std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -608,14 +631,12 @@ Scene loadGltf(const std::string& file, GltfStats* stats) {
     bool binary = magic;  // a .gltf that is really binary loads too
 
     std::string jsonText = binary ? glbJson(file, bytes) : std::string(bytes.begin(), bytes.end());
-    Json doc;
-    try {
-        doc = Json::parse(jsonText);
-    } catch (const Json::exception& e) {
-        std::string msg = e.what();
-        auto pos = msg.find("] ");
-        throw InputError(file, "", "invalid JSON: " + oneLine(pos == std::string::npos ? msg : msg.substr(pos + 2)));
-    }
+    // Depth and size are checked before tinygltf sees the text: its reader recurses into "extras"
+    // and would overflow the stack on a document nested tens of thousands deep.
+    JsonLimits limits;
+    limits.maxValues = 50'000'000;      // big scenes have many nodes and accessors; still bounded
+    limits.rejectDuplicateKeys = false;  // tolerated in glTF files in the wild (the last one wins)
+    Json doc = parseJson(jsonText, file, limits);
     if (!doc.is_object()) throw InputError(file, "", "not a glTF file (the JSON document is not an object)");
     TypeChecker(file).checkObject(doc, kRoot, "");
 
@@ -630,7 +651,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats) {
         std::string cause = oneLine(err + "\n" + warn);
         throw InputError(file, "", cause.empty() ? std::string("tinygltf could not load the file") : cause);
     }
-    return Loader(file, model).run(stats);
+    return Loader(file, model, maxTriangles).run(stats);
 }
 
 } // namespace shadowlab

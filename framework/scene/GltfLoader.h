@@ -22,7 +22,9 @@ struct GltfStats {
     size_t meshTriangles = 0;      ///< in the meshes the scene uses, each mesh counted once (what viewers report)
     size_t instanceTriangles = 0;  ///< over every node instance, before degenerate (zero-area) ones are dropped
 };
-/// As above, also filling `stats` when it is not null.
-Scene loadGltf(const std::string& file, GltfStats* stats);
+/// As above, also filling `stats` when it is not null. More than `maxTriangles` triangle instances
+/// is an InputError raised before they are allocated (a few nodes instancing a big mesh can ask
+/// for billions).
+Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles = 200'000'000);
 
 } // namespace shadowlab

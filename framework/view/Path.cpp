@@ -37,8 +37,8 @@ Path Path::parse(JsonNode node) {
         if (!k.has("time")) k.fail("time", "required key is missing");
         if (!k.has("position")) k.fail("position", "required key is missing");
         kf.time = k.getFloat("time", 0);
-        kf.position = k.getVec3("position", glm::vec3(0));
-        kf.target = k.getVec3("target", kf.position + glm::vec3(0, 0, -1));
+        kf.position = k.getPoint("position", glm::vec3(0));
+        kf.target = k.getPoint("target", kf.position + glm::vec3(0, 0, -1));
         if (!keys.empty() && kf.time <= keys.back().time)
             k.fail("time", "keyframe times must increase strictly (previous is " + std::to_string(keys.back().time) + ")");
         k.finish();

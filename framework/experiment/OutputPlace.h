@@ -1,0 +1,46 @@
+#pragma once
+// Where an experiment's results go, and the promise that they are never lost or half-written.
+//
+//   open():   checks the place before any rendering (a usable path, writable, not a file or link,
+//             replaceable only with force and only if it is a shadowlab output), takes an exclusive
+//             lock (DIR.lock, flock: released by the kernel even on SIGKILL), removes what earlier
+//             killed runs left behind (DIR.partial-PID, DIR.old-PID), and creates DIR.partial-PID.
+//   commit(): swaps the finished DIR.partial-PID with DIR in one step (renameat2 RENAME_EXCHANGE),
+//             so DIR always holds either the previous or the new results, then drops the old ones.
+//   ~OutputPlace(): without commit (an error, an interrupt), removes the partial directory; the
+//             previous DIR is untouched.
+#include <string>
+#include <vector>
+
+namespace shadowlab {
+
+class OutputPlace {
+public:
+    /// `dir` as given (--out or output.dir); `force` allows replacing an existing shadowlab output.
+    /// Throws InputError (exit 2) for a place that cannot be used; `notes` receives what was
+    /// cleaned up or recovered, one line each, for the user.
+    static OutputPlace open(const std::string& dir, bool force, std::vector<std::string>* notes = nullptr);
+
+    OutputPlace(OutputPlace&& other) noexcept;
+    OutputPlace& operator=(OutputPlace&&) = delete;
+    ~OutputPlace();
+
+    const std::string& finalDir() const { return final_; }
+    /// The directory to write into until commit().
+    const std::string& partialDir() const { return partial_; }
+    /// Makes the partial directory the output, atomically replacing a previous one.
+    void commit();
+
+    /// Whether `dir` holds a finished experiment (its summary.json, written last, is present).
+    static bool isCompleteOutput(const std::string& dir);
+
+private:
+    OutputPlace() = default;
+    void release();
+
+    std::string final_, partial_, lockPath_;
+    int lockFd_ = -1;
+    bool committed_ = false;
+};
+
+} // namespace shadowlab

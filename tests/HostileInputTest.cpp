@@ -1,0 +1,146 @@
+// Hostile input, as a user (or a mutated file) hands it over: every case ends in exit code 2 with
+// one short line naming the file, the JSON path and the cause, never a crash, an abort, an exit 1
+// or a silent acceptance.
+#include "framework/core/DiskCache.h"
+#include "framework/core/JsonParse.h"
+#include "tests/HostileInputs.h"
+#include "tests/TestSupport.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sys/stat.h>
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string bin() { return SHADOWLAB_BINARY; }
+
+struct BadCase {
+    const char* name;
+    std::string file;                    ///< written to the temp dir as this name
+    std::string text;                    ///< its content
+    std::vector<std::string> fragments;  ///< each must appear in the error line
+};
+
+std::vector<BadCase> badCases() {
+    using test::configWith;
+    const std::string deep = std::string(20000, '[') + std::string(20000, ']');
+    std::string million = "[";
+    for (int i = 0; i < 1'000'000; ++i) million += i ? ",1" : "1";
+    million += "]";
+    return {
+        {"ConfigNestedTwentyThousandDeep", "c.json", configWith({{"name", deep}}), {"/name/", "nesting deeper than 64"}},
+        {"LightBeyondFloat", "c.json", configWith({{"light", R"({"position": [1e39, 4, 2]})"}}), {"/light/position", "float"}},
+        {"LightAt1e30", "c.json", configWith({{"light", R"({"position": [1e30, 4, 2]})"}}), {"/light/position", "1e15"}},
+        {"DegenerateLightPath", "c.json",
+         configWith({{"light", R"({"type": "directional", "path": {"keyframes": [
+             {"time": 0, "position": [0, 5, 0], "target": [0, 0, 0]},
+             {"time": 1, "position": [0, 5, 0], "target": [0, 5, 0]}]}})"}}),
+         {"/light/path", "frame 1", "equals its position"}},
+        {"NumberOverflowsDouble", "c.json", configWith({{"frames", "1e999"}}), {"/frames", "does not fit in a double"}},
+        {"EmptyOutputDir", "c.json", configWith({{"output", R"({"dir": ""})"}}), {"/output/dir", "must not be empty"}},
+        {"MillionNumberResolution", "c.json", configWith({{"resolution", million}}), {"/resolution", "expected an array of 2"}},
+        {"DuplicateKey", "c.json", configWith({{"frames", "2"}, {"frames", "3"}}), {"/frames", "duplicate key"}},
+        {"RadiusOverflowsFloat", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "sphere", "radius": 3e38}]})"}}),
+         {"/scene/objects/0", "no triangles left"}},
+        {"ScaleOverflowsFloat", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "sphere", "transform": {"scale": 1e30}}]})"}}),
+         {"/scene/objects/0", "no triangles left"}},
+        {"CameraAtTarget", "c.json", configWith({{"camera", R"({"position": [1, 2, 3], "target": [1, 2, 3]})"}}),
+         {"/camera/target", "equals its position"}},
+        {"EmptyScene", "c.json", configWith({{"scene", R"({"objects": []})"}}), {"/scene/objects", "no objects"}},
+        {"SpotTargetIsPosition", "c.json", configWith({{"light", R"({"type": "spot", "position": [0, 3, 0], "target": [0, 3, 0]})"}}),
+         {"/light/target", "must differ"}},
+        {"AreaPathTargetIsPosition", "c.json",
+         configWith({{"light", R"({"type": "area", "path": {"keyframes": [{"time": 0, "position": [0, 3, 0], "target": [0, 3, 0]}]}})"}}),
+         {"/light/path", "frame 0"}},
+        {"IdWithSlash", "c.json", configWith({{"algorithms", R"([{"algorithm": "psv", "id": "../x"}])"}}), {"/algorithms/0/id"}},
+        {"TrianglesOverBudget", "c.json",
+         configWith({{"scene", R"({"max_triangles": 1000, "objects": [{"procedural": "grid", "count": [10, 1, 10],
+                       "object": {"procedural": "sphere", "triangles": 500}}]})"}}),
+         {"/scene/objects/0/count", "max_triangles"}},
+        {"GlbWithDeepExtras", "m.glb", test::glbOf(test::triangleGltf({{"extras", deep}})), {"m.glb", "nesting deeper"}},
+        {"GltfRequiresUnknownExtension", "m.gltf", test::triangleGltf({{"extensionsRequired", R"(["EXT_imaginary"])"}}),
+         {"/extensionsRequired/0", "EXT_imaginary"}},
+        {"AccessorCountBeyondBuffer", "m.gltf", test::triangleGltf({}, 1'000'000'000),
+         {"/accessors/0", "exceed bufferView"}},
+        {"UnbackedAccessorOfGigabytes", "m.gltf", test::triangleGltf({{"accessors", R"([{"componentType": 5126, "type": "MAT4", "count": 120000000}])"}}), {"/accessors/0/count", "too large"}},
+    };
+}
+
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+
+class HostileInputTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(HostileInputTest, ExitsTwoWithOneShortLine) {
+    const BadCase& c = GetParam();
+    std::string dir = test::makeTempDir(std::string("hostile-") + c.name);
+    {
+        std::ofstream(dir + "/" + c.file, std::ios::binary) << c.text;
+    }
+    std::string config = dir + "/" + c.file;
+    if (c.file != "c.json") {  // a scene file: a config that loads it
+        config = dir + "/c.json";
+        std::ofstream(config) << test::configWith({{"scene", R"({"objects": [{"gltf": ")" + c.file + R"("}]})"}});
+    }
+    std::string out;
+    // ulimit -v: a case that allocates before it checks fails here instead of passing slowly.
+    int rc = test::runCommand("(ulimit -v 4000000; " + bin() + " validate " + config + " >/dev/null)", out);
+    EXPECT_EQ(rc, 2) << out;
+    EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+    EXPECT_LT(out.size(), 600u) << out;
+    for (const auto& f : c.fragments) EXPECT_NE(out.find(f), std::string::npos) << "missing \"" << f << "\" in: " << out;
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, HostileInputTest, ::testing::ValuesIn(badCases()),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(HostileInputTest, ParserNamesThePathOfEveryFault) {
+    EXPECT_THROW(parseJson(R"({"a": {"b": [1, {"c": 1, "c": 2}]}})", "f"), InputError);
+    try {
+        parseJson(R"({"a": {"b": [1, {"c": 1, "c": 2}]}})", "f");
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.jsonPath(), "/a/b/1/c");
+    }
+    try {
+        parseJson(R"({"a": [0, 0, 1e400]})", "f");
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.jsonPath(), "/a/2");
+    }
+    // Exactly at the limit parses; one deeper does not.
+    JsonLimits limits;
+    limits.maxDepth = 3;
+    EXPECT_NO_THROW(parseJson("[[[1]]]", "f", limits));
+    EXPECT_THROW(parseJson("[[[[1]]]]", "f", limits), InputError);
+    // The DOM is the one nlohmann builds.
+    const char* text = R"({"x": [1, 2.5, "s", true, null, {"y": []}], "z": {}})";
+    EXPECT_EQ(parseJson(text, "f"), Json::parse(text));
+}
+
+TEST(HostileInputTest, ShortDumpStaysShort) {
+    Json big = Json::array();
+    for (int i = 0; i < 100000; ++i) big.push_back(Json::array({i, i, i}));
+    EXPECT_LE(shortDump(big).size(), 60u);
+    EXPECT_EQ(shortDump(Json::array({1, 2})), "[1,2]");
+}
+
+TEST(HostileInputTest, FifoAtACachePathIsBypassedNotOpened) {
+    std::string dir = test::makeTempDir("fifo-cache");
+    std::string path = dir + "/cache.bin";
+    ASSERT_EQ(::mkfifo(path.c_str(), 0644), 0);
+    bool hit = true, loaded = false;
+    int value = diskcache::loadOrBuild(
+        "test", path, [&](std::string*) { loaded = true; return std::optional<int>(1); }, [] { return 42; },
+        [](int, std::string*) { return true; }, &hit);
+    EXPECT_EQ(value, 42);
+    EXPECT_FALSE(hit);
+    EXPECT_FALSE(loaded);
+    EXPECT_TRUE(fs::is_fifo(path));  // left alone, not replaced
+}
+
+} // namespace
+} // namespace shadowlab
