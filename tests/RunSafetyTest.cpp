@@ -1,0 +1,158 @@
+// `shadowlab run` under interruption and contention, as a user meets them: Ctrl-C or SIGTERM while
+// rendering or while plotting, two runs aimed at one output, and an experiment in which no pixel
+// is lit. Results are never lost or left half-written, and a vacuous 0 % mismatch is never reported.
+#include "framework/core/JsonNode.h"
+#include "tests/HostileInputs.h"
+#include "tests/TestSupport.h"
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// Starts `shadowlab run CONFIG --out OUT [extra]` in the background with stderr to LOG.
+pid_t startRun(const std::string& config, const std::string& out, const std::string& log,
+               std::vector<std::string> extra = {}, const std::string& python = "") {
+    pid_t pid = fork();
+    if (pid == 0) {
+        if (!python.empty()) setenv("SHADOWLAB_PYTHON", python.c_str(), 1);
+        freopen(log.c_str(), "w", stderr);
+        freopen("/dev/null", "w", stdout);
+        std::vector<std::string> args = {SHADOWLAB_BINARY, "run", config, "--out", out, "--no-progress"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        std::vector<char*> argv;
+        for (auto& a : args) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        execv(argv[0], argv.data());
+        _exit(127);
+    }
+    return pid;
+}
+
+/// The exit code, or 1000 + signal; fails the test if it does not end within `limit`.
+int waitExit(pid_t pid, std::chrono::seconds limit) {
+    auto until = std::chrono::steady_clock::now() + limit;
+    int status = 0;
+    while (waitpid(pid, &status, WNOHANG) == 0) {
+        if (std::chrono::steady_clock::now() > until) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &status, 0);
+            ADD_FAILURE() << "the run did not stop within " << limit.count() << " s";
+            return -1;
+        }
+        std::this_thread::sleep_for(20ms);
+    }
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
+}
+
+bool waitFor(const std::function<bool()>& cond, std::chrono::seconds limit = 120s) {
+    auto until = std::chrono::steady_clock::now() + limit;
+    while (!cond()) {
+        if (std::chrono::steady_clock::now() > until) return false;
+        std::this_thread::sleep_for(20ms);
+    }
+    return true;
+}
+
+bool hasPartial(const std::string& base) {
+    for (const auto& e : fs::directory_iterator(base))
+        if (e.path().filename().string().find(".partial-") != std::string::npos) return true;
+    return false;
+}
+
+/// A config of `frames` frames at 32² (shadow_map + reference), and a finished output of it in OUT.
+struct Fixture {
+    std::string base, config, out, previous;
+    Fixture(const std::string& tag, int frames, bool plots = false) {
+        base = test::makeTempDir(tag);
+        config = base + "/c.json";
+        out = base + "/out";
+        std::ofstream(config) << test::configWith({{"resolution", "[32, 32]"}, {"frames", std::to_string(frames)},
+                                                   {"output", std::string(R"({"plots": )") + (plots ? "true" : "false") + "}"}});
+        std::string log;
+        EXPECT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + config + " --out " + out +
+                                       " --no-progress --set frames=1 --set output.plots=false", log), 0) << log;
+        previous = slurp(out + "/summary.json");
+        EXPECT_FALSE(previous.empty());
+    }
+    void expectPreviousKept() const {
+        EXPECT_EQ(slurp(out + "/summary.json"), previous);
+        EXPECT_FALSE(hasPartial(base));
+        EXPECT_FALSE(fs::exists(out + ".lock"));
+    }
+};
+
+TEST(RunSafetyTest, CtrlCWhileRenderingStopsAndKeepsThePreviousResults) {
+    Fixture f("interrupt-render", 100000);
+    pid_t pid = startRun(f.config, f.out, f.base + "/log", {"--force"});
+    ASSERT_TRUE(waitFor([&] { return hasPartial(f.base); })) << slurp(f.base + "/log");
+    std::this_thread::sleep_for(300ms);  // inside the frame loop
+    kill(pid, SIGINT);
+    EXPECT_EQ(waitExit(pid, 60s), 128 + SIGINT) << slurp(f.base + "/log");
+    EXPECT_NE(slurp(f.base + "/log").find("interrupted by SIGINT"), std::string::npos);
+    f.expectPreviousKept();
+}
+
+TEST(RunSafetyTest, SigtermWhilePlottingStopsThePlotterAndKeepsThePreviousResults) {
+    Fixture f("interrupt-plot", 2, true);
+    // A plotter that announces itself and then takes far longer than any real plot.
+    std::string plotter = f.base + "/slow_plotter.sh", marker = f.base + "/plotting";
+    std::ofstream(plotter) << "#!/bin/sh\necho $$ > " << marker << ".tmp; mv " << marker << ".tmp " << marker << "\nexec sleep 300\n";
+    fs::permissions(plotter, fs::perms::owner_all);
+    pid_t pid = startRun(f.config, f.out, f.base + "/log", {"--force"}, plotter);
+    ASSERT_TRUE(waitFor([&] { return fs::exists(marker); })) << slurp(f.base + "/log");
+    pid_t plotterPid = std::stoi(slurp(marker));
+    kill(pid, SIGTERM);
+    EXPECT_EQ(waitExit(pid, 30s), 128 + SIGTERM) << slurp(f.base + "/log");
+    f.expectPreviousKept();
+    EXPECT_NE(kill(plotterPid, 0), 0) << "the plotter still runs";
+}
+
+TEST(RunSafetyTest, ASecondRunIntoTheSameOutputIsRefusedWhileTheFirstRuns) {
+    Fixture f("concurrent", 100000);
+    pid_t first = startRun(f.config, f.out, f.base + "/log", {"--force"});
+    ASSERT_TRUE(waitFor([&] { return hasPartial(f.base); })) << slurp(f.base + "/log");
+    std::string log;
+    EXPECT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + f.config + " --out " + f.out + " --force", log), 2);
+    EXPECT_NE(log.find("in use by another shadowlab run"), std::string::npos) << log;
+    kill(first, SIGINT);
+    EXPECT_EQ(waitExit(first, 60s), 128 + SIGINT);
+    f.expectPreviousKept();
+    // Without --force, a run into a finished output is refused before it starts, also run after run.
+    EXPECT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + f.config + " --out " + f.out, log), 2);
+    EXPECT_NE(log.find("already exists"), std::string::npos) << log;
+    f.expectPreviousKept();
+}
+
+TEST(RunSafetyTest, FramesWithoutLitPixelsAreFlaggedNotScoredZero) {
+    std::string base = test::makeTempDir("no-lit");
+    // A spot light aimed away from everything the camera sees.
+    std::ofstream(base + "/c.json") << test::configWith(
+        {{"light", R"({"type": "spot", "position": [0, 4, 0], "target": [0, 10, 0], "cone_deg": 10})"}});
+    std::string log;
+    ASSERT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + base + "/c.json --out " + base + "/out --no-progress", log), 0)
+        << log;
+    EXPECT_NE(log.find("warning: 2 of 2 frames have no lit pixel"), std::string::npos) << log;
+    Json summary = Json::parse(slurp(base + "/out/summary.json"));
+    EXPECT_EQ(summary["frames_without_lit_pixels"], Json::array({0, 1}));
+    EXPECT_EQ(summary["warnings"].size(), 1u);
+    EXPECT_TRUE(summary["algorithms"]["shadow_map"]["accuracy"].is_null());
+    EXPECT_NE(slurp(base + "/out/report.md").find("**warning**"), std::string::npos);
+}
+
+} // namespace
+} // namespace shadowlab
