@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs shadowlab's Debian 12 build and run dependencies (as root, or through sudo).
 # Skips apt entirely when every package is already installed, so repeated runs are fast.
+# Extra package names may be given (scripts/fuzz.sh asks for clang).
 set -euo pipefail
 
 PACKAGES=(
@@ -10,6 +11,7 @@ PACKAGES=(
   assimp-testmodels python3 python3-matplotlib xvfb xauth fonts-dejavu-core
 )
 
+PACKAGES+=("$@")
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

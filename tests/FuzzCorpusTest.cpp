@@ -6,8 +6,7 @@
 // each must end in success or in the bad-input error (InputError).
 #include "framework/core/Error.h"
 #include "framework/core/JsonParse.h"
-#include "framework/experiment/Config.h"
-#include "framework/scene/GltfLoader.h"
+#include "tests/FuzzHarness.h"
 #include "tests/HostileInputs.h"
 #include "tests/TestSupport.h"
 
@@ -31,8 +30,7 @@ constexpr long kMaxRssKiB = 2L << 20;  // ASan's shadow and quarantine add to ev
 #else
 constexpr long kMaxRssKiB = 1L << 20;  // 1 GiB: the cap on any single case's peak resident memory
 #endif
-constexpr int kCaseSeconds = 30;             // a case still running after this is a hang
-constexpr int kFuzzMaxTriangles = 200'000;   // the scene budget the harness sets (the default is 20 M)
+constexpr int kCaseSeconds = 30;  // a case still running after this is a hang
 
 enum Outcome { kLoaded = 0, kInputError = 2, kOtherException = 3, kOutOfMemory = 4 };
 
@@ -177,18 +175,8 @@ std::vector<Case> mutationsOf(const std::string& seedPath, const std::string& by
 /// Runs in the child: loads the case, returns the outcome as the exit code.
 int loadInChild(const Case& c, bool isScene) {
     try {
-        if (isScene) {
-            Scene s = loadGltf(c.path, nullptr, kFuzzMaxTriangles);
-            return s.triangleCount() > 0 ? kLoaded : kOtherException;
-        }
-        Json j = parseJson(readFile(c.path), c.path);
-        // The harness's own budget keeps each case small; a mutation may still lower it.
-        if (j.is_object() && j.contains("scene") && j["scene"].is_object() &&
-            !(j["scene"].contains("max_triangles") && j["scene"]["max_triangles"].is_number() &&
-              j["scene"]["max_triangles"].get<double>() < kFuzzMaxTriangles))
-            j["scene"]["max_triangles"] = kFuzzMaxTriangles;
-        ExperimentConfig cfg = parseConfig(j, c.path, true);
-        return cfg.scene ? kLoaded : kOtherException;
+        size_t triangles = isScene ? fuzz::loadSceneFile(c.path) : fuzz::loadConfigText(readFile(c.path), c.path);
+        return triangles > 0 ? kLoaded : kOtherException;
     } catch (const InputError&) {
         return kInputError;
     } catch (const std::bad_alloc&) {

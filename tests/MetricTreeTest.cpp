@@ -205,15 +205,15 @@ TEST(MetricTreeTest, CacheRoundTripsAndRejectsBadFiles) {
     const std::string path = cacheFile(dir, hash, o);
     std::string why;
     ASSERT_TRUE(saveCache(path, hash, o, scene.triangleCount(), c, &why)) << why;
-    auto back = loadCache(path, hash, o, scene.triangleCount(), &why);
+    auto back = loadCache(path, hash, o, scene, &why);
     ASSERT_TRUE(back) << why;
     EXPECT_EQ(back->order, c.order);
     EXPECT_EQ(back->capsules, c.capsules);
     ClusteringOptions other = o;
     other.clusterSize = 8;
     EXPECT_NE(cacheFile(dir, hash, other), path);
-    EXPECT_FALSE(loadCache(path, hash, other, scene.triangleCount(), &why));
-    EXPECT_FALSE(loadCache(path, hash + 1, o, scene.triangleCount(), &why));
+    EXPECT_FALSE(loadCache(path, hash, other, scene, &why));
+    EXPECT_FALSE(loadCache(path, hash + 1, o, scene, &why));
     // A flipped byte in the payload, then a truncated file: reported, never trusted.
     {
         std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
@@ -221,10 +221,31 @@ TEST(MetricTreeTest, CacheRoundTripsAndRejectsBadFiles) {
         char x = 0x5A;
         f.write(&x, 1);
     }
-    EXPECT_FALSE(loadCache(path, hash, o, scene.triangleCount(), &why));
+    EXPECT_FALSE(loadCache(path, hash, o, scene, &why));
     EXPECT_NE(why.find("checksum"), std::string::npos) << why;
     std::filesystem::resize_file(path, 100);
-    EXPECT_FALSE(loadCache(path, hash, o, scene.triangleCount(), &why));
+    EXPECT_FALSE(loadCache(path, hash, o, scene, &why));
+}
+
+// A file of another scene with the same triangle count, its header rewritten to this scene's key and
+// its checksums recomputed (what a copied or hand-edited cache looks like): the clusters themselves
+// do not bound this scene's triangles, so it is rejected.
+TEST(MetricTreeTest, CacheOfOtherContentIsRejectedWhateverItsHeaderSays) {
+    const Scene scene = testScene();
+    Scene moved = scene;
+    for (auto& p : moved.positions) p += glm::vec3(0.05f, 0.0f, 0.0f);
+    moved.updateBounds();
+    ClusteringOptions o;
+    const std::string dir = test::makeTempDir("mt-cache-forged");
+    const uint64_t hash = scene.contentHash();
+    const std::string path = cacheFile(dir, hash, o);
+    std::string why;
+    ASSERT_TRUE(saveCache(path, hash, o, moved.triangleCount(), clusterScene(moved, o), &why)) << why;
+    EXPECT_FALSE(loadCache(path, hash, o, scene, &why));
+    EXPECT_NE(why.find("other content"), std::string::npos) << why;
+    // Its own clustering, under the same key, is accepted: the check is not merely strict.
+    ASSERT_TRUE(saveCache(path, hash, o, scene.triangleCount(), clusterScene(scene, o), &why)) << why;
+    EXPECT_TRUE(loadCache(path, hash, o, scene, &why)) << why;
 }
 
 

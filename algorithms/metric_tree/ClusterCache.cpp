@@ -2,6 +2,7 @@
 
 #include "framework/core/DiskCache.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -28,6 +29,30 @@ using diskcache::checksum;
 uint64_t payloadChecksum(const Clustering& c) {
     return checksum(c.order.data(), c.order.size() * sizeof(uint32_t),
                     checksum(c.clusters.data(), c.clusters.size() * sizeof(ClusterGpu)));
+}
+
+/// Whether each cluster encloses its triangles as the shaders assume; the reason when not.
+/// Tolerances are those of the float rounding the clustering itself allows for.
+const char* boundsWrong(const Clustering& c, const Scene& scene) {
+    const float extent = std::max(1.0f, glm::length(scene.bounds.extent()));
+    const float tol = 1e-4f * extent;
+    for (const ClusterGpu& cl : c.clusters) {
+        const glm::vec3 a(cl.a[0], cl.a[1], cl.a[2]), b(cl.b[0], cl.b[1], cl.b[2]), axis(cl.axis[0], cl.axis[1], cl.axis[2]);
+        const glm::vec3 ab = b - a;
+        const float l2 = glm::dot(ab, ab);
+        for (uint32_t k = cl.first; k < cl.first + cl.count; ++k) {
+            const uint32_t t = c.order[k];
+            if (cl.b[3] > -1.0f && glm::dot(axis, scene.normals[t]) < cl.b[3] - 1e-3f) return "a normal lies outside its cone";
+            for (int v = 0; v < 3; ++v) {
+                const glm::vec3 p = scene.positions[3 * size_t(t) + size_t(v)];
+                const float s = l2 > 0 ? std::clamp(glm::dot(p - a, ab) / l2, 0.0f, 1.0f) : 0.0f;
+                if (glm::length(p - (a + s * ab)) > cl.a[3] + tol) return "a vertex lies outside its cluster's bounds";
+                const float d = glm::dot(axis, p);
+                if (d < cl.axis[3] - tol || d > cl.slabMax + tol) return "a vertex lies outside its cluster's slabs";
+            }
+        }
+    }
+    return nullptr;
 }
 
 } // namespace
@@ -61,7 +86,8 @@ bool saveCache(const std::string& path, uint64_t sceneHash, const ClusteringOpti
 }
 
 std::optional<Clustering> loadCache(const std::string& path, uint64_t sceneHash, const ClusteringOptions& o,
-                                    size_t triangles, std::string* why) {
+                                    const Scene& scene, std::string* why) {
+    const size_t triangles = scene.triangleCount();
     auto bad = [why](const std::string& reason) {
         if (why) *why = reason;
         return std::optional<Clustering>{};
@@ -91,8 +117,13 @@ std::optional<Clustering> loadCache(const std::string& path, uint64_t sceneHash,
     // Everything a shader indexes with must stay in range.
     for (const ClusterGpu& cl : c.clusters)
         if (uint64_t(cl.first) + cl.count > triangles) return bad("cluster triangles out of range");
-    for (uint32_t t : c.order)
+    std::vector<bool> seen(triangles, false);
+    for (uint32_t t : c.order) {
         if (t >= triangles) return bad("triangle index out of range");
+        if (seen[t]) return bad("a triangle is listed twice");
+        seen[t] = true;
+    }
+    if (const char* wrong = boundsWrong(c, scene)) return bad(std::string(wrong) + ": the file was built from other content");
     return c;
 }
 

@@ -19,8 +19,11 @@ std::string cacheFile(const std::string& dir, uint64_t sceneHash, const Clusteri
 /// Writes `c` (creating `dir` as needed); false with the reason in `why` on failure.
 bool saveCache(const std::string& path, uint64_t sceneHash, const ClusteringOptions& o, size_t triangles,
                const Clustering& c, std::string* why);
-/// The clustering of that key, or nothing (and the reason in `why`).
+/// The clustering of that key, or nothing (and the reason in `why`). Beyond the header's key and
+/// checksums, which anyone can rewrite, the clusters are checked against `scene` itself: `order` is a
+/// permutation of its triangles, and every cluster's sphere or capsule, normal cone and slabs enclose
+/// its triangles. A file built from other content fails this, whatever its header says.
 std::optional<Clustering> loadCache(const std::string& path, uint64_t sceneHash, const ClusteringOptions& o,
-                                    size_t triangles, std::string* why);
+                                    const Scene& scene, std::string* why);
 
 } // namespace shadowlab::mt

@@ -226,7 +226,7 @@ private:
         const std::string path = dir.empty() ? std::string() : mt::cacheFile(dir, hash, o);
         const size_t n = scene.triangleCount();
         mt::Clustering c = diskcache::loadOrBuild(
-            "metric_tree", path, [&](std::string* why) { return mt::loadCache(path, hash, o, n, why); },
+            "metric_tree", path, [&](std::string* why) { return mt::loadCache(path, hash, o, scene, why); },
             [&] { return mt::clusterScene(scene, o); },
             [&](const mt::Clustering& value, std::string* why) { return mt::saveCache(path, hash, o, n, value, why); },
             &cacheHit_);
