@@ -1,5 +1,5 @@
 // The list of algorithms. Adding one is a folder under algorithms/ and one line here.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 #include "algorithms/bvh_raytrace/BvhRaytrace.h"
 #include "algorithms/line_space/LineSpace.h"
 #include "algorithms/metric_tree/MetricTree.h"

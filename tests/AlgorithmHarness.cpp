@@ -1,6 +1,8 @@
 #include "tests/AlgorithmHarness.h"
 
-#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/algorithm/AlgorithmHost.h"
+#include "framework/algorithm/SharedParams.h"
+#include "framework/reference/EmbreeTracer.h"
 #include "framework/gl/GlObjects.h"
 
 #include <gtest/gtest.h>
@@ -19,27 +21,21 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
     SceneGpu gpu(shot.scene);
     GBuffer gbuffer({res, res});
     gbuffer.render(gpu, shot.camera);
-    std::unique_ptr<ShadowAlgorithm> algorithm = info.create(params);
-    algorithm->setScene(gpu);
-    algorithm->resize({res, res});
-    GlTexture visibility = makeTexture2D(GL_R32F, res, res);
+    AlgorithmHost host(info, params);
+    host.resize({res, res});
+    host.setScene(gpu);
     StageTimer timer;
     AlgorithmRun o;
     o.gbuffer = gbuffer.readBack();
-    const FrameInputs frame{gbuffer, [&]() -> const CpuGBuffer& { return o.gbuffer; }, shot.camera, shot.light, 0,
-                            visibility.id(), timer};
-    if (options.warmUp) {
-        algorithm->computeVisibility(frame);
-        glFinish();
-        timer.collect();
-    }
-    algorithm->computeVisibility(frame);
-    o.stages = timer.collect();
-    o.visibility = readTextureR32F(visibility.id(), res, res);
-    for (const Counter& c : algorithm->counters()) o.counters[c.name] = c.value;
-    o.overflow = algorithm->overflowCount();
-    o.memory = algorithm->memoryBytes();
-    for (const DebugView& v : algorithm->debugViews())
+    const FrameView frame{gbuffer, [&]() -> const CpuGBuffer& { return o.gbuffer; }, shot.camera, shot.light, 0};
+    if (options.warmUp) host.computeFrame(frame, timer);
+    const FrameMeasurement m = host.computeFrame(frame, timer);
+    o.stages = m.stages;
+    o.visibility = host.readVisibility();
+    for (const Counter& c : m.counters) o.counters[c.name] = c.value;
+    o.overflow = m.overflow;
+    o.memory = m.memoryBytes;
+    for (const DebugView& v : host.algorithm().debugViews())
         if (v.name == "stack_overflow") o.overflowMask = readTextureR32F(v.texture, res, res);
         else if (std::find(options.debugViews.begin(), options.debugViews.end(), v.name) != options.debugViews.end())
             o.views[v.name] = readTextureR32F(v.texture, res, res);
@@ -48,8 +44,7 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
     if (options.withReference) {
         EmbreeTracer tracer(shot.scene);
         // The algorithm's own offset, so both trace from the same points and only the tests differ.
-        tracer.traceVisibility(o.gbuffer, shot.light, float(params.getFloat("ray_offset")) * shot.scene.bounds.radius(), 0,
-                               o.reference);
+        tracer.traceVisibility(o.gbuffer, shot.light, float(rayOffsetOf(params)) * shot.scene.bounds.radius(), 0, o.reference);
         o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
     }
     return o;

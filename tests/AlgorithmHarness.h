@@ -3,7 +3,7 @@
 // as the algorithms' GL tests all do: render the G-buffer, run the algorithm, read back what it
 // reports (visibility, counters, overflow, memory, debug views), trace the reference with the
 // algorithm's own ray offset, and compare over the lit pixels.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 #include "framework/gl/StageTimer.h"
 #include "framework/metrics/Accuracy.h"
 #include "tests/ShadowTestScenes.h"

@@ -21,7 +21,7 @@ TEST(ConfigTest, MissingKeysTakeDefaults) {
     EXPECT_TRUE(c.reference);
     ASSERT_EQ(c.algorithms.size(), 1u);
     EXPECT_EQ(c.algorithms[0].id, "shadow_map");
-    EXPECT_EQ(c.algorithms[0].params.getInt("resolution"), 2048);
+    EXPECT_EQ(std::get<int>(c.algorithms[0].params.get("resolution")), 2048);
     EXPECT_EQ(c.outputDir, "/tmp/x/results/experiment"); // relative to the config's folder
     // The resolved config names every value used, defaults included.
     EXPECT_EQ(c.resolved["algorithms"][0]["params"]["pcf"], 1);

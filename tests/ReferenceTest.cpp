@@ -1,7 +1,7 @@
 // The reference (EmbreeTracer) against shadows known in closed form: horizontal squares over a
 // ground plane, seen through a synthetic CPU G-buffer whose "pixels" are points on y = 0.
 // No GL: the tracer is GL-free, and the algorithm entry is only inspected, never run.
-#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/reference/EmbreeTracer.h"
 #include "algorithms/reference/Reference.h"
 #include "tests/ShadowTestScenes.h"
 

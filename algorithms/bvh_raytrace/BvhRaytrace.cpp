@@ -1,6 +1,7 @@
 #include "algorithms/bvh_raytrace/BvhRaytrace.h"
 
-#include "algorithms/AlgorithmSupport.h"
+#include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/SharedParams.h"
 #include "algorithms/bvh_raytrace/BvhBuilder.h"
 #include "algorithms/bvh_raytrace/BvhGpuLayout.h"
 #include "framework/core/Error.h"
@@ -25,37 +26,46 @@ void checkStorageBlock(const char* what, size_t bytes, size_t limit) {
 
 namespace {
 
-const ParamSchema& bvhSchema() {
-    static const ParamSchema s = ParamSchema()
+struct BvhParams {
+    int stackSize;       ///< traversal stack, nodes
+    int leafSize;        ///< most triangles per leaf
+    int sahBins;         ///< split candidates per axis
+    float traversalCost; ///< × triangle test
+    float rayOffset;     ///< × scene radius
+};
+
+const ParamStruct<BvhParams>& bvhParams() {
+    using P = BvhParams;
+    static const ParamStruct<P> s = ParamStruct<P>()
         // A binned-SAH tree over n triangles is rarely deeper than ~2 log2(n) (≈ 45 for 2 M); 64 leaves
         // headroom, and an overflow is reported, never hidden.
-        .integer("stack_size", 64, 1, 256, "nodes",
-                 "traversal stack; a ray that overflows it counts as blocked and is reported", ParamChange::Rebuild)
-        .integer("leaf_size", 4, 1, 16, "triangles", "most triangles per BVH leaf", ParamChange::Rebuild)
-        .integer("sah_bins", 32, 4, 256, "bins", "SAH candidate split planes per axis in the CPU build", ParamChange::Rebuild)
+        .apply(stackSizeRow(&P::stackSize, 64))
+        .integer("leaf_size", &P::leafSize, 4, 1, 16, "triangles", "most triangles per BVH leaf", ParamChange::Rebuild)
+        .integer("sah_bins", &P::sahBins, 32, 4, 256, "bins", "SAH candidate split planes per axis in the CPU build",
+                 ParamChange::Rebuild)
         // Aila & Laine's GPU ratio is near 1: a node fetch costs about what a triangle fetch does.
-        .real("traversal_cost", 1.0, 0.1, 10.0, "× triangle test",
+        .real("traversal_cost", &P::traversalCost, 1.0, 0.1, 10.0, "× triangle test",
               "SAH cost of visiting a node, relative to one ray-triangle test", ParamChange::Rebuild)
-        // Same key, default and unit as the reference's: the rays are the reference's rays.
-        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
-              "shadow ray origin offset along the surface normal, against self-intersection", ParamChange::Update);
+        .apply(rayOffsetRow(&P::rayOffset));
     return s;
 }
+
+const ParamSchema& bvhSchema() { return bvhParams().schema(); }
 
 using Clock = std::chrono::steady_clock;
 
 class BvhRaytrace final : public ShadowAlgorithm {
 public:
-    explicit BvhRaytrace(const ParamValues& p) : params_(p) { compile(); }
+    explicit BvhRaytrace(const ParamValues& p) : p_(bvhParams().read(p)) { compile(); }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
         nodes_ = GlBuffer(), indices_ = GlBuffer(); // free the old tree before building the new one
         auto t0 = Clock::now();
         bvh::BuildOptions opt;
-        opt.maxLeafSize = params_.getInt("leaf_size");
-        opt.bins = params_.getInt("sah_bins");
-        opt.traversalCost = float(params_.getFloat("traversal_cost"));
+        opt.maxLeafSize = p_.leafSize;
+        opt.bins = p_.sahBins;
+        opt.traversalCost = p_.traversalCost;
         bvh::Bvh tree = bvh::buildBvh(scene.cpu(), opt);
         buildMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         const size_t limit = maxShaderStorageBlockBytes();
@@ -72,27 +82,23 @@ public:
     }
 
     void resize(glm::ivec2 resolution) override {
-        resolution_ = resolution;
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
-        params_ = p;
-        if (change != ParamChange::Rebuild) return;
-        compile(); // setScene() and resize() follow a Rebuild (ShadowAlgorithm.h)
+        p_ = bvhParams().read(p);
+        if (change == ParamChange::Recompile) compile();  // a Rebuild (the tree) is followed by setScene()
     }
 
     void computeVisibility(const FrameInputs& f) override {
-        if (!scene_) throw RuntimeError("bvh_raytrace: computeVisibility() before setScene()");
-        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
         const int sampleCount = uploadLightSamples(samples_, f.light);
 
         f.timer.begin("trace");
         counters_.clear();
         setLightUniforms(trace_, f.light);
         const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
-        trace_.set("uRayOffset", float(params_.getFloat("ray_offset")) * radius);
+        trace_.set("uRayOffset", p_.rayOffset * radius);
         trace_.set("uSampleCount", sampleCount);
         scene_->bindStorage();
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_NODE_BINDING);
@@ -143,17 +149,13 @@ public:
 
 private:
     void compile() {
-        const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
-        if (defines == compiledDefines_) return; // leaf_size only rebuilds the tree
-        compiledDefines_ = defines;
+        const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(p_.stackSize)}};
         trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp", defines);
     }
 
-    ParamValues params_;
+    BvhParams p_;
     const SceneGpu* scene_ = nullptr;
-    glm::ivec2 resolution_{0, 0};
     ShaderProgram trace_;
-    ShaderDefines compiledDefines_;
     GlBuffer nodes_, indices_, samples_;
     GpuCounters<BVH_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;

@@ -3,7 +3,7 @@
 // GLSL through a binned-SAH BVH built once on the CPU (setScene) and flattened into SSBOs; a fixed
 // traversal stack whose overflow is reported, any-hit early exit. Hard shadows (point, spot,
 // directional) and soft shadows (area light: the fraction of Light::samplePoints() unblocked).
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 namespace shadowlab {
 

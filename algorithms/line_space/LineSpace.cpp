@@ -1,6 +1,7 @@
 #include "algorithms/line_space/LineSpace.h"
 
-#include "algorithms/AlgorithmSupport.h"
+#include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/SharedParams.h"
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "algorithms/line_space/NTree.h"
 #include "algorithms/line_space/SampleClassifier.h"
@@ -17,45 +18,50 @@
 namespace shadowlab {
 namespace {
 
-const ParamSchema& lineSpaceSchema() {
-    static const ParamSchema s = ParamSchema()
+struct LineSpaceParams {
+    int n, d;          ///< N-tree branching factor and depth
+    bool cache, classify;
+    int maxBlockMib;   ///< 0 = the context's storage block limit
+    float rayOffset;   ///< × scene radius
+};
+
+const ParamStruct<LineSpaceParams>& lineSpaceParams() {
+    using P = LineSpaceParams;
+    static const ParamStruct<P> s = ParamStruct<P>()
         // The paper uses N in 4..8 with d = 4 for N ≤ 5 and d = 3 above; (6, 3) is its mid-size set.
-        .integer("n", 6, 2, ls::kMaxN, "children per axis",
+        .integer("n", &P::n, 6, 2, ls::kMaxN, "children per axis",
                  "branching factor N of the N-tree: N³ children per subdivided node, 15 N⁴ shaft bits each",
                  ParamChange::Rebuild)
-        .integer("d", 3, 1, ls::kMaxDepth, "levels",
+        .integer("d", &P::d, 3, 1, ls::kMaxDepth, "levels",
                  "depth d of the N-tree: levels 0..d-1 hold line spaces, level d (N^d cells per axis) is implicit",
                  ParamChange::Rebuild)
-        .boolean("cache", true,
-                 "reuse the N-tree from the disk cache ($XDG_CACHE_HOME or ~/.cache /shadowlab/line_space), "
-                 "keyed by scene content, N and d",
-                 ParamChange::Rebuild)
+        .apply(cacheRow(&P::cache, "line_space"))
         // Off by default: it traces every sample again on the CPU, far slower than the GPU pass.
-        .boolean("classify", false,
+        .boolean("classify", &P::classify, false,
                  "also trace every sample exactly on the CPU (untimed) and report over-/under-occluded shares",
                  ParamChange::Update)
         // A GPU's limit is usually 128 MiB to 2 GiB; a smaller cap shows how a big line-space pool is
         // split (and lets the tests exercise the split on small scenes).
-        .integer("max_block_mib", 0, 0, 1 << 16, "MiB",
+        .integer("max_block_mib", &P::maxBlockMib, 0, 0, 1 << 16, "MiB",
                  "cap on one SSBO (0 = GL_MAX_SHADER_STORAGE_BLOCK_SIZE); the line-space pool may span 4 of them",
                  ParamChange::Rebuild)
-        // Same key, default and unit as the reference's: the rays are the reference's rays.
-        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
-              "shadow ray origin offset along the surface normal, against self-shadowing", ParamChange::Update);
+        .apply(rayOffsetRow(&P::rayOffset));
     return s;
 }
 
+const ParamSchema& lineSpaceSchema() { return lineSpaceParams().schema(); }
+
 class LineSpace final : public ShadowAlgorithm {
 public:
-    explicit LineSpace(const ParamValues& p) : params_(p) { compile(); }
+    explicit LineSpace(const ParamValues& p) : p_(lineSpaceParams().read(p)) { compile(); }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
         tracer_.reset();
         nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(); // free the old pools first
         for (GlBuffer& b : bitsBuf_) b = GlBuffer();
-        const int n = params_.getInt("n"), d = params_.getInt("d");
-        const size_t cap = size_t(params_.getInt("max_block_mib")) << 20;
+        const int n = p_.n, d = p_.d;
+        const size_t cap = size_t(p_.maxBlockMib) << 20;
         const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
         tree_ = obtainTree(scene.cpu(), n, d, limit);
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
@@ -104,15 +110,13 @@ public:
     }
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
-        params_ = p;
+        p_ = lineSpaceParams().read(p);
         // setScene() follows a Rebuild (ShadowAlgorithm.h) and compiles for the new tree's block count.
         if (change == ParamChange::Rebuild) bitChunks_ = 0;
     }
 
     void computeVisibility(const FrameInputs& f) override {
-        if (!scene_) throw RuntimeError("line_space: computeVisibility() before setScene()");
-        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
-        const bool classify = params_.getBool("classify");
+        const bool classify = p_.classify;
         const int sampleCount = uploadLightSamples(samples_, f.light);
         const size_t classifyBytes = size_t(resolution_.x) * size_t(resolution_.y) * ls::classifyStride(size_t(sampleCount)) * 4;
         if (classify && classifyBytes > classifyBuf_.size()) classifyBuf_ = GlBuffer(classifyBytes, nullptr, 0);
@@ -164,7 +168,7 @@ public:
                                     {"line_space_pool_bytes", double(poolBytes_[2])}};
         for (size_t l = 0; l < tree_.nodesPerLevel.size(); ++l)
             out.push_back({"nodes_level_" + std::to_string(l), double(tree_.nodesPerLevel[l])});
-        if (params_.getBool("classify") && pendingG_.width > 0) {
+        if (p_.classify && pendingG_.width > 0) {
             const ls::SampleClasses& k = classify();
             const double n = k.samples > 0 ? double(k.samples) : 1.0;
             out.push_back({"classified_samples", double(k.samples)});
@@ -191,8 +195,8 @@ public:
 
 private:
     ShaderDefines defines(bool classify) const {
-        return {{"LS_N", std::to_string(params_.getInt("n"))},
-                {"LS_DEPTH", std::to_string(params_.getInt("d"))},
+        return {{"LS_N", std::to_string(p_.n)},
+                {"LS_DEPTH", std::to_string(p_.d)},
                 {"LS_CLASSIFY", classify ? "1" : "0"},
                 {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)}};
     }
@@ -204,12 +208,12 @@ private:
 
     float rayOffset() const {
         const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
-        return float(params_.getFloat("ray_offset")) * radius;
+        return p_.rayOffset * radius;
     }
 
     /// The tree from the disk cache when allowed and valid, else built (and cached).
     ls::NTree obtainTree(const Scene& scene, int n, int d, size_t blockLimit) {
-        const std::string dir = params_.getBool("cache") ? ls::cacheDirectory() : std::string();
+        const std::string dir = p_.cache ? ls::cacheDirectory() : std::string();
         const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
         const std::string path = dir.empty() ? std::string() : ls::cacheFile(dir, hash, n, d);
         return diskcache::loadOrBuild(
@@ -228,7 +232,7 @@ private:
         return *classes_;
     }
 
-    ParamValues params_;
+    LineSpaceParams p_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     ShaderProgram trace_, classifyProgram_;

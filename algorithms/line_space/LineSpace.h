@@ -5,7 +5,7 @@
 // without ever testing a triangle (shaders/line_space/trace.comp). Soft shadows: the area light's
 // own samples (the reference uses the same); hard shadows (the paper's Figure 7): a point, spot or
 // directional light, one ray per pixel.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 namespace shadowlab {
 

@@ -8,7 +8,7 @@
 //                   there would be a miss outside the start node, which must never happen.
 // Used by the `classify` parameter (counters, untimed) and the tests.
 #include "algorithms/line_space/NTree.h"
-#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/reference/EmbreeTracer.h"
 #include "framework/render/GBuffer.h"
 #include "framework/view/Light.h"
 

@@ -1,6 +1,7 @@
 #include "algorithms/metric_tree/MetricTree.h"
 
-#include "algorithms/AlgorithmSupport.h"
+#include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/SharedParams.h"
 #include "algorithms/metric_tree/ClusterCache.h"
 #include "algorithms/metric_tree/Clustering.h"
 #include "algorithms/metric_tree/CpuTree.h"
@@ -21,48 +22,58 @@
 namespace shadowlab {
 namespace {
 
-const ParamSchema& metricTreeSchema() {
-    static const ParamSchema s = ParamSchema()
-        .integer("cluster_size", 16, 2, 64, "triangles",
+struct MetricTreeParams {
+    int clusterSize, chunkTriangles, kmeansIterations; ///< the clustering (cached on disk)
+    bool capsules, randomOrder, cache;
+    int seed;
+    bool slabs, overlapInterval, depthSkip, normalConeCulling; ///< the query's tests (shader defines)
+    std::string treeBuilder;                                   ///< "gpu" | "cpu"
+    int stackSize;                                             ///< query stack, nodes
+    float rayOffset;                                           ///< × scene radius
+};
+
+const ParamStruct<MetricTreeParams>& metricTreeParams() {
+    using P = MetricTreeParams;
+    static const ParamStruct<P> s = ParamStruct<P>()
+        .integer("cluster_size", &P::clusterSize, 16, 2, 64, "triangles",
                  "most triangles per cluster (paper: 16 to 32); fewer clusters build faster, more triangles are tested",
                  ParamChange::Rebuild)
-        .integer("chunk_triangles", 512, 16, 65536, "triangles",
+        .integer("chunk_triangles", &P::chunkTriangles, 512, 16, 65536, "triangles",
                  "triangles per Morton-curve chunk clustered independently by k-means (paper: 512)", ParamChange::Rebuild)
-        .integer("kmeans_iterations", 8, 1, 100, "iterations", "Lloyd iterations of each k-means split",
+        .integer("kmeans_iterations", &P::kmeansIterations, 8, 1, 100, "iterations", "Lloyd iterations of each k-means split",
                  ParamChange::Rebuild)
-        .boolean("capsules", true,
+        .boolean("capsules", &P::capsules, true,
                  "bound elongated clusters (OBB longest extent >= 2x the others) by capsules, else spheres only",
                  ParamChange::Rebuild)
-        .boolean("slabs", true, "test the shadow ray against a cluster's two slabs before its triangles (paper step 2)",
-                 ParamChange::Rebuild)
-        .boolean("overlap_interval", true,
+        .boolean("slabs", &P::slabs, true,
+                 "test the shadow ray against a cluster's two slabs before its triangles (paper step 2)",
+                 ParamChange::Recompile)
+        .boolean("overlap_interval", &P::overlapInterval, true,
                  "visit an overlap child only when the point's distance is inside its [min, max] (paper step 3)",
-                 ParamChange::Rebuild)
-        .boolean("depth_skip", true,
+                 ParamChange::Recompile)
+        .boolean("depth_skip", &P::depthSkip, true,
                  "skip a subtree whose geometry is all farther from the light than the point (paper step 1)",
-                 ParamChange::Rebuild)
+                 ParamChange::Recompile)
         // Off by default: exact for closed meshes only (an open mesh would leak light through its back).
-        .boolean("normal_cone_culling", false,
+        .boolean("normal_cone_culling", &P::normalConeCulling, false,
                  "drop clusters whose normal cone faces the light (paper 5.3); exact for closed meshes only",
-                 ParamChange::Rebuild)
-        .boolean("random_order", true,
+                 ParamChange::Recompile)
+        .boolean("random_order", &P::randomOrder, true,
                  "insert the clusters in a seeded shuffled order (pivots spread over the scene) instead of Morton order",
                  ParamChange::Rebuild)
-        .integer("seed", 1, 0, INT_MAX, "", "seed of the k-means seeding and of the insertion order", ParamChange::Rebuild)
-        .choice("tree_builder", "gpu", {"gpu", "cpu"},
+        .integer("seed", &P::seed, 1, 0, INT_MAX, "", "seed of the k-means seeding and of the insertion order",
+                 ParamChange::Rebuild)
+        .choice("tree_builder", &P::treeBuilder, "gpu", {"gpu", "cpu"},
                 "gpu: concurrent insertion with the delta-halving heuristic (paper 5.3); cpu: median partitioning "
                 "with Yianilos pivots (the paper's Table 2 reference, slow)",
                 ParamChange::Update)
-        .integer("stack_size", 64, 1, 256, "nodes",
-                 "query stack; a pixel that overflows it is written shadowed and counted", ParamChange::Rebuild)
-        .boolean("cache", true,
-                 "reuse the clustering from the disk cache ($XDG_CACHE_HOME or ~/.cache /shadowlab/metric_tree)",
-                 ParamChange::Rebuild)
-        // Same key, default and unit as the reference's: the query point is the reference's ray origin.
-        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
-              "query point offset along the surface normal, against self-shadowing", ParamChange::Update);
+        .apply(stackSizeRow(&P::stackSize, 64))
+        .apply(cacheRow(&P::cache, "metric_tree"))
+        .apply(rayOffsetRow(&P::rayOffset));
     return s;
 }
+
+const ParamSchema& metricTreeSchema() { return metricTreeParams().schema(); }
 
 constexpr GLuint kGroup = 64;        ///< local_size_x of prepare.comp and insert.comp
 /// Light-space margin of a point light, in radians: above the ~1e-7 rad rounding of the angles and
@@ -71,7 +82,7 @@ constexpr float kAngularEps = 1e-4f;
 
 class MetricTree final : public ShadowAlgorithm {
 public:
-    explicit MetricTree(const ParamValues& p) : params_(p) { compile(); }
+    explicit MetricTree(const ParamValues& p) : p_(metricTreeParams().read(p)) { compile(); }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
@@ -107,7 +118,6 @@ public:
     }
 
     void resize(glm::ivec2 resolution) override {
-        resolution_ = resolution;
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         triangleTests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         fruitless_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
@@ -115,15 +125,11 @@ public:
     }
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
-        params_ = p;
-        if (change == ParamChange::Rebuild) compile(); // setScene() follows a Rebuild
+        p_ = metricTreeParams().read(p);
+        if (change == ParamChange::Recompile) compile();  // a Rebuild (the clustering) is followed by setScene()
     }
 
     void computeVisibility(const FrameInputs& f) override {
-        if (!scene_) throw RuntimeError("metric_tree: computeVisibility() before setScene()");
-        if (f.light.type != LightType::Point && f.light.type != LightType::Directional)
-            throw RuntimeError(std::string("metric_tree supports point and directional lights, not ") + toString(f.light.type));
-        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
         setUniforms(f.light);
         bind();
 
@@ -132,7 +138,7 @@ public:
         if (clusterCount_ > 0) {
             dispatchPerCluster(prepare_);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-            if (params_.getEnum("tree_builder") == "cpu") {
+            if (p_.treeBuilder == "cpu") {
                 buildOnCpu(f.light);
             } else {
                 dispatchPerCluster(insert_);
@@ -197,15 +203,12 @@ public:
 
 private:
     void compile() {
-        auto flag = [&](const char* key) { return params_.getBool(key) ? std::string("1") : std::string("0"); };
-        const ShaderDefines defines = {{"MT_SLABS", flag("slabs")},
-                                       {"MT_OVERLAP_INTERVAL", flag("overlap_interval")},
-                                       {"MT_DEPTH_SKIP", flag("depth_skip")},
-                                       {"MT_NORMAL_CONE_CULLING", flag("normal_cone_culling")},
-                                       {"MT_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
-        // Rebuild-only parameters (scene structures, buffers) leave the programs as they are.
-        if (defines == compiledDefines_) return;
-        compiledDefines_ = defines;
+        auto flag = [](bool on) { return on ? std::string("1") : std::string("0"); };
+        const ShaderDefines defines = {{"MT_SLABS", flag(p_.slabs)},
+                                       {"MT_OVERLAP_INTERVAL", flag(p_.overlapInterval)},
+                                       {"MT_DEPTH_SKIP", flag(p_.depthSkip)},
+                                       {"MT_NORMAL_CONE_CULLING", flag(p_.normalConeCulling)},
+                                       {"MT_STACK_SIZE", std::to_string(p_.stackSize)}};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
         insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
@@ -215,13 +218,13 @@ private:
     mt::Clustering cluster(const Scene& scene) {
         const auto start = std::chrono::steady_clock::now();
         mt::ClusteringOptions o;
-        o.clusterSize = params_.getInt("cluster_size");
-        o.chunkTriangles = params_.getInt("chunk_triangles");
-        o.kmeansIterations = params_.getInt("kmeans_iterations");
-        o.capsules = params_.getBool("capsules");
-        o.randomOrder = params_.getBool("random_order");
-        o.seed = uint32_t(params_.getInt("seed"));
-        const std::string dir = params_.getBool("cache") ? mt::cacheDirectory() : std::string();
+        o.clusterSize = p_.clusterSize;
+        o.chunkTriangles = p_.chunkTriangles;
+        o.kmeansIterations = p_.kmeansIterations;
+        o.capsules = p_.capsules;
+        o.randomOrder = p_.randomOrder;
+        o.seed = uint32_t(p_.seed);
+        const std::string dir = p_.cache ? mt::cacheDirectory() : std::string();
         const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
         const std::string path = dir.empty() ? std::string() : mt::cacheFile(dir, hash, o);
         const size_t n = scene.triangleCount();
@@ -274,7 +277,7 @@ private:
         }
         prepare_.set("uDepthTolerance", tolerance);
         insert_.set("uDelta0", delta0);
-        query_.set("uRayOffset", float(params_.getFloat("ray_offset")) * radius);
+        query_.set("uRayOffset", p_.rayOffset * radius);
         query_.set("uSlabTolerance", tolerance);
     }
 
@@ -287,8 +290,8 @@ private:
         mt::CpuTreeOptions o;
         o.directional = light.type == LightType::Directional;
         o.lsEps = lsEps_;
-        o.overlapInterval = params_.getBool("overlap_interval");
-        o.depthSkip = params_.getBool("depth_skip");
+        o.overlapInterval = p_.overlapInterval;
+        o.depthSkip = p_.depthSkip;
         const uint32_t root = mt::buildCpuTree(nodes, o);
         uint32_t inserted = 0, culled = 0;
         for (const mt::NodeGpu& nd : nodes) (nd.flags & MT_NODE_CULLED ? culled : inserted) += 1;
@@ -298,11 +301,9 @@ private:
         counters_.upload(head, sizeof head);
     }
 
-    ParamValues params_;
+    MetricTreeParams p_;
     const SceneGpu* scene_ = nullptr;
-    glm::ivec2 resolution_{0, 0};
     ShaderProgram prepare_, insert_, query_;
-    ShaderDefines compiledDefines_; ///< what the programs were built with
     GlBuffer clusters_, nodes_;
     GpuCounters<MT_COUNTER_WORDS> counters_;
     std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;

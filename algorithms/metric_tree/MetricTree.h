@@ -6,7 +6,7 @@
 // with atomics (stage `build`); a second one walks it per G-buffer point and tests the triangles of
 // the clusters whose cone holds the point (stage `traverse`). Exact hard shadows for point and
 // directional lights. Design, parameters and measurements: docs/algorithms/metric_tree.md.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 namespace shadowlab {
 

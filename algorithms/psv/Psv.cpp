@@ -1,6 +1,7 @@
 #include "algorithms/psv/Psv.h"
 
-#include "algorithms/AlgorithmSupport.h"
+#include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/SharedParams.h"
 #include "algorithms/psv/PsvGpuLayout.h"
 #include "algorithms/psv/PsvPermutation.h"
 #include "framework/core/Error.h"
@@ -14,39 +15,46 @@
 namespace shadowlab {
 namespace {
 
-const ParamSchema& psvSchema() {
-    static const ParamSchema s = ParamSchema()
-        .boolean("wedge", true,
+struct PsvParams {
+    bool wedge, randomOrder, frontFaceCulling, depthSkip, transparency;
+    int seed;        ///< of the insertion order
+    int stackSize;   ///< query stack, nodes
+    float rayOffset; ///< × scene radius
+};
+
+const ParamStruct<PsvParams>& psvParams() {
+    using P = PsvParams;
+    static const ParamStruct<P> s = ParamStruct<P>()
+        .boolean("wedge", &P::wedge, true,
                  "wedge optimisation (paper 3.5): an intersection child is visited only inside its wedge",
-                 ParamChange::Rebuild)
-        .boolean("random_order", true,
+                 ParamChange::Recompile)
+        .boolean("random_order", &P::randomOrder, true,
                  "merge triangles in a seeded pseudo-random order (paper 3.3) instead of scene order",
-                 ParamChange::Rebuild)
-        .integer("seed", 1, 0, INT_MAX, "", "seed of the insertion order (with random_order)", ParamChange::Update)
+                 ParamChange::Recompile)
+        .integer("seed", &P::seed, 1, 0, INT_MAX, "", "seed of the insertion order (with random_order)", ParamChange::Update)
         // Off by default: it is exact only for closed, consistently wound meshes (a ground plane
         // facing the light is dropped, fine; an open mesh would leak light through its back).
-        .boolean("front_face_culling", false,
+        .boolean("front_face_culling", &P::frontFaceCulling, false,
                  "only triangles facing away from the light cast (paper 4.2); exact for closed meshes only",
-                 ParamChange::Rebuild)
-        .boolean("depth_skip", true,
+                 ParamChange::Recompile)
+        .boolean("depth_skip", &P::depthSkip, true,
                  "skip a capping node's subtree when the point is nearer the light than all of it (Mora et al. 2016)",
-                 ParamChange::Rebuild)
-        .integer("stack_size", 32, 1, 256, "nodes",
-                 "query stack; a pixel that overflows it is written shadowed and counted", ParamChange::Rebuild)
-        .boolean("transparency", false,
+                 ParamChange::Recompile)
+        .apply(stackSizeRow(&P::stackSize, 32))
+        .boolean("transparency", &P::transparency, false,
                  "x-ray shadows (paper 4.3): multiply (1 - opacity) of every frustum containing the point",
-                 ParamChange::Rebuild)
-        // Same key, default and unit as the reference's: the query point is the reference's ray origin.
-        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
-              "query point offset along the surface normal, against self-shadowing", ParamChange::Update);
+                 ParamChange::Recompile)
+        .apply(rayOffsetRow(&P::rayOffset));
     return s;
 }
+
+const ParamSchema& psvSchema() { return psvParams().schema(); }
 
 constexpr GLuint kBuildGroup = 64;  ///< local_size_x of frusta.comp and build.comp
 
 class Psv final : public ShadowAlgorithm {
 public:
-    explicit Psv(const ParamValues& p) : params_(p) { compile(); }
+    explicit Psv(const ParamValues& p) : p_(psvParams().read(p)) { compile(); }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
@@ -56,27 +64,22 @@ public:
         nodes_ = GlBuffer(psv::nodeCount(n) * PSV_NODE_BYTES, nullptr, 0);
         counters_.allocate();
         nodes_.clearUint(0);
-        permutation_ = psv::makePermutation(uint32_t(n), uint32_t(params_.getInt("seed")));
+        permutation_ = psv::makePermutation(uint32_t(n), uint32_t(p_.seed));
     }
 
     void resize(glm::ivec2 resolution) override {
-        resolution_ = resolution;
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
-        params_ = p;
+        p_ = psvParams().read(p);
         // The seed only keys the insertion order's bijection, passed as uniforms each frame.
-        if (scene_) permutation_ = psv::makePermutation(uint32_t(scene_->triangleCount()), uint32_t(p.getInt("seed")));
-        if (change == ParamChange::Rebuild) compile(); // setScene() follows a Rebuild (ShadowAlgorithm.h)
+        if (scene_) permutation_ = psv::makePermutation(uint32_t(scene_->triangleCount()), uint32_t(p_.seed));
+        if (change == ParamChange::Recompile) compile();
     }
 
     void computeVisibility(const FrameInputs& f) override {
-        if (!scene_) throw RuntimeError("psv: computeVisibility() before setScene()");
-        if (f.light.type != LightType::Point && f.light.type != LightType::Directional)
-            throw RuntimeError(std::string("psv supports point and directional lights, not ") + toString(f.light.type));
-        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
         setUniforms(f.light);
 
         f.timer.begin("build");
@@ -139,16 +142,13 @@ public:
 
 private:
     void compile() {
-        auto flag = [&](const char* key) { return params_.getBool(key) ? std::string("1") : std::string("0"); };
-        const ShaderDefines defines = {{"PSV_WEDGE", flag("wedge")},
-                                       {"PSV_RANDOM_ORDER", flag("random_order")},
-                                       {"PSV_FRONT_FACE_CULLING", flag("front_face_culling")},
-                                       {"PSV_DEPTH_SKIP", flag("depth_skip")},
-                                       {"PSV_TRANSPARENCY", flag("transparency")},
-                                       {"PSV_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
-        // Rebuild-only parameters (scene structures, buffers) leave the programs as they are.
-        if (defines == compiledDefines_) return;
-        compiledDefines_ = defines;
+        auto flag = [](bool on) { return on ? std::string("1") : std::string("0"); };
+        const ShaderDefines defines = {{"PSV_WEDGE", flag(p_.wedge)},
+                                       {"PSV_RANDOM_ORDER", flag(p_.randomOrder)},
+                                       {"PSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
+                                       {"PSV_DEPTH_SKIP", flag(p_.depthSkip)},
+                                       {"PSV_TRANSPARENCY", flag(p_.transparency)},
+                                       {"PSV_STACK_SIZE", std::to_string(p_.stackSize)}};
         frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
         build_ = ShaderProgram::compute("psv/build.comp", defines);
         query_ = ShaderProgram::compute("psv/query.comp", defines);
@@ -165,7 +165,7 @@ private:
         if (light.type == LightType::Point) magnitude = std::max(magnitude, glm::length(light.position));
         const float tolerance = 4e-6f * magnitude;
         const glm::vec3 depthOrigin = center - light.direction() * (2.0f * radius);
-        const float rayOffset = float(params_.getFloat("ray_offset")) * radius;
+        const float rayOffset = p_.rayOffset * radius;
         const uint32_t n = uint32_t(scene_->triangleCount());
         for (const ShaderProgram* p : {&frusta_, &build_, &query_}) {
             setLightUniforms(*p, light);
@@ -182,11 +182,9 @@ private:
     /// One invocation per triangle, as a 2D grid when n needs more than 65535 groups of 64.
     void dispatchPerTriangle(const ShaderProgram& p) const { p.dispatchLinear(scene_->triangleCount(), kBuildGroup); }
 
-    ParamValues params_;
+    PsvParams p_;
     const SceneGpu* scene_ = nullptr;
-    glm::ivec2 resolution_{0, 0};
     ShaderProgram frusta_, build_, query_;
-    ShaderDefines compiledDefines_; ///< what the programs were built with
     GlBuffer nodes_;
     GpuCounters<PSV_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;

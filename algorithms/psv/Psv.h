@@ -5,7 +5,7 @@
 // shadows for point and directional lights, with the paper's wedge optimisation, random insertion
 // order, front-face culling, x-ray transparency, and the depth skip of Mora et al. 2016.
 // Design, parameters and measurements: docs/algorithms/psv.md.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 namespace shadowlab {
 

@@ -1,6 +1,7 @@
 #include "algorithms/ptsv/Ptsv.h"
 
-#include "algorithms/AlgorithmSupport.h"
+#include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/SharedParams.h"
 #include "algorithms/ptsv/PtsvLayout.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
@@ -14,61 +15,73 @@
 namespace shadowlab {
 namespace {
 
-const ParamSchema& ptsvSchema() {
-    static const ParamSchema s = ParamSchema()
-        .choice("bounds", "explicit", {"explicit", "implicit"},
+struct PtsvParams {
+    std::string bounds;      ///< "explicit" | "implicit"
+    bool cullingPlanes, twoPass, frontFaceCulling, jobIterations, heatMap;
+    int splitLevel, tileSize, maxKeyBits, jobCapacity, jobsPerWorkgroup;
+    float planeBias, rayOffset; ///< × scene radius
+    std::string vote;        ///< "auto" | "ballot" | "shared"
+    std::string leafSamples; ///< "tile" | "cluster"
+};
+
+const ParamStruct<PtsvParams>& ptsvParams() {
+    using P = PtsvParams;
+    // Shader variants are Recompile: the per-frame layout (ensureLayout) follows them without a
+    // setScene(). Buffer capacities are Rebuild.
+    static const ParamStruct<P> s = ParamStruct<P>()
+        .choice("bounds", &P::bounds, "explicit", {"explicit", "implicit"},
                 "node bounds: the tight box of its samples (paper 2.1) or the cluster frustum its key implies",
-                ParamChange::Rebuild)
-        .boolean("culling_planes", true,
+                ParamChange::Recompile)
+        .boolean("culling_planes", &P::cullingPlanes, true,
                  "the three additional culling planes through the light and each vertex (paper 2, Figure 4)",
-                 ParamChange::Rebuild)
-        .boolean("two_pass", true,
+                 ParamChange::Recompile)
+        .boolean("two_pass", &P::twoPass, true,
                  "two-pass traversal (paper 2.2): pass one stops at split_level and queues jobs, pass two finishes them",
-                 ParamChange::Rebuild)
-        .integer("split_level", 0, 0, PTSV_MAX_LEVELS, "tree depth",
+                 ParamChange::Recompile)
+        .integer("split_level", &P::splitLevel, 0, 0, PTSV_MAX_LEVELS, "tree depth",
                  "depth L where pass one queues its jobs (root 0, clusters = levels); 0 = levels - 1",
                  ParamChange::Update)
-        .integer("tile_size", 8, 2, 16, "px", "cluster tile width and height (paper: 8)", ParamChange::Rebuild)
+        .integer("tile_size", &P::tileSize, 8, 2, 16, "px", "cluster tile width and height (paper: 8)", ParamChange::Recompile)
         // 22 bits keep the full tree's explicit bounds under 100 MiB (the paper's 1024² needs 24:
         // there slices become 4× deeper than wide).
-        .integer("max_key_bits", 22, 10, PTSV_MAX_KEY_BITS, "bits",
+        .integer("max_key_bits", &P::maxKeyBits, 22, 10, PTSV_MAX_KEY_BITS, "bits",
                  "cluster key length cap: beyond it depth slices are merged in pairs (bounds memory 24 B × 2^bits)",
                  ParamChange::Rebuild)
         // Off by default: it is exact only for closed, consistently wound meshes (as in psv).
-        .boolean("front_face_culling", false,
+        .boolean("front_face_culling", &P::frontFaceCulling, false,
                  "only triangles facing away from the light cast; exact for closed meshes only",
-                 ParamChange::Rebuild)
+                 ParamChange::Recompile)
         // 0 by default: the samples already sit ray_offset in front of their own triangle (the
         // reference's convention), and any bias lights receivers just behind a caster (measured on
         // the demo: 1e-6 adds 8 lit pixels to its 60 frames).
-        .real("plane_bias", 0.0, 0.0, 1e-3, "× scene radius",
+        .real("plane_bias", &P::planeBias, 0.0, 0.0, 1e-3, "× scene radius",
               "triangle plane moved away from the light when front faces cast (paper 2), against self-shadowing",
               ParamChange::Update)
-        // Same key, default and unit as the reference's: the samples are the reference's ray origins.
-        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
-              "sample offset along the surface normal, against self-shadowing", ParamChange::Update)
-        .integer("job_capacity", 1 << 20, 1, 1 << 24, "jobs",
+        .apply(rayOffsetRow(&P::rayOffset))
+        .integer("job_capacity", &P::jobCapacity, 1 << 20, 1, 1 << 24, "jobs",
                  "two-pass job list; jobs that find it full are finished by pass one (counted in overflow)",
                  ParamChange::Rebuild)
-        .integer("jobs_per_workgroup", 1, 1, 64, "jobs",
+        .integer("jobs_per_workgroup", &P::jobsPerWorkgroup, 1, 1, 64, "jobs",
                  "consecutive jobs one traversal workgroup runs in turn (the paper's persistent threads run "
                  "until the queue is empty; bounded here by llvmpipe's per-invocation loop cap)",
-                 ParamChange::Rebuild)
-        .choice("vote", "auto", {"auto", "ballot", "shared"},
+                 ParamChange::Recompile)
+        .choice("vote", &P::vote, "auto", {"auto", "ballot", "shared"},
                 "how a node's 32 children are tested together: ballot (ARB_shader_ballot: one subgroup, each "
                 "invocation testing 32 / width children, no barrier), shared (32 invocations, shared memory and a "
                 "barrier per node), auto (ballot where the driver has it)",
-                ParamChange::Rebuild)
-        .choice("leaf_samples", "tile", {"tile", "cluster"},
+                ParamChange::Recompile)
+        .choice("leaf_samples", &P::leafSamples, "tile", {"tile", "cluster"},
                 "samples tested at a leaf: the whole tile (paper) or only the cluster's (its key compared first)",
-                ParamChange::Rebuild)
-        .boolean("job_iterations", false,
+                ParamChange::Recompile)
+        .boolean("job_iterations", &P::jobIterations, false,
                  "record every job's traversal iterations and report the mean of the 1024 largest (Figure 7)",
-                 ParamChange::Rebuild)
-        .boolean("heat_map", false, "count test-and-set operations per pixel (debug view, costs one atomic per test)",
-                 ParamChange::Rebuild);
+                 ParamChange::Recompile)
+        .boolean("heat_map", &P::heatMap, false,
+                 "count test-and-set operations per pixel (debug view, costs one atomic per test)", ParamChange::Recompile);
     return s;
 }
+
+const ParamSchema& ptsvSchema() { return ptsvParams().schema(); }
 
 constexpr GLuint kSetupGroup = 64;   ///< local_size_x of setup.comp and reduce.comp
 constexpr GLuint kMaxGroups = 65535; ///< GL's minimum max work group count per dimension
@@ -78,7 +91,7 @@ enum Vote { kVoteShared = 0, kVoteBallot = 1 };
 
 class Ptsv final : public ShadowAlgorithm {
 public:
-    explicit Ptsv(const ParamValues& p) : params_(p) {
+    explicit Ptsv(const ParamValues& p) : p_(ptsvParams().read(p)) {
         subgroupSize_ = querySubgroupSize();
         compile();
     }
@@ -100,24 +113,19 @@ public:
     }
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
-        params_ = p;
-        if (change != ParamChange::Rebuild) return;
-        compile();
-        layoutKey_ = {};
+        p_ = ptsvParams().read(p);
+        if (change == ParamChange::Recompile) compile();
+        if (change != ParamChange::Update) layoutKey_ = {};  // buffers follow at the next frame
     }
 
     void computeVisibility(const FrameInputs& f) override {
-        if (!scene_) throw RuntimeError("ptsv: computeVisibility() before setScene()");
-        if (f.light.type != LightType::Point && f.light.type != LightType::Directional)
-            throw RuntimeError(std::string("ptsv supports point and directional lights, not ") + toString(f.light.type));
-        if (f.gbuffer.resolution() != resolution_) resize(f.gbuffer.resolution());
         ensureLayout(f.camera);
         setUniforms(f.camera, f.light);
         bindAll();
 
         f.timer.begin("hierarchy");
         counters_.clear();
-        if (params_.getBool("job_iterations")) jobIterations_.clearUint(0);
+        if (p_.jobIterations) jobIterations_.clearUint(0);
         glClearNamedBufferSubData(masks_.id(), GL_R32UI, 0, GLsizeiptr(layout_.maskWords * 4), GL_RED_INTEGER,
                                   GL_UNSIGNED_INT, nullptr);
         glBindTextureUnit(0, f.gbuffer.position());
@@ -146,13 +154,13 @@ public:
         f.timer.begin("traverse");
         if (n > 0) {
             // One workgroup per batch of triangles, as a 2D grid past 65535.
-            const size_t perGroup = size_t(params_.getInt("jobs_per_workgroup"));
+            const size_t perGroup = size_t(p_.jobsPerWorkgroup);
             const size_t groups = (n + perGroup - 1) / perGroup;
             const GLuint gx = GLuint(std::min<size_t>(groups, kMaxGroups)), gy = GLuint((groups + gx - 1) / gx);
             pass1_.use();
             glDispatchCompute(gx, gy, 1);
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-            if (params_.getBool("two_pass")) {
+            if (p_.twoPass) {
                 jobArgs_.use();
                 glDispatchCompute(1, 1, 1);
                 glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
@@ -180,14 +188,14 @@ public:
         static_assert(PTSV_C_TESTS_HI == PTSV_C_TESTS_LO + 1 && PTSV_C_NODE_TESTS_HI == PTSV_C_NODE_TESTS_LO + 1);
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double jobs1 = c[PTSV_C_JOBS_1];
-        const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(params_.getInt("job_capacity")));
+        const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(p_.jobCapacity));
         std::vector<Counter> out = {{"test_and_set", wide(PTSV_C_TESTS_LO)},
                 {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
                 {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
                 {"iterations_mean_pass1", jobs1 > 0 ? c[PTSV_C_ITER_SUM_1] / jobs1 : 0.0},
                 {"iterations_max_pass2", double(c[PTSV_C_ITER_MAX_2])},
                 {"iterations_mean_pass2", pushed > 0 ? c[PTSV_C_ITER_SUM_2] / pushed : 0.0},
-                {"jobs", params_.getBool("two_pass") ? pushed : 0.0},
+                {"jobs", p_.twoPass ? pushed : 0.0},
                 {"job_overflow", double(c[PTSV_C_JOB_OVERFLOW])},
                 {"truncated_jobs", double(c[PTSV_C_TRUNCATED])},
                 {"accepted_nodes", double(c[PTSV_C_ACCEPTED])},
@@ -201,11 +209,11 @@ public:
                 {"tree_levels", double(layout_.levels)},
                 {"key_bits", double(layout_.keyBits)},
                 {"slices_merged", double(layout_.merged)},
-                {"split_depth", params_.getBool("two_pass") ? double(splitDepth()) : 0.0},
+                {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
                 {"vote_path", double(vote_)},
                 {"traversal_lanes", double(lanes_)},
                 {"subgroup_size", double(subgroupSize_)}};
-        if (params_.getBool("job_iterations")) {
+        if (p_.jobIterations) {
             // Figure 7: the jobs that keep a multiprocessor busy longest, against the average.
             const size_t n = scene_ ? scene_->triangleCount() : 0;
             std::vector<uint32_t> it = jobIterations_.read<uint32_t>(n + size_t(pushed));
@@ -224,7 +232,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
-        if (!params_.getBool("heat_map")) return {};
+        if (!p_.heatMap) return {};
         return {{"tests_per_pixel", heat_.id(), 0.0f, "test-and-set"}};
     }
 
@@ -248,7 +256,7 @@ public:
 
 private:
     int splitDepth() const {
-        const int l = params_.getInt("split_level");
+        const int l = p_.splitLevel;
         return l == 0 ? std::max(1, layout_.levels - 1) : std::min(l, layout_.levels);
     }
 
@@ -256,27 +264,24 @@ private:
         // The ballot path needs the workgroup to be one subgroup: widths dividing 32 give
         // 32 / width children per invocation; wider subgroups run 32 invocations in one.
         const bool ballotUsable = subgroupSize_ >= 32 || (subgroupSize_ > 0 && 32 % subgroupSize_ == 0);
-        const std::string vote = params_.getEnum("vote");
+        const std::string vote = p_.vote;
         if (vote == "ballot" && !ballotUsable)
             throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width dividing 32 or "
                                "above it (this context: " + std::to_string(subgroupSize_) + ")");
         vote_ = vote != "shared" && ballotUsable ? kVoteBallot : kVoteShared;
         lanes_ = vote_ == kVoteBallot ? std::min(subgroupSize_, 32) : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
-        ShaderDefines defines = {{"PTSV_TILE", std::to_string(params_.getInt("tile_size"))},
-                                 {"PTSV_EXPLICIT_BOUNDS", flag(params_.getEnum("bounds") == "explicit")},
-                                 {"PTSV_CULLING_PLANES", flag(params_.getBool("culling_planes"))},
-                                 {"PTSV_TWO_PASS", flag(params_.getBool("two_pass"))},
-                                 {"PTSV_FRONT_FACE_CULLING", flag(params_.getBool("front_face_culling"))},
-                                 {"PTSV_LEAF_CLUSTER_ONLY", flag(params_.getEnum("leaf_samples") == "cluster")},
-                                 {"PTSV_HEAT_MAP", flag(params_.getBool("heat_map"))},
-                                 {"PTSV_JOB_ITERATIONS", flag(params_.getBool("job_iterations"))},
+        ShaderDefines defines = {{"PTSV_TILE", std::to_string(p_.tileSize)},
+                                 {"PTSV_EXPLICIT_BOUNDS", flag(p_.bounds == "explicit")},
+                                 {"PTSV_CULLING_PLANES", flag(p_.cullingPlanes)},
+                                 {"PTSV_TWO_PASS", flag(p_.twoPass)},
+                                 {"PTSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
+                                 {"PTSV_LEAF_CLUSTER_ONLY", flag(p_.leafSamples == "cluster")},
+                                 {"PTSV_HEAT_MAP", flag(p_.heatMap)},
+                                 {"PTSV_JOB_ITERATIONS", flag(p_.jobIterations)},
                                  {"PTSV_BALLOT", flag(vote_ == kVoteBallot)},
                                  {"PTSV_LANES", std::to_string(lanes_)},
-                                 {"PTSV_JOBS_PER_GROUP", std::to_string(params_.getInt("jobs_per_workgroup"))}};
-        // Rebuild-only parameters (scene structures, buffers) leave the programs as they are.
-        if (defines == compiledDefines_) return;
-        compiledDefines_ = defines;
+                                 {"PTSV_JOBS_PER_GROUP", std::to_string(p_.jobsPerWorkgroup)}};
         hierarchy_ = ShaderProgram::compute("ptsv/hierarchy.comp", defines);
         reduce_ = ShaderProgram::compute("ptsv/reduce.comp", defines);
         setup_ = ShaderProgram::compute("ptsv/setup.comp", defines);
@@ -293,13 +298,13 @@ private:
     /// (re)allocated when one of them changes.
     void ensureLayout(const Camera& camera) {
         const std::array<float, 6> key = {float(resolution_.x), float(resolution_.y), camera.fovYDeg, camera.nearPlane,
-                                          camera.farPlane, float(params_.getInt("tile_size"))};
+                                          camera.farPlane, float(p_.tileSize)};
         if (key == layoutKey_ && masks_) return;
         layoutKey_ = key;
-        const int tile = params_.getInt("tile_size");
+        const int tile = p_.tileSize;
         layout_ = ptsv::makeKeyLayout(resolution_, tile, camera.fovYDeg, camera.nearPlane, camera.farPlane,
-                                      params_.getInt("max_key_bits"));
-        const bool explicitBounds = params_.getEnum("bounds") == "explicit";
+                                      p_.maxKeyBits);
+        const bool explicitBounds = p_.bounds == "explicit";
         const size_t boundsBytes = explicitBounds ? layout_.boundsNodes * 6 * sizeof(float) : 4;
         if (boundsBytes > maxShaderStorageBlockBytes())
             throw RuntimeError("ptsv: explicit bounds of a full tree with " + std::to_string(layout_.keyBits) +
@@ -312,11 +317,11 @@ private:
         samples_ = GlBuffer(slots * 16, nullptr, 0);
         keys_ = GlBuffer(slots * 4, nullptr, 0);
         shadow_ = GlBuffer(slots * 4, nullptr, 0);
-        heatCounts_ = GlBuffer(params_.getBool("heat_map") ? slots * 4 : 4, nullptr, 0);
-        jobs_ = GlBuffer(params_.getBool("two_pass") ? size_t(params_.getInt("job_capacity")) * 8 : 8, nullptr, 0);
-        const size_t jobSlots = scene_->triangleCount() + (params_.getBool("two_pass") ? size_t(params_.getInt("job_capacity")) : 0);
+        heatCounts_ = GlBuffer(p_.heatMap ? slots * 4 : 4, nullptr, 0);
+        jobs_ = GlBuffer(p_.twoPass ? size_t(p_.jobCapacity) * 8 : 8, nullptr, 0);
+        const size_t jobSlots = scene_->triangleCount() + (p_.twoPass ? size_t(p_.jobCapacity) : 0);
         // Zero-filled: a culled triangle (no workgroup writes its slot) counts 0 iterations.
-        jobIterations_ = GlBuffer(params_.getBool("job_iterations") ? std::max<size_t>(jobSlots, 1) * 4 : 4, nullptr, 0);
+        jobIterations_ = GlBuffer(p_.jobIterations ? std::max<size_t>(jobSlots, 1) * 4 : 4, nullptr, 0);
         warnedSplit_ = false;
     }
 
@@ -330,14 +335,14 @@ private:
         float magnitude = glm::length(center) + radius + glm::length(camera.position);
         if (light.type == LightType::Point) magnitude = std::max(magnitude, glm::length(light.position));
         const float tolerance = 4e-6f * magnitude;
-        const float rayOffset = float(params_.getFloat("ray_offset")) * radius;
+        const float rayOffset = p_.rayOffset * radius;
         const float aspect = float(resolution_.x) / float(resolution_.y);
         const float tanHalf = std::tan(glm::radians(camera.fovYDeg) * 0.5f);
         const glm::mat4 view = camera.view();
         const int split = splitDepth();
-        if (params_.getBool("two_pass") && params_.getInt("split_level") > layout_.levels && !warnedSplit_) {
+        if (p_.twoPass && p_.splitLevel > layout_.levels && !warnedSplit_) {
             std::fprintf(stderr, "ptsv: split_level %d is below the %d-level tree: using %d\n",
-                         params_.getInt("split_level"), layout_.levels, split);
+                         p_.splitLevel, layout_.levels, split);
             warnedSplit_ = true;
         }
         for (const ShaderProgram* p : {&hierarchy_, &reduce_, &setup_, &pass1_, &pass2_, &jobArgs_, &resolve_}) {
@@ -359,11 +364,11 @@ private:
             p->set("uTanHalf", glm::vec2(tanHalf * aspect, tanHalf));
         }
         hierarchy_.set("uRayOffset", rayOffset);
-        setup_.set("uPlaneBias", float(params_.getFloat("plane_bias")) * radius);
+        setup_.set("uPlaneBias", p_.planeBias * radius);
         for (const ShaderProgram* p : {&pass1_, &pass2_, &jobArgs_}) {
             p->set("uTriangleCount", unsigned(scene_->triangleCount()));
             p->set("uSplitDepth", split);
-            p->set("uJobCapacity", unsigned(params_.getInt("job_capacity")));
+            p->set("uJobCapacity", unsigned(p_.jobCapacity));
             p->set("uTolerance", tolerance);
             // q lies within |n| ray_offset of the G-buffer point that chose its implicit node, and
             // the 16-bit normal's length is within 1e-3 of 1.
@@ -389,7 +394,7 @@ private:
     /// One invocation per item, as a 2D grid when the count needs more than 65535 groups of 64.
     static void dispatchLinear(const ShaderProgram& p, size_t count) { p.dispatchLinear(count, kSetupGroup); }
 
-    ParamValues params_;
+    PtsvParams p_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     int subgroupSize_ = 0;
@@ -399,7 +404,6 @@ private:
     std::array<float, 6> layoutKey_{};
     bool warnedSplit_ = false;
     ShaderProgram hierarchy_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
-    ShaderDefines compiledDefines_; ///< what the programs were built with
     GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
     GpuCounters<PTSV_COUNTER_WORDS> counters_;
     GlTexture heat_;

@@ -7,7 +7,7 @@
 // passes), and finally shadow the samples of trivially accepted nodes (stage `resolve`). Exact hard
 // shadows for point and directional lights. Design, parameters and measurements:
 // docs/algorithms/ptsv.md.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 namespace shadowlab {
 

@@ -1,7 +1,8 @@
 #include "algorithms/reference/Reference.h"
 
-#include "algorithms/AlgorithmSupport.h"
-#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/SharedParams.h"
+#include "framework/reference/EmbreeTracer.h"
 
 #include <chrono>
 #include <memory>
@@ -9,20 +10,25 @@
 namespace shadowlab {
 namespace {
 
-const ParamSchema& referenceSchema() {
-    static const ParamSchema schema = ParamSchema()
-        .integer("threads", 0, 0, 256, "",
-                 "CPU threads tracing rays (0 = all hardware threads)", ParamChange::Update)
-        // Relative to the scene so one default suits scenes of any scale; 1e-4 of the radius clears
-        // float error of the G-buffer positions without visibly detaching contact shadows.
-        .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
-              "shadow ray origin offset along the surface normal, against self-intersection", ParamChange::Update);
-    return schema;
+struct ReferenceParams {
+    int threads;     ///< 0 = all hardware threads
+    float rayOffset; ///< × scene radius
+};
+
+const ParamStruct<ReferenceParams>& referenceParams() {
+    using P = ReferenceParams;
+    static const ParamStruct<P> s = ParamStruct<P>()
+        .integer("threads", &P::threads, 0, 0, 256, "", "CPU threads tracing rays (0 = all hardware threads)",
+                 ParamChange::Update)
+        .apply(rayOffsetRow(&P::rayOffset));
+    return s;
 }
+
+const ParamSchema& referenceSchema() { return referenceParams().schema(); }
 
 class Reference final : public ShadowAlgorithm {
 public:
-    explicit Reference(const ParamValues& params) { read(params); }
+    explicit Reference(const ParamValues& params) : p_(referenceParams().read(params)) {}
 
     void setScene(const SceneGpu& scene) override {
         tracer_.reset(); // free the old BVH before building the new one
@@ -30,13 +36,13 @@ public:
         sceneRadius_ = scene.bounds().empty() ? 1.0f : scene.bounds().radius();
     }
 
-    void paramsChanged(const ParamValues& params, ParamChange) override { read(params); }
+    void paramsChanged(const ParamValues& params, ParamChange) override { p_ = referenceParams().read(params); }
 
     void computeVisibility(const FrameInputs& frame) override {
         const CpuGBuffer& g = frame.cpuGBuffer();
         frame.timer.begin("trace", false); // CPU stage: no GPU query
         auto t0 = std::chrono::steady_clock::now();
-        tracer_->traceVisibility(g, frame.light, rayOffset_ * sceneRadius_, threads_, visibility_);
+        tracer_->traceVisibility(g, frame.light, p_.rayOffset * sceneRadius_, p_.threads, visibility_);
         double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         frame.timer.end();
         rays_ = double(tracer_->lastRayCount());
@@ -54,15 +60,9 @@ public:
     const std::vector<float>& lastVisibility() const { return visibility_; }
 
 private:
-    void read(const ParamValues& params) {
-        threads_ = params.getInt("threads");
-        rayOffset_ = float(params.getFloat("ray_offset"));
-    }
-
     std::unique_ptr<EmbreeTracer> tracer_;
     float sceneRadius_ = 1.0f;
-    int threads_ = 0;
-    float rayOffset_ = 1e-4f;
+    ReferenceParams p_;
     std::vector<float> visibility_;
     double rays_ = 0, mraysPerS_ = 0;
 };

@@ -1,7 +1,7 @@
 #pragma once
 // `reference`: exact shadows ray-traced on the CPU with Embree 3 (EmbreeTracer), the ground truth
 // every other algorithm is measured against. See EmbreeTracer.h for the visibility convention.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 namespace shadowlab {
 

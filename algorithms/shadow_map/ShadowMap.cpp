@@ -1,7 +1,6 @@
 #include "algorithms/shadow_map/ShadowMap.h"
 
-#include "algorithms/AlgorithmSupport.h"
-#include "framework/core/Error.h"
+#include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/render/LightUniforms.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -9,17 +8,27 @@
 namespace shadowlab {
 namespace {
 
-const ParamSchema& schema() {
-    static const ParamSchema s = ParamSchema()
-        .integer("resolution", 2048, 64, 8192, "texels", "side of the shadow map (of each cube face for point lights)",
-                 ParamChange::Rebuild)
-        .real("bias_constant", 0.002, 0.0, 0.1, "× scene radius", "depth bias added to every comparison",
+struct ShadowMapParams {
+    int resolution;     ///< texels per side (per cube face)
+    float biasConstant; ///< × scene radius
+    float biasSlope;    ///< × texel size × tan θ
+    int pcf;            ///< kernel radius, texels
+};
+
+const ParamStruct<ShadowMapParams>& params() {
+    using P = ShadowMapParams;
+    static const ParamStruct<P> s = ParamStruct<P>()
+        .integer("resolution", &P::resolution, 2048, 64, 8192, "texels",
+                 "side of the shadow map (of each cube face for point lights)", ParamChange::Rebuild)
+        .real("bias_constant", &P::biasConstant, 0.002, 0.0, 0.1, "× scene radius", "depth bias added to every comparison",
               ParamChange::Update)
-        .real("bias_slope", 1.5, 0.0, 20.0, "× texel size × tan θ",
+        .real("bias_slope", &P::biasSlope, 1.5, 0.0, 20.0, "× texel size × tan θ",
               "slope-scaled bias: grows with the receiver's angle to the light", ParamChange::Update)
-        .integer("pcf", 1, 0, 7, "texels", "PCF kernel radius: 0 = hard, k = (2k+1)² taps", ParamChange::Update);
+        .integer("pcf", &P::pcf, 1, 0, 7, "texels", "PCF kernel radius: 0 = hard, k = (2k+1)² taps", ParamChange::Update);
     return s;
 }
+
+const ParamSchema& schema() { return params().schema(); }
 
 // Cube face view matrices in GL's face order (+X, -X, +Y, -Y, +Z, -Z).
 const glm::vec3 kFaceDir[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
@@ -27,7 +36,7 @@ const glm::vec3 kFaceUp[6] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0,
 
 class ShadowMap : public ShadowAlgorithm {
 public:
-    explicit ShadowMap(const ParamValues& p) : params_(p) {
+    explicit ShadowMap(const ParamValues& p) : p_(params().read(p)) {
         depthProgram_ = ShaderProgram::graphics("shadow_map/depth.vert", "shadow_map/depth.frag");
         lookup2D_ = ShaderProgram::compute("shadow_map/lookup.comp", {{"CUBE", "0"}});
         lookupCube_ = ShaderProgram::compute("shadow_map/lookup.comp", {{"CUBE", "1"}});
@@ -38,18 +47,16 @@ public:
         allocate();
     }
 
-    void paramsChanged(const ParamValues& p, ParamChange change) override {
-        params_ = p;
-        if (change == ParamChange::Rebuild && scene_) allocate();
+    void paramsChanged(const ParamValues& p, ParamChange) override {
+        p_ = params().read(p);  // a Rebuild (resolution) is followed by setScene(), which reallocates
     }
 
     void computeVisibility(const FrameInputs& f) override {
         const Light& light = f.light;
-        if (light.type == LightType::Area) throw RuntimeError("shadow_map does not support area lights");
         const bool cube = light.type == LightType::Point;
         const float radius = scene_->bounds().radius();
         const glm::vec3 center = scene_->bounds().center();
-        int res = params_.getInt("resolution");
+        const int res = p_.resolution;
         ensureTargets(cube);
 
         f.timer.begin("shadow_pass");
@@ -105,11 +112,11 @@ public:
         setLightUniforms(p, light);
         p.set("uLightViewProj", lightViewProj);
         p.set("uDirectionalOrigin", center - light.direction() * (2.0f * radius));
-        p.set("uBiasConstant", float(params_.getFloat("bias_constant")) * radius);
-        p.set("uBiasSlope", float(params_.getFloat("bias_slope")));
+        p.set("uBiasConstant", p_.biasConstant * radius);
+        p.set("uBiasSlope", p_.biasSlope);
         p.set("uTexelAngle", texelAngle);
         p.set("uOrthoTexel", orthoTexel);
-        p.set("uPcf", params_.getInt("pcf"));
+        p.set("uPcf", p_.pcf);
         p.set("uMapSize", float(res));
         glBindTextureUnit(0, f.gbuffer.position());
         glBindTextureUnit(1, f.gbuffer.normal());
@@ -121,7 +128,7 @@ public:
     }
 
     size_t memoryBytes() const override {
-        size_t r = size_t(params_.getInt("resolution"));
+        size_t r = size_t(p_.resolution);
         // distance (R32F) + depth (32F): 8 bytes per texel, on one 2D map and/or six cube faces
         return r * r * 8 * ((map2D_ ? 1 : 0) + (cubeMap_ ? 6 : 0));
     }
@@ -135,7 +142,7 @@ private:
     }
 
     void ensureTargets(bool cube) {
-        int r = params_.getInt("resolution");
+        const int r = p_.resolution;
         GLuint fbo = 0;
         if (cube && !cubeMap_) {
             GLuint tex[2];
@@ -163,7 +170,7 @@ private:
         }
     }
 
-    ParamValues params_;
+    ShadowMapParams p_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram depthProgram_, lookup2D_, lookupCube_;
     GlTexture map2D_, depth2D_, cubeMap_, cubeDepth_;

@@ -1,5 +1,5 @@
 // shadowlab: the headless command line. One binary per GL back end (OSMesa, EGL) links this file.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
 #include "framework/experiment/Config.h"
@@ -59,7 +59,7 @@ void printList(bool json) {
                 for (const auto& c : s.choices) std::cout << " " << c;
             }
             if (!s.unit.empty()) std::cout << ", " << s.unit;
-            std::cout << ", " << (s.change == ParamChange::Rebuild ? "rebuild" : "update") << ")\n      " << s.doc << "\n";
+            std::cout << ", " << toString(s.change) << ")\n      " << s.doc << "\n";
         }
     }
 }

@@ -15,6 +15,15 @@ const char* toString(ParamType t) {
     return "?";
 }
 
+const char* toString(ParamChange c) {
+    switch (c) {
+    case ParamChange::Update: return "update";
+    case ParamChange::Recompile: return "recompile";
+    case ParamChange::Rebuild: return "rebuild";
+    }
+    return "?";
+}
+
 std::string toString(const ParamValue& v) {
     struct V {
         std::string operator()(bool b) const { return b ? "true" : "false"; }
@@ -66,7 +75,7 @@ Json ParamSchema::toJson() const {
     Json out = Json::array();
     for (const auto& s : specs_) {
         Json j = {{"key", s.key}, {"type", toString(s.type)}, {"default", valueToJson(s.def)}, {"doc", s.doc},
-                  {"change", s.change == ParamChange::Rebuild ? "rebuild" : "update"}};
+                  {"change", toString(s.change)}};
         if (s.type == ParamType::Int || s.type == ParamType::Float) j["range"] = {s.min, s.max};
         if (!s.unit.empty()) j["unit"] = s.unit;
         if (s.type == ParamType::Enum) j["choices"] = s.choices;
@@ -107,10 +116,6 @@ const ParamValue& ParamValues::get(const std::string& key) const {
     return it->second;
 }
 
-bool ParamValues::getBool(const std::string& key) const { return std::get<bool>(get(key)); }
-int ParamValues::getInt(const std::string& key) const { return std::get<int>(get(key)); }
-double ParamValues::getFloat(const std::string& key) const { return std::get<double>(get(key)); }
-const std::string& ParamValues::getEnum(const std::string& key) const { return std::get<std::string>(get(key)); }
 
 void ParamValues::set(const std::string& key, const ParamValue& value) { setJson(key, valueToJson(value)); }
 

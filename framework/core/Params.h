@@ -3,8 +3,10 @@
 // config validation, `shadowlab list`, results metadata, docs and the GUI panel all read it.
 #include "framework/core/JsonNode.h"
 
+#include <functional>
 #include <map>
 #include <string>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -12,8 +14,12 @@ namespace shadowlab {
 
 enum class ParamType { Bool, Int, Float, Enum };
 
-/// What a change of the parameter costs: re-running setScene()/resources, or only new uniforms.
-enum class ParamChange { Rebuild, Update };
+/// What a change of the parameter costs, cheapest first: new uniforms only (Update); new shader
+/// programs, the structures kept (Recompile: shader #defines); re-running setScene() and resize()
+/// (Rebuild: per-scene structures, buffer sizes). A host applies the costliest kind among the
+/// keys that changed (AlgorithmHost::setParams).
+enum class ParamChange { Update, Recompile, Rebuild };
+const char* toString(ParamChange c);
 
 using ParamValue = std::variant<bool, int, double, std::string>;
 
@@ -26,6 +32,8 @@ struct ParamSpec {
     std::string doc;                  ///< one line: what it does
     std::vector<std::string> choices; ///< accepted values (Enum)
     ParamChange change = ParamChange::Update;
+    /// Stores the value into the member of a typed params struct it was declared with (ParamStruct).
+    std::function<void(void* params, const ParamValue& value)> assign;
 };
 
 class ParamSchema {
@@ -38,6 +46,8 @@ public:
                         ParamChange change);
 
     const std::vector<ParamSpec>& specs() const { return specs_; }
+    /// Sets how the last row declared is stored into a typed struct (used by ParamStruct).
+    void bindLast(std::function<void(void*, const ParamValue&)> assign) { specs_.back().assign = std::move(assign); }
     const ParamSpec* find(const std::string& key) const;
 
     /// Schema as JSON (for `list --json` and results).
@@ -57,11 +67,6 @@ public:
     /// values are InputErrors naming their JSON path. Missing keys take their defaults.
     static ParamValues parse(const ParamSchema& schema, JsonNode node);
 
-    bool getBool(const std::string& key) const;
-    int getInt(const std::string& key) const;
-    double getFloat(const std::string& key) const;
-    const std::string& getEnum(const std::string& key) const;
-
     /// Sets one value; throws InputError when the key is unknown or the value invalid for its spec.
     void set(const std::string& key, const ParamValue& value);
     /// The same from a JSON value, validated exactly as in a config file (type, range, choices).
@@ -79,5 +84,64 @@ private:
 
 std::string toString(const ParamValue& v);
 const char* toString(ParamType t);
+
+/// A typed view of one algorithm's parameters: the schema's rows are declared with the member of
+/// `T` each one fills, so a key, its type, default, range, unit, doc and change kind are written
+/// once, and the algorithm reads plain fields (`params.rayOffset`) instead of strings.
+///
+///   struct PsvParams { bool wedge = true; float rayOffset = 1e-4f; ... };
+///   const ParamStruct<PsvParams>& psvParams() {
+///       static const ParamStruct<PsvParams> s = ParamStruct<PsvParams>()
+///           .boolean("wedge", &PsvParams::wedge, true, "wedge optimisation", ParamChange::Recompile)
+///           .apply(rayOffsetRow<PsvParams>(&PsvParams::rayOffset));   // a shared row
+///       return s;
+///   }
+///   PsvParams p = psvParams().read(values);   // once per change
+template <class T>
+class ParamStruct {
+public:
+    ParamStruct& boolean(std::string key, bool T::*member, bool def, std::string doc, ParamChange change) {
+        schema_.boolean(std::move(key), def, std::move(doc), change);
+        return bind([member](T& t, const ParamValue& v) { t.*member = std::get<bool>(v); });
+    }
+    ParamStruct& integer(std::string key, int T::*member, int def, int min, int max, std::string unit, std::string doc,
+                         ParamChange change) {
+        schema_.integer(std::move(key), def, min, max, std::move(unit), std::move(doc), change);
+        return bind([member](T& t, const ParamValue& v) { t.*member = std::get<int>(v); });
+    }
+    /// A real stored as a float (what reaches a shader) or a double.
+    template <class F>
+    ParamStruct& real(std::string key, F T::*member, double def, double min, double max, std::string unit, std::string doc,
+                      ParamChange change) {
+        static_assert(std::is_floating_point_v<F>);
+        schema_.real(std::move(key), def, min, max, std::move(unit), std::move(doc), change);
+        return bind([member](T& t, const ParamValue& v) { t.*member = F(std::get<double>(v)); });
+    }
+    ParamStruct& choice(std::string key, std::string T::*member, std::string def, std::vector<std::string> choices,
+                        std::string doc, ParamChange change) {
+        schema_.choice(std::move(key), std::move(def), std::move(choices), std::move(doc), change);
+        return bind([member](T& t, const ParamValue& v) { t.*member = std::get<std::string>(v); });
+    }
+    /// Adds rows declared elsewhere once (shared rows such as ray_offset), `row(*this)`.
+    template <class Row> ParamStruct& apply(Row row) {
+        row(*this);
+        return *this;
+    }
+
+    const ParamSchema& schema() const { return schema_; }
+    /// The values as a T: every member declared here is set.
+    T read(const ParamValues& values) const {
+        T out{};
+        for (const ParamSpec& s : schema_.specs()) s.assign(&out, values.get(s.key));
+        return out;
+    }
+
+private:
+    ParamStruct& bind(std::function<void(T&, const ParamValue&)> set) {
+        schema_.bindLast([set](void* p, const ParamValue& v) { set(*static_cast<T*>(p), v); });
+        return *this;
+    }
+    ParamSchema schema_;
+};
 
 } // namespace shadowlab

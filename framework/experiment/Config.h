@@ -2,7 +2,7 @@
 // An experiment config (see docs/config.md): scene, camera and light paths, algorithm entries,
 // outputs. Parsing is strict: unknown keys are errors naming their JSON path; missing keys take
 // defaults; `resolved` holds every value actually used (written as config.resolved.json).
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 #include "framework/scene/Scene.h"
 #include "framework/view/Camera.h"
 #include "framework/view/Light.h"

@@ -1,5 +1,6 @@
 #include "framework/experiment/Runner.h"
 
+#include "framework/algorithm/AlgorithmHost.h"
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
 #include "framework/experiment/OutputPlace.h"
@@ -26,8 +27,7 @@ double msSince(Clock::time_point t) { return std::chrono::duration<double, std::
 
 struct Instance {
     const AlgorithmEntry* entry;
-    std::unique_ptr<ShadowAlgorithm> algorithm;
-    GlTexture visibility;
+    std::unique_ptr<AlgorithmHost> host;
     AlgorithmResults results;
 };
 
@@ -87,15 +87,13 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
 
     std::vector<Instance> instances;
     for (const AlgorithmEntry* e : entries) {
-        Instance inst{e, e->info->create(e->params), makeTexture2D(GL_R32F, res.x, res.y), {}};
+        Instance inst{e, std::make_unique<AlgorithmHost>(*e->info, e->params), {}};
         inst.results.id = e->id;
         inst.results.algorithm = e->info->name;
         inst.results.params = e->params.toJson();
-        auto t = Clock::now();
-        inst.algorithm->setScene(sceneGpu);
-        inst.algorithm->resize(res);
-        glFinish();
-        inst.results.preprocessMs = msSince(t);
+        inst.host->resize(res);
+        inst.host->setScene(sceneGpu);
+        inst.results.preprocessMs = inst.host->preprocessMs();
         instances.push_back(std::move(inst));
     }
 
@@ -119,10 +117,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     std::vector<int> framesWithoutLit;  // accuracy is measured over lit pixels: none, nothing to measure
     Progress progress(opt.progress, size_t(cfg.frames + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
     std::optional<CpuGBuffer> cpuG;
-    auto renderFrame = [&](int frame, const Camera& cam) {
+    auto renderFrame = [&](const Camera& cam) {
         gbuffer.render(sceneGpu, cam);
         cpuG.reset();
-        (void)frame;
     };
     auto getCpuG = [&]() -> const CpuGBuffer& {
         if (!cpuG) cpuG = gbuffer.readBack();
@@ -133,22 +130,18 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     if (cfg.warmupFrames > 0) {
         Camera cam = cfg.cameraAt(0);
         Light light = cfg.lightAt(0);
-        renderFrame(0, cam);
+        renderFrame(cam);
         for (auto& inst : instances) {
             throwIfInterrupted();
             progress.step("warm-up " + inst.entry->id);
-            for (int w = 0; w < cfg.warmupFrames; ++w) {
-                inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, 0, inst.visibility.id(), timer});
-                glFinish();
-                timer.collect();
-            }
+            for (int w = 0; w < cfg.warmupFrames; ++w) inst.host->computeFrame({gbuffer, getCpuG, cam, light, 0}, timer);
         }
     }
 
     for (int frame = 0; frame < cfg.frames; ++frame) {
         Camera cam = cfg.cameraAt(frame);
         Light light = cfg.lightAt(frame);
-        renderFrame(frame, cam);
+        renderFrame(cam);
         glFinish();
         const CpuGBuffer& g = getCpuG();
         std::vector<uint8_t> lit = litMask(g, light);
@@ -162,18 +155,15 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         for (auto& inst : instances) {
             throwIfInterrupted();
             progress.step(inst.entry->id + " frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
-            TimedWork timed = timeWork(timer, [&] {
-                inst.algorithm->computeVisibility({gbuffer, getCpuG, cam, light, frame, inst.visibility.id(), timer});
-            });
+            const FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
             FrameRecord rec;
             rec.frame = frame;
-            rec.stages = std::move(timed.stages);
-            rec.stages.push_back({"total", sumGpuMs(rec.stages), timed.wallMs});
-            for (const auto& c : inst.algorithm->counters()) rec.counters[c.name] = c.value;
-            rec.overflow = inst.algorithm->overflowCount();
-            inst.results.memoryBytes = std::max(inst.results.memoryBytes, inst.algorithm->memoryBytes());
+            rec.stages = m.stagesWithTotal();
+            for (const auto& c : m.counters) rec.counters[c.name] = c.value;
+            rec.overflow = m.overflow;
+            inst.results.memoryBytes = std::max(inst.results.memoryBytes, m.memoryBytes);
 
-            std::vector<float> vis = readTextureR32F(inst.visibility.id(), res.x, res.y);
+            std::vector<float> vis = inst.host->readVisibility();
             bool isReference = cfg.reference && inst.entry == &cfg.referenceEntry;
             if (isReference) reference = vis;
             if (cfg.reference && (framesWithoutLit.empty() || framesWithoutLit.back() != frame)) {
@@ -181,9 +171,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                 rec.accuracy = compareVisibility(vis, reference, lit);
             }
             if (saveImages) {
-                shading.run(gbuffer, inst.visibility.id(), light);
+                shading.run(gbuffer, inst.host->visibility(), light);
                 writeImages(dir, inst.entry->id, frame, res, shading, vis, cfg.reference && !isReference ? &reference : nullptr,
-                            lit, covered, *inst.algorithm);
+                            lit, covered, inst.host->algorithm());
             }
             inst.results.frames.push_back(std::move(rec));
         }

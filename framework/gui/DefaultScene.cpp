@@ -1,6 +1,6 @@
 #include "framework/gui/DefaultScene.h"
 
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 namespace shadowlab {
 

@@ -1,7 +1,7 @@
 #pragma once
 // Rolling per-frame measurements of the active algorithm for the graphs: GPU time per stage,
 // frame time, and the latest counters and memory.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 
 #include <deque>
 #include <string>

@@ -31,7 +31,9 @@ std::string tooltip(const ParamSpec& spec) {
              toString(spec.type == ParamType::Int ? ParamValue(int(spec.max)) : ParamValue(spec.max)) + "]";
         if (!spec.unit.empty()) t += " " + spec.unit;
     }
-    t += spec.change == ParamChange::Rebuild ? "\nchanging it rebuilds the algorithm's structures" : "\napplies immediately";
+    t += spec.change == ParamChange::Rebuild     ? "\nchanging it rebuilds the algorithm's structures"
+         : spec.change == ParamChange::Recompile ? "\nchanging it recompiles the algorithm's shaders"
+                                                 : "\napplies immediately";
     return t;
 }
 
@@ -101,7 +103,8 @@ void ParamWidgets::draw(Viewer& viewer) {
         bool changed = drawOne(spec, value);
         bool active = ImGui::IsItemActive();
         bool released = ImGui::IsItemDeactivatedAfterEdit();
-        bool deferred = spec.change == ParamChange::Rebuild && active &&
+        // Sliders of costly keys apply when released, not at every step of the drag.
+        bool deferred = spec.change != ParamChange::Update && active &&
                         (spec.type == ParamType::Int || spec.type == ParamType::Float);
         if (deferred) {
             if (changed) pending_[spec.key] = value;

@@ -53,18 +53,11 @@ void ViewImages::computeReference(Viewer& viewer) {
     const AlgorithmEntry& entry = viewer.config().referenceEntry;
     if (!reference_) {
         // Built once (Embree BVH) and kept: only the frame changes between requests.
-        reference_ = entry.info->create(entry.params);
+        reference_ = std::make_unique<AlgorithmHost>(*entry.info, entry.params);
         reference_->setScene(viewer.sceneGpu());
     }
-    if (res != referenceResolution_) {
-        reference_->resize(res);
-        referenceVisibility_ = makeTexture2D(GL_R32F, res.x, res.y);
-        referenceResolution_ = res;
-    }
-    viewer.runOn(*reference_, referenceVisibility_.id(), referenceTimer_);
-    glFinish();
-    referenceTimer_.collect();
-    refValues_ = readTextureR32F(referenceVisibility_.id(), res.x, res.y);
+    viewer.runOn(*reference_, referenceTimer_);  // resizes to the frame's resolution
+    refValues_ = reference_->readVisibility();
     lit_ = litMask(viewer.cpuGBuffer(), viewer.light);
     refKey_ = keyOf(viewer);
     referenceMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();

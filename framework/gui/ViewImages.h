@@ -65,9 +65,7 @@ private:
     glm::ivec2 displaySize_{0, 0};
     GlTexture ramp_;
 
-    std::unique_ptr<ShadowAlgorithm> reference_;
-    glm::ivec2 referenceResolution_{0, 0};
-    GlTexture referenceVisibility_;
+    std::unique_ptr<AlgorithmHost> reference_;
     StageTimer referenceTimer_;
     std::vector<float> refValues_;
     std::vector<uint8_t> lit_;

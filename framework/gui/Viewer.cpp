@@ -47,24 +47,20 @@ int findChoice(const std::vector<AlgorithmChoice>& choices, const std::string& i
 
 void Viewer::selectAlgorithm(int index) {
     if (index < 0 || size_t(index) >= choices_.size()) throw InputError("", "", "no algorithm choice " + std::to_string(index));
-    if (index == active_ && algorithm_) return;
+    if (index == active_ && host_) return;
     active_ = index;
     instantiate();
 }
 
-std::string Viewer::unsupportedReason() const {
-    const AlgorithmInfo& info = *active().info;
-    if (info.supports(light.type)) return "";
-    return info.name + " does not support " + std::string(toString(light.type)) + " lights";
-}
+std::string Viewer::unsupportedReason() const { return host_->unsupportedReason(light); }
 
 void Viewer::instantiate() {
     const AlgorithmChoice& c = active();
     // Drop the old instance first: two sets of shadow maps or trees need not fit at once.
-    algorithm_.reset();
-    algorithm_ = c.info->create(c.params);
-    algorithm_->setScene(*sceneGpu_);
-    if (resolution_.x > 0) algorithm_->resize(resolution_);
+    host_.reset();
+    host_ = std::make_unique<AlgorithmHost>(*c.info, c.params);
+    if (resolution_.x > 0) host_->resize(resolution_);
+    host_->setScene(*sceneGpu_);
 }
 
 void Viewer::applyPlayback() {
@@ -92,9 +88,8 @@ void Viewer::setResolution(glm::ivec2 res) {
     resolution_ = res;
     gbuffer_ = std::make_unique<GBuffer>(res);
     shading_ = std::make_unique<ShadingPass>(res);
-    visibility_ = makeTexture2D(GL_R32F, res.x, res.y);
     cpuG_.reset();
-    if (algorithm_) algorithm_->resize(res);
+    if (host_) host_->resize(res);
 }
 
 const CpuGBuffer& Viewer::cpuGBuffer() {
@@ -102,9 +97,9 @@ const CpuGBuffer& Viewer::cpuGBuffer() {
     return *cpuG_;
 }
 
-void Viewer::runOn(ShadowAlgorithm& algorithm, GLuint visibility, StageTimer& timer) {
-    auto getCpuG = [this]() -> const CpuGBuffer& { return cpuGBuffer(); };
-    algorithm.computeVisibility({*gbuffer_, getCpuG, camera, light, playback.frame, visibility, timer});
+FrameMeasurement Viewer::runOn(AlgorithmHost& host, StageTimer& timer) {
+    return host.computeFrame({*gbuffer_, [this]() -> const CpuGBuffer& { return cpuGBuffer(); }, camera, light, playback.frame},
+                             timer);
 }
 
 void Viewer::renderFrame() {
@@ -113,17 +108,16 @@ void Viewer::renderFrame() {
     cpuG_.reset();
     lastStages_.clear();
     if (unsupportedReason().empty()) {
-        // Measured as the runner measures a frame (timeWork).
-        TimedWork timed = timeWork(timer_, [&] { runOn(*algorithm_, visibility_.id(), timer_); });
-        lastWallMs_ = timed.wallMs;
-        lastStages_ = std::move(timed.stages);
+        FrameMeasurement m = runOn(*host_, timer_);  // measured as the runner measures a frame
+        lastWallMs_ = m.wallMs;
+        lastStages_ = std::move(m.stages);
     } else {
         // Shown unshadowed rather than with stale visibility; the panel says why.
         const float one = 1.0f;
-        glClearTexImage(visibility_.id(), 0, GL_RED, GL_FLOAT, &one);
+        glClearTexImage(host_->visibility(), 0, GL_RED, GL_FLOAT, &one);
         lastWallMs_ = 0;
     }
-    shading_->run(*gbuffer_, visibility_.id(), light);
+    shading_->run(*gbuffer_, host_->visibility(), light);
     ++renderedFrames_;
 }
 
@@ -131,17 +125,9 @@ void applyParamChanges(Viewer& viewer, const std::vector<std::pair<std::string, 
     if (changes.empty()) return;
     AlgorithmChoice& choice = viewer.choices_[size_t(viewer.active_)];
     ParamValues next = choice.params;
-    ParamChange change = ParamChange::Update;
-    for (const auto& [key, value] : changes) {
-        next.set(key, value); // throws InputError on an unknown key or an invalid value; nothing changed yet
-        if (choice.info->schema().find(key)->change == ParamChange::Rebuild) change = ParamChange::Rebuild;
-    }
+    for (const auto& [key, value] : changes) next.set(key, value);  // throws on a bad value; nothing changed yet
     choice.params = next;
-    viewer.algorithm_->paramsChanged(choice.params, change);
-    if (change == ParamChange::Rebuild) {
-        viewer.algorithm_->setScene(*viewer.sceneGpu_);
-        if (viewer.resolution_.x > 0) viewer.algorithm_->resize(viewer.resolution_);
-    }
+    viewer.host_->setParams(choice.params);
 }
 
 void applyParamChange(Viewer& viewer, const std::string& key, const ParamValue& value) {

@@ -2,7 +2,7 @@
 // The GUI's model: one scene, one active algorithm and the per-frame pipeline of Runner.cpp
 // (G-buffer → algorithm → visibility → shading), with the camera, light and fly-through state the
 // panels edit. It holds no ImGui code, so automation and widgets drive it through the same calls.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/AlgorithmHost.h"
 #include "framework/experiment/Config.h"
 #include "framework/render/ShadingPass.h"
 
@@ -56,7 +56,7 @@ public:
     void selectAlgorithm(int index);
     /// Why the active algorithm cannot run under the current light; empty when it can.
     std::string unsupportedReason() const;
-    const ShadowAlgorithm* algorithm() const { return algorithm_.get(); }
+    const ShadowAlgorithm* algorithm() const { return host_ ? &host_->algorithm() : nullptr; }
 
     Camera camera; ///< edited by the camera controller and panels; overwritten by a followed path
     Light light;   ///< edited by the light panel; overwritten by a followed path
@@ -72,12 +72,12 @@ public:
 
     /// Renders one frame: G-buffer, the active algorithm's visibility (timed), shading.
     void renderFrame();
-    /// Runs `algorithm` on the frame last rendered, writing into `visibility` (for the reference).
-    void runOn(ShadowAlgorithm& algorithm, GLuint visibility, StageTimer& timer);
+    /// Runs another hosted algorithm on the frame last rendered (the reference view).
+    FrameMeasurement runOn(AlgorithmHost& host, StageTimer& timer);
 
     const SceneGpu& sceneGpu() const { return *sceneGpu_; }
     GLuint shadedTexture() const { return shading_->output(); }
-    GLuint visibilityTexture() const { return visibility_.id(); }
+    GLuint visibilityTexture() const { return host_->visibility(); }
     /// The G-buffer of the last frame on the CPU (read back once per frame, on first use).
     const CpuGBuffer& cpuGBuffer();
     /// Stages of the last frame (GPU and CPU ms), as StageTimer::collect() returned them.
@@ -96,12 +96,11 @@ private:
     std::unique_ptr<SceneGpu> sceneGpu_;
     std::vector<AlgorithmChoice> choices_;
     int active_ = 0;
-    std::unique_ptr<ShadowAlgorithm> algorithm_;
+    std::unique_ptr<AlgorithmHost> host_;
 
     glm::ivec2 resolution_{0, 0};
     std::unique_ptr<GBuffer> gbuffer_;
     std::unique_ptr<ShadingPass> shading_;
-    GlTexture visibility_;
     StageTimer timer_;
     std::optional<CpuGBuffer> cpuG_;
     std::vector<StageTime> lastStages_;
@@ -111,7 +110,8 @@ private:
 
 /// The one way parameters change, shared by the widgets and the automation (--set): validates
 /// every value through ParamValues::set (InputError when unknown or out of range, leaving all the
-/// old values), then one paramsChanged() and, if any key is a Rebuild one, one setScene() + resize().
+/// old values), then applies them all at once through AlgorithmHost::setParams (one update,
+/// recompile or rebuild, the costliest the changed keys need).
 void applyParamChanges(Viewer& viewer, const std::vector<std::pair<std::string, ParamValue>>& changes);
 /// One parameter: applyParamChanges() with a single change.
 void applyParamChange(Viewer& viewer, const std::string& key, const ParamValue& value);

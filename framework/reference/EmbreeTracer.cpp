@@ -1,4 +1,4 @@
-#include "algorithms/reference/EmbreeTracer.h"
+#include "framework/reference/EmbreeTracer.h"
 
 #include "framework/core/Error.h"
 

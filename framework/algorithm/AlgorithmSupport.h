@@ -1,7 +1,7 @@
 #pragma once
 // What several algorithm plugins share besides the interface: their registry entry, and the
 // binding convention of per-pixel compute passes.
-#include "algorithms/ShadowAlgorithm.h"
+#include "framework/algorithm/ShadowAlgorithm.h"
 #include "framework/gl/Shader.h"
 
 #include <initializer_list>

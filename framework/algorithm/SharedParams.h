@@ -1,0 +1,52 @@
+#pragma once
+// Parameter rows that several algorithms share, declared once: the same key, default, range, unit
+// and meaning wherever they appear, so configs, the GUI and results compare like with like.
+#include "framework/core/Params.h"
+
+#include <string>
+
+namespace shadowlab {
+
+/// Default of ray_offset, in scene radii: 1e-4 of the radius clears the float error of the
+/// G-buffer positions without visibly detaching contact shadows, at any scene scale.
+constexpr double kDefaultRayOffset = 1e-4;
+
+/// `ray_offset`: the shadow query point (the reference's ray origin) is the G-buffer point moved
+/// this far along its normal. Every algorithm that has it uses the reference's definition, so an
+/// algorithm and the reference trace from the same points and only their tests differ.
+template <class T> auto rayOffsetRow(float T::*member) {
+    return [member](ParamStruct<T>& s) {
+        s.real("ray_offset", member, kDefaultRayOffset, 0.0, 1e-2, "× scene radius",
+               "shadow query point (ray origin) offset along the surface normal, against self-shadowing", ParamChange::Update);
+    };
+}
+
+/// `stack_size`: a fixed-size traversal stack, compiled into the shader. Overflow is never silent:
+/// the pixel (or ray) is written shadowed (blocked) and counted in the overflow.
+template <class T> auto stackSizeRow(int T::*member, int def) {
+    return [member, def](ParamStruct<T>& s) {
+        s.integer("stack_size", member, def, 1, 256, "nodes",
+                  "traversal stack; a pixel or ray that overflows it is written shadowed and counted as overflow",
+                  ParamChange::Recompile);
+    };
+}
+
+/// `cache`: reuse the algorithm's per-scene preprocessing from the disk cache
+/// ($XDG_CACHE_HOME or ~/.cache, /shadowlab/<folder>), keyed and checked by the scene's content.
+template <class T> auto cacheRow(bool T::*member, const std::string& folder) {
+    return [member, folder](ParamStruct<T>& s) {
+        s.boolean("cache", member, true,
+                  "reuse the preprocessing from the disk cache ($XDG_CACHE_HOME or ~/.cache /shadowlab/" + folder +
+                      "), keyed by the scene's content",
+                  ParamChange::Rebuild);
+    };
+}
+
+/// The ray offset of an algorithm's values (kDefaultRayOffset where its schema has no such row):
+/// the tests trace the reference from the algorithm's own query points.
+inline double rayOffsetOf(const ParamValues& values) {
+    const ParamSchema* s = values.schema();
+    return s && s->find("ray_offset") ? std::get<double>(values.get("ray_offset")) : kDefaultRayOffset;
+}
+
+} // namespace shadowlab
