@@ -26,19 +26,19 @@ const ParamStruct<PsvParams>& psvParams() {
     using P = PsvParams;
     static const ParamStruct<P> s = ParamStruct<P>()
         .boolean("wedge", &P::wedge, true,
-                 "wedge optimisation (paper 3.5): an intersection child is visited only inside its wedge",
+                 "wedge optimisation (paper 3.5): an intersection child is visited only inside its wedge; off = the paper's \"No opt\"",
                  ParamChange::Recompile)
         .boolean("random_order", &P::randomOrder, true,
-                 "merge triangles in a seeded pseudo-random order (paper 3.3) instead of scene order",
+                 "merge triangles in a seeded pseudo-random order (paper 3.3) instead of scene order; off = \"No rand\"",
                  ParamChange::Recompile)
         .integer("seed", &P::seed, 1, 0, INT_MAX, "", "seed of the insertion order (with random_order)", ParamChange::Update)
         // Off by default: it is exact only for closed, consistently wound meshes (a ground plane
         // facing the light is dropped, fine; an open mesh would leak light through its back).
         .boolean("front_face_culling", &P::frontFaceCulling, false,
-                 "only triangles facing away from the light cast (paper 4.2); exact for closed meshes only",
+                 "only triangles facing away from the light cast (paper 4.2, its setting); exact for closed meshes only",
                  ParamChange::Recompile)
         .boolean("depth_skip", &P::depthSkip, true,
-                 "skip a capping node's subtree when the point is nearer the light than all of it (Mora et al. 2016)",
+                 "skip a capping node's subtree when the point is nearer the light than all of it (Mora et al. 2016); off = the 2015 paper",
                  ParamChange::Recompile)
         .apply(stackSizeRow(&P::stackSize, 32))
         .boolean("transparency", &P::transparency, false,

@@ -28,8 +28,9 @@ Usage:
       --set algorithms.0.params.pcf=0 --set light.type=directional
   shadowlab validate CONFIG.json [--set PATH=VALUE]...
       Checks the config (and loads its scene) without rendering; prints the resolved config.
-  shadowlab list [--json]
-      Lists the registered algorithms and their parameters.
+  shadowlab list [--json | --markdown [NAME]]
+      Lists the registered algorithms and their parameters; --markdown prints each parameter table
+      as docs/algorithms/NAME.md holds it (scripts/update_param_docs.py rewrites the docs from it).
   shadowlab --help | --version
 
 Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.
@@ -62,6 +63,18 @@ void printList(bool json) {
             std::cout << ", " << toString(s.change) << ")\n      " << s.doc << "\n";
         }
     }
+}
+
+/// The parameter tables of the docs: one algorithm's, or each one's under a heading.
+int printMarkdown(const std::string& name) {
+    if (!name.empty()) {
+        const AlgorithmInfo* a = findAlgorithm(name);
+        if (!a) throw InputError("list", "", "unknown algorithm \"" + name + "\"");
+        std::cout << a->schema().markdownTable();
+        return 0;
+    }
+    for (const auto& a : algorithmRegistry()) std::cout << "## " << a.name << "\n\n" << a.schema().markdownTable() << "\n";
+    return 0;
 }
 
 [[noreturn]] void usageError(const std::string& msg) {
@@ -134,8 +147,12 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "list") {
+            if (args.size() > 1 && args[1] == "--markdown") {
+                if (args.size() > 3) usageError("list --markdown takes at most one algorithm name");
+                return printMarkdown(args.size() == 3 ? args[2] : "");
+            }
             bool json = args.size() > 1 && args[1] == "--json";
-            if (args.size() > (json ? 2u : 1u)) usageError("list takes only --json");
+            if (args.size() > (json ? 2u : 1u)) usageError("list takes only --json or --markdown [NAME]");
             printList(json);
             return 0;
         }

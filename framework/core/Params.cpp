@@ -84,6 +84,22 @@ Json ParamSchema::toJson() const {
     return out;
 }
 
+std::string ParamSchema::markdownTable() const {
+    std::ostringstream os;
+    os << "| key | type | default | range | change | meaning |\n|---|---|---|---|---|---|\n";
+    for (const auto& s : specs_) {
+        std::string range;
+        if (s.type == ParamType::Int) range = std::to_string(int(s.min)) + "–" + std::to_string(int(s.max));
+        if (s.type == ParamType::Float) range = toString(ParamValue(s.min)) + "–" + toString(ParamValue(s.max));
+        if (s.type == ParamType::Enum)
+            for (const auto& c : s.choices) range += (range.empty() ? "`" : ", `") + c + "`";
+        if (!s.unit.empty()) range += " " + s.unit;
+        os << "| `" << s.key << "` | " << toString(s.type) << " | `" << toString(s.def) << "` | " << range << " | "
+           << toString(s.change) << " | " << s.doc << " |\n";
+    }
+    return os.str();
+}
+
 ParamValues::ParamValues(const ParamSchema& schema) : schema_(&schema) {
     for (const auto& s : schema.specs()) values_[s.key] = s.def;
 }

@@ -52,6 +52,8 @@ public:
 
     /// Schema as JSON (for `list --json` and results).
     Json toJson() const;
+    /// Schema as a Markdown table (`list --markdown`): the parameter table of docs/algorithms/NAME.md.
+    std::string markdownTable() const;
 
 private:
     std::vector<ParamSpec> specs_;
