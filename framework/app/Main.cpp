@@ -4,6 +4,7 @@
 #include "framework/experiment/Config.h"
 #include "framework/experiment/Runner.h"
 #include "framework/gl/GlContext.h"
+#include "framework/sweep/SweepCli.h"
 
 #include <cstdio>
 #include <cstring>
@@ -29,7 +30,7 @@ Usage:
       Checks the config (and loads its scene) without rendering; prints the resolved config.
   shadowlab list [--json]
       Lists the registered algorithms and their parameters.
-  shadowlab --help | --version
+%s  shadowlab --help | --version
 
 Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.
 )";
@@ -116,7 +117,9 @@ int main(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);
     try {
         if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-            std::fputs(kUsage, args.empty() ? stderr : stdout);
+            std::string usage = kUsage;
+            usage.replace(usage.find("%s"), 2, kSweepUsage);
+            std::fputs(usage.c_str(), args.empty() ? stderr : stdout);
             return args.empty() ? 2 : 0;
         }
         if (args[0] == "--version") {
@@ -143,6 +146,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "run") return run(args);
+        if (args[0] == "sweep") return sweepCommand(args);
         usageError("unknown command " + args[0]);
     } catch (const InputError& e) {
         std::fprintf(stderr, "shadowlab: error: %s\n", e.what());

@@ -229,11 +229,28 @@ Builder parseObject(JsonNode node, int depth) {
 
 } // namespace
 
-Scene buildScene(JsonNode sceneNode) {
+/// Checks the whole description and returns one builder per object; nothing is generated or loaded yet.
+static std::vector<Builder> parseScene(JsonNode& sceneNode) {
     std::vector<Builder> builders;
     for (JsonNode& object : sceneNode.objectArray("objects")) builders.push_back(parseObject(object, 0));
     sceneNode.finish();
     if (builders.empty()) sceneNode.fail("objects", "scene has no objects");
+    return builders;
+}
+
+void checkScene(JsonNode sceneNode) { parseScene(sceneNode); }
+
+void absolutiseScenePaths(Json& object, const std::string& baseDir) {
+    if (!object.is_object()) return;
+    if (object.contains("gltf") && object["gltf"].is_string())
+        object["gltf"] = resolvePath(baseDir, object["gltf"].get<std::string>());
+    if (object.contains("object")) absolutiseScenePaths(object["object"], baseDir);
+    if (object.contains("objects") && object["objects"].is_array())
+        for (Json& o : object["objects"]) absolutiseScenePaths(o, baseDir);
+}
+
+Scene buildScene(JsonNode sceneNode) {
+    std::vector<Builder> builders = parseScene(sceneNode);
     Scene scene;
     for (size_t i = 0; i < builders.size(); ++i) {
         Scene s = builders[i]();
