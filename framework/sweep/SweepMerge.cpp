@@ -41,6 +41,22 @@ std::vector<std::pair<std::string, Json>> measures(const Json& a) {
     return m;
 }
 
+/// What a measure depends on besides the run's config, so tables can be compared across machines
+/// and reruns:
+///   "result"   accuracy, memory, overflow: equal for equal configs on the same renderer;
+///   "counter"  an algorithm's work counters: equal too where the algorithm is deterministic, but
+///              a structure built by parallel GPU threads (psv's insertions race for their place
+///              in the tree) changes a little with the threads' timing, even on one machine;
+///   "cache"    counters named cache*: whether a disk cache was warm;
+///   "time"     stage times, preprocessing, and counters named *_ms, *_s, *_per_s.
+const char* measureKind(const std::string& m) {
+    auto ends = [&](const std::string& suffix) { return m.size() > suffix.size() && m.compare(m.size() - suffix.size(), suffix.size(), suffix) == 0; };
+    if (m.rfind("time_ms.", 0) == 0 || m == "preprocess_ms" || ends("_ms") || ends("_s")) return "time";
+    if (m.rfind("counters.cache", 0) == 0) return "cache";
+    if (m.rfind("counters.", 0) == 0) return "counter";
+    return "result";
+}
+
 } // namespace
 
 MergeResult mergeSweep(const std::string& dir, bool plots) {
@@ -53,7 +69,7 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
     std::ostringstream csv;
     csv << "run,index";
     for (const auto& axis : sweep.axes) csv << "," << axis.name;
-    csv << ",triangles,pixels,id,algorithm,measure,value\n";
+    csv << ",triangles,pixels,id,algorithm,measure,kind,value\n";
     Json plan = planJson(sweep);
     for (size_t i = 0; i < sweep.runs.size(); ++i) {
         const SweepRun& run = sweep.runs[i];
@@ -79,7 +95,7 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
         for (const auto& [id, a] : s.at("algorithms").items())
             for (const auto& [measure, value] : measures(a))
                 csv << prefix.str() << "," << csvField(id) << "," << csvField(a.at("algorithm").get<std::string>()) << "," << measure
-                    << "," << number(value) << "\n";
+                    << "," << measureKind(measure) << "," << number(value) << "\n";
         ++r.merged;
     }
     writeFileAtomic(dir + "/plan.json", plan.dump(2) + "\n");
