@@ -66,10 +66,11 @@ EOF
 )
 host=$(hostname -s)
 cpus=$(nproc)
+# The loopback address is given explicitly: containers often cannot resolve their own host name.
 cat > "$dir/slurm.conf" <<EOF
 # One node, this machine: written by scripts/slurm_local.sh.
 ClusterName=shadowlab
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmctldPort=$ctld_port
 SlurmdPort=$slurmd_port
 SrunPortRange=$srun_port-$srun_port
@@ -95,7 +96,7 @@ SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
 ReturnToService=2
 MinJobAge=3600
-NodeName=$host CPUs=$cpus RealMemory=1000 State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=1000 State=UNKNOWN
 PartitionName=debug Nodes=ALL Default=YES MaxTime=INFINITE State=UP
 EOF
 
