@@ -241,7 +241,7 @@ TEST(SweepTest, MergeWritesTheTidyTableReportAndPlots) {
     std::string header;
     std::getline(csv, header);
     EXPECT_EQ(header, "run,index,tris,pcf,triangles,pixels,id,algorithm,measure,kind,value");
-    const auto rows = test::rowsOfKind(out + "/sweep.csv", "result");
+    const auto rows = test::rowsOfKind(out + "/sweep.csv", "accuracy");
     // 4 runs × 3 algorithms (reference, shadow_map, psv), each with its accuracy.
     size_t accuracy = 0;
     for (const auto& [key, value] : rows) accuracy += key.find(",accuracy.mismatch_ratio_max") != std::string::npos;

@@ -39,8 +39,8 @@ inline std::string writeJson(const std::string& path, const Json& j) {
     return path;
 }
 
-/// sweep.csv rows of one kind (SweepMerge.cpp: "result" = accuracy, memory, overflow, which do
-/// not depend on timing), keyed "run,index,axes...,triangles,pixels,id,algorithm,measure" → value;
+/// sweep.csv rows of one kind (SweepMerge.cpp: "accuracy", which depends on the config alone;
+/// "counter"; "cache"; "time"), keyed "run,index,axes...,triangles,pixels,id,algorithm,measure" → value;
 /// an empty kind keeps every row (with its value blanked: the keys alone).
 inline std::map<std::string, std::string> rowsOfKind(const std::string& csvPath, const std::string& kind) {
     std::ifstream in(csvPath);

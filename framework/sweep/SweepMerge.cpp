@@ -43,18 +43,21 @@ std::vector<std::pair<std::string, Json>> measures(const Json& a) {
 
 /// What a measure depends on besides the run's config, so tables can be compared across machines
 /// and reruns:
-///   "result"   accuracy, memory, overflow: equal for equal configs on the same renderer;
-///   "counter"  an algorithm's work counters: equal too where the algorithm is deterministic, but
-///              a structure built by parallel GPU threads (psv's insertions race for their place
-///              in the tree) changes a little with the threads' timing, even on one machine;
-///   "cache"    counters named cache*: whether a disk cache was warm;
-///   "time"     stage times, preprocessing, and counters named *_ms, *_s, *_per_s.
+///   "accuracy"  accuracy.*: equal for equal configs on the same renderer;
+///   "counter"   work counters, memory, overflow: equal too where an algorithm builds its structures
+///               deterministically, but those built by racing threads change a little from run to
+///               run even on one machine (the trees psv and metric_tree build on the GPU, whose
+///               threads race for their place in them: node counts, triangle tests, a rare stack
+///               overflow; the reference's Embree BVH, built in parallel: its memory at millions
+///               of triangles);
+///   "cache"     counters named cache*: whether a disk cache was warm;
+///   "time"      stage times, preprocessing, and counters named *_ms, *_s, *_per_s.
 const char* measureKind(const std::string& m) {
     auto ends = [&](const std::string& suffix) { return m.size() > suffix.size() && m.compare(m.size() - suffix.size(), suffix.size(), suffix) == 0; };
     if (m.rfind("time_ms.", 0) == 0 || m == "preprocess_ms" || ends("_ms") || ends("_s")) return "time";
     if (m.rfind("counters.cache", 0) == 0) return "cache";
-    if (m.rfind("counters.", 0) == 0) return "counter";
-    return "result";
+    if (m.rfind("accuracy.", 0) == 0) return "accuracy";
+    return "counter";
 }
 
 } // namespace
