@@ -4,6 +4,7 @@
 #include "tests/SweepTestData.h"
 #include "tests/TestSupport.h"
 
+#include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -188,6 +189,33 @@ TEST(SweepTest, KilledMidwayThenRestartedRunsOnlyTheMissingRuns) {
     EXPECT_EQ(countOf(log, "] skip"), 4u) << log;
     ASSERT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 0) << log;
     EXPECT_EQ(test::runIds(out + "/sweep.csv").size(), 4u);
+}
+
+TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {
+    const std::string dir = test::makeTempDir("sweep-term");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";
+    // What scancel and Ctrl-C send: only the sweep process gets it, and it stops its runs itself.
+    const pid_t pid = startGroup("exec " + bin() + " sweep run " + file + " --out " + out + " --jobs 1 > " + dir + "/first.log 2>&1");
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (completeRuns(out) < 1 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    kill(pid, SIGTERM);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    const size_t done = completeRuns(out);
+    if (done < 4) {
+        ASSERT_TRUE(WIFEXITED(status));
+        EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+    }
+    // Nothing left running (the sweep waited for its runs), and no half-written run folder left.
+    const bool groupGone = kill(-pid, 0) != 0 && errno == ESRCH;
+    EXPECT_TRUE(groupGone) << "a run outlived the sweep";
+    if (!groupGone) kill(-pid, SIGKILL);
+    for (const auto& e : fs::directory_iterator(out + "/runs"))
+        EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out + " --jobs 2", log), 0) << log;
+    EXPECT_EQ(countOf(log, "] skip"), done) << log;
+    EXPECT_EQ(countOf(log, "] done"), 4 - done) << log;
 }
 
 TEST(SweepTest, AFailedRunLeavesAnErrorRecordAndTheOthersGoOn) {

@@ -174,7 +174,12 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
     if (gStopSignal) {
         // Stop the runs in flight and wait for them: nothing is left writing once this returns.
         for (const auto& [pid, r] : running) kill(pid, SIGTERM);
-        for (const auto& [pid, r] : running) waitpid(pid, nullptr, 0);
+        for (const auto& [pid, r] : running) {
+            waitpid(pid, nullptr, 0);
+            // A run assembles its folder under ID.partial-PID (Runner.h); a stopped one never finishes it.
+            std::error_code ec;
+            fs::remove_all(RunPaths(opt.outputDir, sweep.runs[r.index].id).dir + ".partial-" + std::to_string(pid), ec);
+        }
         std::fprintf(stderr, "sweep: stopped by signal %d; %zu of %zu runs reported; run the same command again to finish\n",
                      int(gStopSignal), reported, n);
         return 128 + int(gStopSignal);
