@@ -157,7 +157,7 @@ def report(s, directory):
              f"missing {statuses.count('missing')}",
              f"- renderer: {', '.join(renderers)}",
              f"- stage times: {src}, mean ms per frame",
-             "- axes: " + "; ".join(f"`{a['name']}` ({a['scale']}): {', '.join(a['labels'])}" for a in s.axes), ""]
+             "- axes: " + ("; ".join(f"`{a['name']}` ({a['scale']}): {', '.join(a['labels'])}" for a in s.axes) or "none"), ""]
     for r in s.plan["runs"]:
         if r.get("status") != "complete":
             labels = " ".join(f"{k}={v}" for k, v in r["axes"].items())

@@ -138,6 +138,33 @@ TEST(SweepTest, RunsKeepTheirIdsWhenAnAxisIsAdded) {
         if (s["axes"]["light"] == "directional") EXPECT_FALSE(ids.count(s["id"].get<std::string>())) << s.dump();
 }
 
+TEST(SweepTest, SlurmScriptRunsOneTaskPerRunOrPerShard) {
+    const std::string dir = test::makeTempDir("sweep-sbatch");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep());
+    std::string out;
+    auto script = [&](const std::string& options) {
+        EXPECT_EQ(test::runCommand(bin() + " sweep slurm " + file + " --out " + dir + "/out " + options, out), 0) << out;
+        std::ifstream in(dir + "/out/sweep.sbatch");
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    };
+    const std::string perRun = script("--partition debug --time 00:05:00 --max-parallel 2");
+    for (const char* line : {"#SBATCH --array=0-3%2\n", "#SBATCH --partition=debug\n", "#SBATCH --time=00:05:00\n",
+                             "/shadowlab' sweep run '", "/out/sweep.json' --out '", " --index \"$SLURM_ARRAY_TASK_ID\"\n"})
+        EXPECT_NE(perRun.find(line), std::string::npos) << line << " in\n" << perRun;
+    EXPECT_EQ(perRun.find("--gpus-per-task"), std::string::npos) << perRun;
+    EXPECT_TRUE(fs::exists(dir + "/out/sweep.json"));
+    EXPECT_TRUE(fs::is_directory(dir + "/out/slurm")) << "Slurm does not create the folder of --output itself";
+#ifdef SHADOWLAB_EGL_BINARY
+    // GPU nodes have no display: the EGL runner.
+    const std::string gpu = script("--gpus-per-task 1 --cpus-per-task 4 --shards 3");
+    for (const char* line : {"#SBATCH --array=0-2\n", "#SBATCH --gpus-per-task=1\n", "#SBATCH --cpus-per-task=4\n", "/shadowlab-egl' sweep run",
+                             " --shard \"$SLURM_ARRAY_TASK_ID/3\"\n"})
+        EXPECT_NE(gpu.find(line), std::string::npos) << line << " in\n" << gpu;
+#endif
+}
+
 // ---- Running ----------------------------------------------------------------------------------------
 
 /// Starts `command` in its own process group (so it can be killed with everything it started).
