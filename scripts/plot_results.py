@@ -5,6 +5,7 @@
 Usage: plot_results.py DIR   (writes DIR/plot_frame_time.png, DIR/plot_stages.png, DIR/plot_accuracy.png)
 """
 import csv
+import os
 import sys
 from collections import defaultdict
 
@@ -12,6 +13,10 @@ import matplotlib
 
 matplotlib.use("Agg")  # headless: no display on CI or servers
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import plot_style  # noqa: E402
 
 
 def load(path):
@@ -30,11 +35,12 @@ def load(path):
 def main(directory):
     total, stages = load(f"{directory}/frames.csv")
     ids = list(total)
+    colour = plot_style.colours(ids)
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for i in ids:
         frames = sorted(total[i])
-        ax.plot(frames, [float(total[i][f]["cpu_ms"]) for f in frames], label=i)
+        ax.plot(frames, [float(total[i][f]["cpu_ms"]) for f in frames], label=i, color=colour[i])
     ax.set_xlabel("frame")
     ax.set_ylabel("visibility time per frame (ms, wall clock)")
     ax.set_yscale("log")
@@ -45,19 +51,26 @@ def main(directory):
     fig.savefig(f"{directory}/plot_frame_time.png", dpi=120)
     plt.close(fig)
 
+    # Stacked bars: the bar's colour is its algorithm, a segment's hatch (and shade) its stage, and
+    # one stage name keeps one hatch in every bar, so no two (algorithm, stage) pairs look alike.
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    labels, bottoms = [], defaultdict(float)
+    style = plot_style.variants(s for i in ids for s in stages[i])
+    labels = []
     for x, i in enumerate(ids):
-        for stage, values in stages[i].items():
+        bottom = 0.0
+        for k, (stage, values) in enumerate(stages[i].items()):
             mean = sum(values) / len(values)
-            ax.bar(x, mean, bottom=bottoms[i], label=f"{i}: {stage}")
-            bottoms[i] += mean
+            ax.bar(x, mean, bottom=bottom, color=plot_style.shade(colour[i], k), hatch=style[stage]["hatch"],
+                   edgecolor="black", linewidth=0.6)
+            bottom += mean
         labels.append(i)
+    handles = [Patch(facecolor="white", edgecolor="black", hatch=style[st]["hatch"], label=st) for st in style]
+    if handles:
+        ax.legend(handles=handles, title="stage", fontsize="small")
     ax.set_xticks(range(len(labels)))
     ax.set_xticklabels(labels, rotation=20)
     ax.set_ylabel("mean time per frame (ms; GPU where timed)")
     ax.set_title("Per-stage time")
-    ax.legend(fontsize="small")
     fig.tight_layout()
     fig.savefig(f"{directory}/plot_stages.png", dpi=120)
     plt.close(fig)
@@ -68,7 +81,7 @@ def main(directory):
         frames = [f for f in sorted(total[i]) if total[i][f]["mismatch_ratio"] != ""]
         if not frames or total[i][frames[0]]["algorithm"] == "reference":
             continue
-        ax.plot(frames, [100.0 * float(total[i][f]["mismatch_ratio"]) for f in frames], label=i)
+        ax.plot(frames, [100.0 * float(total[i][f]["mismatch_ratio"]) for f in frames], label=i, color=colour[i])
         plotted = True
     ax.set_xlabel("frame")
     ax.set_ylabel("mismatch against the reference (% of lit pixels)")

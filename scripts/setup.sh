@@ -9,6 +9,10 @@ PACKAGES=(
   libglm-dev nlohmann-json3-dev libtinygltf-dev libembree-dev libstb-dev libgtest-dev
   libosmesa6-dev libegl-dev libopengl-dev libgl-dev libglfw3-dev libimgui-dev
   assimp-testmodels python3 python3-matplotlib xvfb xauth fonts-dejavu-core
+  # Sweeps on a Slurm cluster: tests/SweepSlurmTest.cpp runs a one-node cluster on this machine
+  # (scripts/slurm_local.sh). slurm-wlm brings slurmctld, slurmd and the client (sbatch, squeue);
+  # munge is its authentication daemon.
+  slurm-wlm munge
 )
 
 PACKAGES+=("$@")

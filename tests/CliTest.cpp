@@ -16,6 +16,7 @@ TEST(CliTest, HelpAndListSucceed) {
     std::string out;
     EXPECT_EQ(test::runCommand(bin() + " --help", out), 0);
     EXPECT_NE(out.find("shadowlab run CONFIG.json"), std::string::npos);
+    EXPECT_NE(out.find("shadowlab sweep run SWEEP.json"), std::string::npos);
     EXPECT_EQ(test::runCommand(bin() + " list", out), 0);
     EXPECT_NE(out.find("shadow_map"), std::string::npos);
     EXPECT_NE(out.find("reference"), std::string::npos);
@@ -30,8 +31,10 @@ TEST(CliTest, EveryShippedConfigValidates) {
     size_t n = 0;
     for (const auto& e : std::filesystem::recursive_directory_iterator(std::string(SHADOWLAB_SOURCE_DIR) + "/configs")) {
         if (e.path().extension() != ".json") continue;
+        // A sweep file (docs/sweep.md) is checked run by run by `sweep plan`.
+        const bool sweep = e.path().string().ends_with(".sweep.json");
         std::string out;
-        EXPECT_EQ(test::runCommand(bin() + " validate " + e.path().string(), out), 0) << out;
+        EXPECT_EQ(test::runCommand(bin() + (sweep ? " sweep plan " : " validate ") + e.path().string(), out), 0) << out;
         ++n;
     }
     EXPECT_GE(n, 2u);

@@ -314,9 +314,12 @@ struct ConfigCase {
     const char* name;
     const char* args; ///< config file (relative to the source tree) and --set overrides
     double maxMismatchPerFrame;
+    int sweepRun = -1; ///< ≥ 0: the config is run K of the sweep file in `args` (`sweep config`)
 };
 
-void PrintTo(const ConfigCase& c, std::ostream* os) { *os << c.name << ": " << c.args << " ≤ " << c.maxMismatchPerFrame; }
+void PrintTo(const ConfigCase& c, std::ostream* os) {
+    *os << c.name << ": " << c.args << (c.sweepRun >= 0 ? " run " + std::to_string(c.sweepRun) : "") << " ≤ " << c.maxMismatchPerFrame;
+}
 
 #define MT_ONLY "--set 'algorithms=[{\"id\":\"metric_tree\",\"algorithm\":\"metric_tree\"}]' --set 'output.images_at_frames=[0]'"
 // Exact like the scene table above: the goal of 0.01 % of lit pixels, i.e. no mismatching pixel at
@@ -325,9 +328,9 @@ const ConfigCase kConfigs[] = {
     {"demo_point", "configs/demo.json --set resolution=[128,128] --set frames=4 --set warmup_frames=1 " MT_ONLY, 1e-4},
     {"demo_directional",
      "configs/demo.json --set resolution=[128,128] --set frames=4 --set warmup_frames=1 --set light.type=directional " MT_ONLY, 1e-4},
-    {"scaling_100k", "configs/metric_tree/scaling_100k.json " MT_ONLY, 1e-4},
-    {"scaling_1m", "configs/metric_tree/scaling_1m.json " MT_ONLY, 1e-4},
-    {"scaling_1m_directional", "configs/metric_tree/scaling_1m.json --set light.type=directional " MT_ONLY, 1e-4},
+    {"scaling_100k", "configs/metric_tree/scaling.sweep.json " MT_ONLY, 1e-4, 0},
+    {"scaling_1m", "configs/metric_tree/scaling.sweep.json " MT_ONLY, 1e-4, 1},
+    {"scaling_1m_directional", "configs/metric_tree/scaling.sweep.json --set light.type=directional " MT_ONLY, 1e-4, 1},
 };
 #undef MT_ONLY
 
@@ -336,10 +339,17 @@ class MetricTreeConfigGLTest : public ::testing::TestWithParam<ConfigCase> {};
 TEST_P(MetricTreeConfigGLTest, AgreesWithReferenceOnEveryFrame) {
     const ConfigCase& c = GetParam();
     const std::string dir = test::makeTempDir("mt-config");
-    std::string out;
+    std::string out, args = std::string(SHADOWLAB_SOURCE_DIR) + "/" + c.args;
+    if (c.sweepRun >= 0) {
+        // One size of the scaling sweep: its config, then the overrides that follow the file name.
+        const std::string sweepFile = args.substr(0, args.find(' ')), config = dir + "/config.json";
+        ASSERT_EQ(test::runCommand("(" + std::string(SHADOWLAB_BINARY) + " sweep config " + sweepFile + " " +
+                                       std::to_string(c.sweepRun) + " > " + config + ")", out), 0) << out;
+        args = config + args.substr(args.find(' '));
+    }
     // The clustering cache goes to the test's folder, not ~/.cache.
-    const int rc = test::runCommand("XDG_CACHE_HOME=" + dir + " " + std::string(SHADOWLAB_BINARY) + " run " +
-                                        std::string(SHADOWLAB_SOURCE_DIR) + "/" + c.args + " --no-progress --out " + dir + "/out",
+    const int rc = test::runCommand("XDG_CACHE_HOME=" + dir + " " + std::string(SHADOWLAB_BINARY) + " run " + args +
+                                        " --no-progress --out " + dir + "/out",
                                     out);
     ASSERT_EQ(rc, 0) << out;
     const Json s = Json::parse(slurp(dir + "/out/summary.json"));

@@ -5,6 +5,7 @@
 #include "framework/experiment/Config.h"
 #include "framework/experiment/Runner.h"
 #include "framework/gl/GlContext.h"
+#include "framework/sweep/SweepCli.h"
 
 #include <cstdio>
 #include <cstring>
@@ -31,7 +32,7 @@ Usage:
   shadowlab list [--json | --markdown [NAME]]
       Lists the registered algorithms and their parameters; --markdown prints each parameter table
       as docs/algorithms/NAME.md holds it (scripts/update_param_docs.py rewrites the docs from it).
-  shadowlab --help | --version
+%s  shadowlab --help | --version
 
 Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.
 )";
@@ -139,7 +140,9 @@ int main(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);
     try {
         if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-            std::fputs(kUsage, args.empty() ? stderr : stdout);
+            std::string usage = kUsage;
+            usage.replace(usage.find("%s"), 2, kSweepUsage);
+            std::fputs(usage.c_str(), args.empty() ? stderr : stdout);
             return args.empty() ? 2 : 0;
         }
         if (args[0] == "--version") {
@@ -170,6 +173,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "run") return run(args);
+        if (args[0] == "sweep") return sweepCommand(args);
         usageError("unknown command " + args[0]);
     } catch (const InputError& e) {
         std::fprintf(stderr, "shadowlab: error: %s\n", e.what());

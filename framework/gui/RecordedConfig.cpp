@@ -3,20 +3,13 @@
 #include "framework/experiment/Config.h"
 #include "framework/experiment/Results.h"
 #include "framework/gui/Viewer.h"
+#include "framework/scene/SceneConfig.h"
 
 namespace shadowlab {
 
 namespace {
 
 Json vec(glm::vec3 v) { return Json::array({v.x, v.y, v.z}); }
-
-/// Rewrites every "gltf" path of a scene object (and of grids' inner objects) against `baseDir`.
-void absolutiseGltf(Json& object, const std::string& baseDir) {
-    if (!object.is_object()) return;
-    if (object.contains("gltf") && object["gltf"].is_string())
-        object["gltf"] = resolvePath(baseDir, object["gltf"].get<std::string>());
-    if (object.contains("object")) absolutiseGltf(object["object"], baseDir);
-}
 
 Json lightJson(const Viewer& viewer) {
     const Light& l = viewer.light;
@@ -39,7 +32,7 @@ Json recordedConfigJson(const Viewer& viewer, const Path& cameraPath, const std:
     const ExperimentConfig& cfg = viewer.config();
     Json scene = viewer.source().at("scene");
     if (scene.contains("objects") && scene["objects"].is_array())
-        for (Json& o : scene["objects"]) absolutiseGltf(o, parentDir(cfg.file));
+        for (Json& o : scene["objects"]) absolutiseScenePaths(o, parentDir(cfg.file));
 
     const Camera& cam = viewer.camera;
     Json camera = {{"fov_y_deg", cam.fovYDeg}, {"near", cam.nearPlane}, {"far", cam.farPlane},

@@ -250,13 +250,40 @@ Builder parseObject(JsonNode node, int depth, int budget) {
 
 } // namespace
 
-Scene buildScene(JsonNode sceneNode) {
-    const int budget = sceneNode.getInt("max_triangles", kDefaultMaxTriangles, 1, kMaxTrianglesCeiling);
+/// The scene's objects, each checked, with the budget they are built under; nothing is generated
+/// or loaded yet.
+struct ParsedScene {
+    int budget;
+    std::vector<JsonNode> objects;
     std::vector<Builder> builders;
-    std::vector<JsonNode> objects = sceneNode.objectArray("objects");
-    for (JsonNode& object : objects) builders.push_back(parseObject(object, 0, budget));
+};
+
+static ParsedScene parseScene(JsonNode& sceneNode) {
+    ParsedScene p;
+    p.budget = sceneNode.getInt("max_triangles", kDefaultMaxTriangles, 1, kMaxTrianglesCeiling);
+    p.objects = sceneNode.objectArray("objects");
+    for (JsonNode& object : p.objects) p.builders.push_back(parseObject(object, 0, p.budget));
     sceneNode.finish();
-    if (builders.empty()) sceneNode.fail("objects", "scene has no objects");
+    if (p.builders.empty()) sceneNode.fail("objects", "scene has no objects");
+    return p;
+}
+
+void checkScene(JsonNode sceneNode) { parseScene(sceneNode); }
+
+void absolutiseScenePaths(Json& object, const std::string& baseDir) {
+    if (!object.is_object()) return;
+    if (object.contains("gltf") && object["gltf"].is_string())
+        object["gltf"] = resolvePath(baseDir, object["gltf"].get<std::string>());
+    if (object.contains("object")) absolutiseScenePaths(object["object"], baseDir);
+    if (object.contains("objects") && object["objects"].is_array())
+        for (Json& o : object["objects"]) absolutiseScenePaths(o, baseDir);
+}
+
+Scene buildScene(JsonNode sceneNode) {
+    ParsedScene parsed = parseScene(sceneNode);
+    const std::vector<Builder>& builders = parsed.builders;
+    const std::vector<JsonNode>& objects = parsed.objects;
+    const int budget = parsed.budget;
     Scene scene;
     for (size_t i = 0; i < builders.size(); ++i) {
         Scene s = builders[i]();

@@ -8,5 +8,12 @@ namespace shadowlab {
 /// Reads {"objects": [...]} (schema: docs/scene.md) and returns the world-space triangle soup.
 /// Every error (unknown keys, bad values, unreadable or malformed glTF) is an InputError.
 Scene buildScene(JsonNode sceneNode);
+/// The same checks as buildScene (keys, values, glTF files present, triangle limits) without
+/// generating or loading anything, so thousands of scenes can be checked in a moment. A malformed
+/// glTF file is found only when it is loaded.
+void checkScene(JsonNode sceneNode);
+/// Rewrites every "gltf" path of a scene (or of one object, and of grids' inner objects) against
+/// `baseDir`, so the JSON keeps its meaning when written to another folder.
+void absolutiseScenePaths(Json& sceneOrObject, const std::string& baseDir);
 
 } // namespace shadowlab

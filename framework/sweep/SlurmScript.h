@@ -1,0 +1,31 @@
+#pragma once
+// `sweep slurm`: an sbatch array script that runs a sweep on a Slurm cluster, one array task per
+// run (or per shard), each task an ordinary `shadowlab sweep run --index K` on a compute node.
+#include "framework/sweep/SweepFile.h"
+
+#include <string>
+
+namespace shadowlab {
+
+struct SlurmOptions {
+    std::string outputDir;   ///< DIR; must be on a file system the compute nodes share (docs/cluster.md)
+    std::string partition;   ///< --partition, empty: the cluster's default
+    int gpusPerTask = 0;     ///< --gpus-per-task; > 0 runs shadowlab-egl (GPU, no display) instead of shadowlab (OSMesa)
+    int cpusPerTask = 0;     ///< --cpus-per-task, 0: the cluster's default
+    std::string time;        ///< --time per task, e.g. 01:00:00; empty: the partition's default
+    size_t maxParallel = 0;  ///< the array's %K throttle, 0: none
+    size_t shards = 0;       ///< 0: one task per run; N: N tasks, task i doing runs i, i+N, i+2N, ...
+};
+
+/// The sbatch script text for `sweep` (its snapshot at DIR/sweep.json), run by `binary`.
+std::string slurmScript(const Sweep& sweep, const SlurmOptions& options, const std::string& binary);
+
+/// Writes DIR/sweep.json and DIR/sweep.sbatch (and DIR/slurm/ for the tasks' logs); returns the
+/// script's path. `binary` is the shadowlab that wrote it; the tasks run it, or shadowlab-egl
+/// beside it when GPUs are requested.
+std::string writeSlurmScript(const Sweep& sweep, const SlurmOptions& options, const std::string& binary);
+
+/// Submits the script with `sbatch --parsable`; returns the job id. RuntimeError when sbatch fails.
+std::string submitSlurmScript(const std::string& script);
+
+} // namespace shadowlab

@@ -1,0 +1,14 @@
+#pragma once
+// `shadowlab sweep plan|config|run|slurm|merge`: the command line of sweeps (docs/sweep.md).
+#include <string>
+#include <vector>
+
+namespace shadowlab {
+
+/// The usage text of the sweep commands (part of `shadowlab --help`).
+extern const char* kSweepUsage;
+
+/// Runs `shadowlab sweep ...` (args[0] == "sweep"); returns the exit code. Bad input throws InputError.
+int sweepCommand(const std::vector<std::string>& args);
+
+} // namespace shadowlab

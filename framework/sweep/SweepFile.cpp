@@ -1,0 +1,283 @@
+#include "framework/sweep/SweepFile.h"
+
+#include "framework/experiment/Config.h"
+#include "framework/scene/SceneConfig.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+
+namespace shadowlab {
+
+namespace {
+
+// A sweep beyond this is almost certainly a mistake (an axis of 1000 values times a few more), and
+// expanding it would validate millions of configs before saying so.
+constexpr size_t kMaxRuns = 100000;
+
+// Column names of sweep.csv that an axis must not shadow.
+const std::set<std::string> kReservedNames = {"run", "index", "triangles", "pixels", "id", "algorithm", "measure", "value"};
+
+const std::vector<std::string> kScales = {"category", "value", "triangles", "pixels"};
+
+std::string defaultName(const std::string& file) {
+    std::string stem = std::filesystem::path(file).filename().string();
+    for (const char* ext : {".sweep.json", ".json"}) {
+        const std::string e = ext;
+        if (stem.size() > e.size() && stem.compare(stem.size() - e.size(), e.size(), e) == 0) return stem.substr(0, stem.size() - e.size());
+    }
+    return stem;
+}
+
+bool isIdentifier(const std::string& s) {
+    if (s.empty()) return false;
+    for (char c : s)
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
+    return true;
+}
+
+/// "scene.objects.1" → "/scene/objects/1" (the form JsonNode uses in its errors).
+std::string slashPath(const std::string& dotted) {
+    std::string s = "/" + dotted;
+    for (char& c : s)
+        if (c == '.') c = '/';
+    return s;
+}
+
+bool overlaps(const std::string& a, const std::string& b) {
+    auto under = [](const std::string& x, const std::string& root) {
+        return x == root || (x.size() > root.size() && x.compare(0, root.size(), root) == 0 && x[root.size()] == '/');
+    };
+    return under(a, b) || under(b, a);
+}
+
+std::string axisWhere(size_t a, const SweepAxis& axis) { return "/axes/" + std::to_string(a) + " (axis \"" + axis.name + "\")"; }
+
+SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names, std::set<std::string>& allPaths) {
+    SweepAxis axis;
+    axis.name = node.requireString("name");
+    if (!isIdentifier(axis.name)) node.fail("name", "\"" + axis.name + "\" is not a name of letters, digits and _ (it becomes a column name)");
+    if (kReservedNames.count(axis.name)) node.fail("name", "\"" + axis.name + "\" is a column of sweep.csv already; choose another name");
+    if (names.count(axis.name)) node.fail("name", "two axes are named \"" + axis.name + "\"");
+    const std::string where = axisWhere(a, axis);
+
+    if (!node.has("values")) node.fail("values", "required key is missing: {\"dotted.path\": [value, ...], ...}");
+    const Json& values = node.raw()["values"];
+    node.markRead("values");
+    if (!values.is_object() || values.empty())
+        throw InputError(node.file(), where + "/values", "expected an object of one or more dotted paths, each with a list of values");
+    size_t count = 0;
+    for (const auto& [path, list] : values.items()) {
+        const std::string at = where + ", path " + path;
+        if (path.empty() || path.front() == '.' || path.back() == '.' || path.find("..") != std::string::npos)
+            throw InputError(node.file(), at, "not a dotted path like scene.objects.1.object.triangles");
+        if (!list.is_array() || list.empty()) throw InputError(node.file(), at, "expected a non-empty list of values");
+        if (!allPaths.insert(path).second) throw InputError(node.file(), at, "another axis sets this path already");
+        for (const std::string& other : allPaths)
+            if (other != path && overlaps(slashPath(other), slashPath(path)))
+                throw InputError(node.file(), at, "overlaps the path " + other + " of an axis (one would overwrite the other)");
+        if (count && list.size() != count)
+            throw InputError(node.file(), at, "has " + std::to_string(list.size()) + " values but " + axis.paths.front() + " has " +
+                                                  std::to_string(count) + " (the paths of one axis move together)");
+        count = list.size();
+        axis.paths.push_back(path);
+        axis.values.push_back(std::vector<Json>(list.begin(), list.end()));
+    }
+
+    if (node.has("labels")) {
+        const Json& labels = node.raw()["labels"];
+        node.markRead("labels");
+        if (!labels.is_array() || labels.size() != count)
+            node.fail("labels", "expected a list of " + std::to_string(count) + " strings, one per value");
+        for (const Json& l : labels) {
+            if (!l.is_string() || l.get<std::string>().empty()) node.fail("labels", "expected non-empty strings, got " + l.dump());
+            axis.labels.push_back(l.get<std::string>());
+        }
+    } else if (axis.paths.size() > 1) {
+        node.fail("labels", "required when an axis sets several paths (name each of its " + std::to_string(count) + " points)");
+    } else {
+        for (const Json& v : axis.values.front()) axis.labels.push_back(v.is_string() ? v.get<std::string>() : v.dump());
+    }
+    std::set<std::string> seen;
+    for (const auto& l : axis.labels)
+        if (!seen.insert(l).second) throw InputError(node.file(), where, "the label \"" + l + "\" appears twice");
+
+    const std::string scale = node.getEnum("scale", "category", kScales);
+    axis.scale = AxisScale(std::find(kScales.begin(), kScales.end(), scale) - kScales.begin());
+    if (axis.scale == AxisScale::Value)
+        for (size_t p = 0; p < axis.paths.size(); ++p)
+            for (const Json& v : axis.values[p])
+                if (!v.is_number() || v.get<double>() <= 0)
+                    node.fail("scale", "\"value\" needs positive numbers (x of a log-log plot), but " + axis.paths[p] + " has " + v.dump());
+    node.finish();
+    return axis;
+}
+
+/// Validates one run's config as `shadowlab run` would, without generating or loading its scene,
+/// and returns the resolved config (defaults filled in, scene included) that its id is made from.
+Json resolveRun(const Json& config, const std::string& file) {
+    ExperimentConfig c = parseConfig(config, file, false);
+    Json resolved = c.resolved;
+    resolved["scene"] = Json::object();
+    checkScene(JsonNode(file, &config.at("scene"), "/scene", &resolved["scene"]));
+    return resolved;
+}
+
+/// Rethrows a run's config error with the sweep's context: the axis whose path the error lies in
+/// (or under), else the base config.
+[[noreturn]] void rethrowRunError(const InputError& e, const Sweep& s, const SweepRun& run, const std::string& baseFile,
+                                  const std::string& baseWhere) {
+    for (size_t a = 0; a < s.axes.size(); ++a) {
+        const SweepAxis& axis = s.axes[a];
+        for (size_t p = 0; p < axis.paths.size(); ++p)
+            if (overlaps(e.jsonPath(), slashPath(axis.paths[p])))
+                throw InputError(s.file, axisWhere(a, axis) + ", path " + axis.paths[p] + " = " + axis.values[p][run.point[a]].dump(),
+                                 "at " + e.jsonPath() + ": " + e.cause());
+    }
+    // Not an axis path: the base config itself is wrong (in the sweep file at /base, or in its own file).
+    throw InputError(baseWhere.empty() ? baseFile : s.file, baseWhere + e.jsonPath(),
+                     e.cause() + " (run " + std::to_string(run.index) + ": " + runLabel(s, run) + ")");
+}
+
+} // namespace
+
+std::string toString(AxisScale scale) { return kScales[size_t(scale)]; }
+
+std::string runId(const Json& resolvedConfig) {
+    Json j = resolvedConfig;
+    if (j.contains("output") && j["output"].is_object()) j["output"].erase("dir");
+    // FNV-1a over the canonical dump (nlohmann sorts object keys): stable across runs and machines.
+    uint64_t h = 1469598103934665603ull;
+    for (unsigned char c : j.dump()) h = (h ^ c) * 1099511628211ull;
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%012llx", static_cast<unsigned long long>(h >> 16));
+    return buf;
+}
+
+std::string runLabel(const Sweep& sweep, const SweepRun& run) {
+    std::string s;
+    for (size_t a = 0; a < sweep.axes.size(); ++a)
+        s += (a ? " " : "") + sweep.axes[a].name + "=" + sweep.axes[a].labels[run.point[a]];
+    return s.empty() ? "(base)" : s;
+}
+
+Json planJson(const Sweep& sweep) {
+    Json axes = Json::array(), runs = Json::array();
+    for (const auto& a : sweep.axes) axes.push_back({{"name", a.name}, {"scale", toString(a.scale)}, {"labels", a.labels}, {"paths", a.paths}});
+    for (const auto& r : sweep.runs) {
+        Json labels = Json::object();
+        for (size_t a = 0; a < sweep.axes.size(); ++a) labels[sweep.axes[a].name] = sweep.axes[a].labels[r.point[a]];
+        runs.push_back({{"index", r.index}, {"id", r.id}, {"axes", labels}});
+    }
+    return {{"name", sweep.name}, {"file", sweep.file}, {"axes", axes}, {"merge", sweep.merge}, {"runs", runs}};
+}
+
+Json Sweep::snapshot(const std::string& dir) const {
+    Json j = {{"name", name}, {"base", base}, {"axes", axesJson}, {"output", {{"dir", std::filesystem::absolute(dir).string()}}}};
+    if (!merge.empty()) j["merge"] = merge;
+    return j;
+}
+
+Sweep parseSweep(const Json& json, const std::string& file) {
+    Sweep s;
+    s.file = file;
+    JsonNode root(file, &json, "", nullptr);
+    s.name = root.getString("name", defaultName(file));
+
+    // The base: a config inline, or the name of a config file (relative to the sweep file).
+    if (!root.has("base")) root.fail("base", "required key is missing (an experiment config, inline or a file name)");
+    const Json& base = root.raw()["base"];
+    root.markRead("base");
+    std::string baseFile = file, baseDir = parentDir(file), baseWhere = "/base";
+    if (base.is_string()) {
+        baseFile = resolvePath(baseDir, base.get<std::string>());
+        s.base = JsonNode::parseFile(baseFile);
+        baseDir = parentDir(baseFile);
+        baseWhere = "";
+    } else if (base.is_object()) {
+        s.base = base;
+    } else {
+        root.fail("base", "expected an experiment config object or the file name of one");
+    }
+    // Run configs are written under the output folder: their glTF files must not depend on where.
+    if (s.base.is_object() && s.base.contains("scene")) absolutiseScenePaths(s.base["scene"], baseDir);
+
+    std::set<std::string> names, paths;
+    s.axesJson = root.has("axes") ? root.raw()["axes"] : Json::array();
+    std::vector<JsonNode> axisNodes = root.objectArray("axes");
+    for (size_t a = 0; a < axisNodes.size(); ++a) {
+        s.axes.push_back(parseAxis(axisNodes[a], a, names, paths));
+        names.insert(s.axes.back().name);
+    }
+
+    JsonNode merge = root.child("merge");
+    for (const char* key : {"stages", "counters", "ratios"}) {
+        if (!merge.has(key)) continue;
+        const Json& list = merge.raw()[key];
+        merge.markRead(key);
+        bool ok = list.is_array();
+        for (const Json& v : list) ok = ok && v.is_string();
+        if (!ok) merge.fail(key, "expected a list of strings");
+        if (std::string(key) == "ratios")
+            for (const Json& v : list)
+                if (v.get<std::string>().find('/') == std::string::npos)
+                    merge.fail(key, "\"" + v.get<std::string>() + "\" is not ID/ID (the total time of one algorithm id over another's)");
+    }
+    merge.finish();
+    s.merge = root.has("merge") ? root.raw()["merge"] : Json::object();
+    JsonNode out = root.child("output");
+    s.outputDir = out.getPath("dir", "results/" + s.name);
+    out.finish();
+    root.finish();
+
+    size_t total = 1;
+    for (const auto& axis : s.axes) {
+        total *= axis.size();
+        if (total > kMaxRuns) root.fail("axes", "more than " + std::to_string(kMaxRuns) + " runs");
+    }
+
+    std::map<std::string, size_t> ids;
+    for (size_t index = 0; index < total; ++index) {
+        SweepRun run;
+        run.index = index;
+        run.point.resize(s.axes.size());
+        for (size_t a = s.axes.size(), rest = index; a-- > 0;) {
+            run.point[a] = rest % s.axes[a].size();
+            rest /= s.axes[a].size();
+        }
+        run.config = s.base;
+        for (size_t a = 0; a < s.axes.size(); ++a) {
+            const SweepAxis& axis = s.axes[a];
+            for (size_t p = 0; p < axis.paths.size(); ++p) {
+                const Json& v = axis.values[p][run.point[a]];
+                try {
+                    // The --set walker, so an axis path means exactly what --set PATH means.
+                    applyOverride(run.config, axis.paths[p] + "=" + v.dump());
+                } catch (const InputError& e) {
+                    throw InputError(file, axisWhere(a, axis) + ", path " + axis.paths[p], e.cause() + " (at " + e.jsonPath() + ")");
+                }
+            }
+        }
+        Json resolved;
+        try {
+            resolved = resolveRun(run.config, baseFile);
+        } catch (const InputError& e) {
+            if (e.file() != baseFile) throw; // a glTF file's own error names that file
+            rethrowRunError(e, s, run, baseFile, baseWhere);
+        }
+        run.id = runId(resolved);
+        if (auto [it, fresh] = ids.emplace(run.id, index); !fresh)
+            root.fail("axes", "runs " + std::to_string(it->second) + " (" + runLabel(s, s.runs[it->second]) + ") and " +
+                                  std::to_string(index) + " (" + runLabel(s, run) +
+                                  ") resolve to the same config (an axis repeats a value, or sets one to its default)");
+        s.runs.push_back(std::move(run));
+    }
+    return s;
+}
+
+Sweep loadSweep(const std::string& file) { return parseSweep(JsonNode::parseFile(file), file); }
+
+} // namespace shadowlab

@@ -1,0 +1,70 @@
+#pragma once
+// A sweep file (docs/sweep.md): a base experiment config plus axes. Each axis sets one or more
+// dotted JSON paths of the config (the syntax of `--set`); the paths of one axis move together
+// (zip) and the axes combine as a product. Every generated run is validated like a config before
+// anything runs, and gets an id derived from its resolved config.
+#include "framework/core/JsonNode.h"
+
+#include <string>
+#include <vector>
+
+namespace shadowlab {
+
+/// How plots and fits treat an axis.
+enum class AxisScale {
+    Category,  ///< plotted in order, linear axes (parameter values, light types, ...)
+    Value,     ///< a size: the axis value itself (a number) is x; log-log plots and power-law fits
+    Triangles, ///< a size: the run's triangle count (summary.json `triangles`) is x
+    Pixels,    ///< a size: the run's width × height is x
+};
+
+struct SweepAxis {
+    std::string name;                     ///< column name in sweep.csv, plan and tables
+    std::vector<std::string> paths;       ///< dotted config paths, in file order
+    std::vector<std::vector<Json>> values; ///< values[path][k]: the k-th value of each path
+    std::vector<std::string> labels;      ///< labels[k]: how the k-th value is shown
+    AxisScale scale = AxisScale::Category;
+    size_t size() const { return labels.size(); }
+};
+
+struct SweepRun {
+    size_t index = 0;          ///< position in the product (the last axis varies fastest)
+    std::string id;            ///< runId() of the resolved config: the run's folder name
+    std::vector<size_t> point; ///< point[a]: the value index on axis a
+    Json config;               ///< the run's experiment config (glTF paths absolute)
+};
+
+struct Sweep {
+    std::string file;        ///< the sweep file
+    std::string name;        ///< `name`, default: the file name without .sweep.json / .json
+    Json base;               ///< the base config, glTF paths made absolute
+    std::vector<SweepAxis> axes;
+    Json axesJson;           ///< `axes` as written (for the snapshot)
+    Json merge;              ///< the `merge` object: stages, counters, ratios for sweep.md
+    std::string outputDir;   ///< `output.dir`, resolved against the sweep file's folder
+    std::vector<SweepRun> runs;
+
+    /// The sweep as one self-contained file: base inlined, paths absolute, output.dir = `dir`.
+    /// Written as DIR/sweep.json; expanding it again gives the same runs and ids.
+    Json snapshot(const std::string& dir) const;
+};
+
+/// Reads, expands and validates a sweep file; any problem is an InputError naming the file, the
+/// axis and the JSON path.
+Sweep loadSweep(const std::string& file);
+Sweep parseSweep(const Json& json, const std::string& file);
+
+/// A stable id of a run: a hash of its resolved config with output.dir left out, so the same run
+/// keeps its id when axes are added or the sweep is written to another folder.
+std::string runId(const Json& resolvedConfig);
+
+/// The runs as JSON: {name, axes: [{name, scale, labels, paths}], merge, runs: [{index, id, axes: {name: label}}]}
+/// (`sweep plan --json`, and DIR/plan.json for the merge's report).
+Json planJson(const Sweep& sweep);
+
+/// "size=10k res=[64,64]": the run's axis labels, for progress lines and errors.
+std::string runLabel(const Sweep& sweep, const SweepRun& run);
+
+std::string toString(AxisScale scale);
+
+} // namespace shadowlab

@@ -1,0 +1,249 @@
+#!/usr/bin/env python3
+"""The report of a merged sweep: reads DIR/plan.json and DIR/sweep.csv (written by
+`shadowlab sweep merge DIR`, which runs this script) and writes
+
+  DIR/sweep.md         a table per axis, the ratios the sweep file asks for (merge.ratios), and
+                       power-law fits  time = c * n^k  per (algorithm id, stage) along size axes
+  DIR/sweep_AXIS.png   mean time per frame of each stage against the axis, one line per algorithm
+                       id (and per value of the other axes); log-log where the axis is a size
+
+Usage: sweep_report.py DIR [--no-plots]
+"""
+import csv
+import json
+import math
+import os
+import sys
+from collections import defaultdict
+
+SIZE_SCALES = ("value", "triangles", "pixels")
+
+
+def power_fit(ns, ts):
+    """Least-squares fit of log t = log c + k log n; returns (k, c) or None."""
+    pts = [(math.log(n), math.log(t)) for n, t in zip(ns, ts) if n > 0 and t > 0]
+    if len(pts) < 2:
+        return None
+    mx = sum(p[0] for p in pts) / len(pts)
+    my = sum(p[1] for p in pts) / len(pts)
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    if sxx == 0:
+        return None
+    k = sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
+    return k, math.exp(my - k * mx)
+
+
+def nlogn_ratio(ns, ts):
+    """t / (n log2 n), normalised to the smallest n: flat when the growth is n log n."""
+    base, out = None, []
+    for n, t in zip(ns, ts):
+        r = t / (n * math.log2(n)) if n > 1 and t > 0 else float("nan")
+        base = base or r
+        out.append(r / base if base else float("nan"))
+    return out
+
+
+class Sweep:
+    def __init__(self, directory):
+        with open(os.path.join(directory, "plan.json")) as f:
+            self.plan = json.load(f)
+        self.axes = self.plan["axes"]
+        self.merge = self.plan.get("merge") or {}
+        # run id -> {"axes": {name: label}, "triangles", "pixels", "values": {alg id: {measure: float}}}
+        self.runs = {}
+        self.algorithms = {}  # alg id -> algorithm name, in first-seen order
+        with open(os.path.join(directory, "sweep.csv"), newline="") as f:
+            for row in csv.DictReader(f):
+                r = self.runs.setdefault(row["run"], {"index": int(row["index"]), "triangles": int(row["triangles"]),
+                                                      "pixels": int(row["pixels"]), "values": defaultdict(dict),
+                                                      "axes": {a["name"]: row[a["name"]] for a in self.axes}})
+                self.algorithms.setdefault(row["id"], row["algorithm"])
+                r["values"][row["id"]][row["measure"]] = float(row["value"]) if row["value"] != "" else None
+        measures = {m for r in self.runs.values() for v in r["values"].values() for m in v}
+        found = sorted({m[len("time_ms."):] for m in measures if m.startswith("time_ms.")}, key=lambda s: (s == "total", s))
+        self.stages = self.merge.get("stages") or found
+        self.counters = self.merge.get("counters") or []
+
+    def x(self, axis, run):
+        """The x of a run along an axis: its size for size axes, else the label's position."""
+        scale = axis["scale"]
+        if scale == "triangles":
+            return run["triangles"]
+        if scale == "pixels":
+            return run["pixels"]
+        label = run["axes"][axis["name"]]
+        return float(label) if scale == "value" else axis["labels"].index(label)
+
+    def others(self, axis):
+        return [a for a in self.axes if a["name"] != axis["name"]]
+
+    def group_key(self, axis, run):
+        """The labels of the other axes (what stays fixed along one line of this axis)."""
+        return tuple(run["axes"][a["name"]] for a in self.others(axis))
+
+    def ordered_runs(self, axis):
+        """Runs sorted by the other axes, then along this axis."""
+        def key(run):
+            return ([a["labels"].index(run["axes"][a["name"]]) for a in self.others(axis)] +
+                    [axis["labels"].index(run["axes"][axis["name"]])])
+        return sorted(self.runs.values(), key=key)
+
+
+def fmt(v, spec):
+    return "" if v is None else format(v, spec)
+
+
+def axis_table(s, axis):
+    others = s.others(axis)
+    head = [a["name"] for a in others] + ["id", axis["name"], "triangles"] + s.stages + s.counters + \
+        ["memory (MiB)", "mismatch (worst frame)", "overflow"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(others) + "---|---|" + "---:|" * (len(head) - len(others) - 2)]
+    for aid in s.algorithms:
+        for run in s.ordered_runs(axis):
+            v = run["values"].get(aid)
+            if v is None:
+                continue
+            mm = v.get("accuracy.mismatch_ratio_max")
+            cells = [run["axes"][a["name"]] for a in others] + [aid, run["axes"][axis["name"]], f"{run['triangles']:,}"]
+            cells += [fmt(v.get(f"time_ms.{st}"), ".2f") for st in s.stages]
+            cells += [fmt(v.get(f"counters.{c}"), ".2f") for c in s.counters]
+            cells += [fmt(v["memory_bytes"] / 2 ** 20, ".1f"), "" if mm is None else f"{100 * mm:.4f} %",
+                      fmt(v.get("overflow"), ".0f")]
+            lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def ratio_table(s, ratio):
+    num, _, den = ratio.partition("/")
+    head = [a["name"] for a in s.axes] + ["triangles", f"{num} / {den}"]
+    lines = [f"## {num} / {den}: total time per frame, same run", "", "| " + " | ".join(head) + " |",
+             "|" + "---|" * len(s.axes) + "---:|---:|"]
+    for run in sorted(s.runs.values(), key=lambda r: r["index"]):
+        a, b = run["values"].get(num, {}).get("time_ms.total"), run["values"].get(den, {}).get("time_ms.total")
+        if a is not None and b:
+            lines.append("| " + " | ".join([run["axes"][x["name"]] for x in s.axes] + [f"{run['triangles']:,}", f"{a / b:.2f}"]) + " |")
+    return lines
+
+
+def fit_table(s, axis):
+    others = s.others(axis)
+    xname = {"triangles": "n = triangles", "pixels": "n = pixels", "value": f"n = {axis['name']}"}[axis["scale"]]
+    lines = [f"## Power-law fits along `{axis['name']}`: time = c · n^k ({xname}; least squares in log-log)", "",
+             "| " + " | ".join([a["name"] for a in others] + ["id", "stage", "k", "t / (n log n), normalised to the smallest n"]) + " |",
+             "|" + "---|" * len(others) + "---|---|---:|---|"]
+    groups = defaultdict(list)
+    for run in s.ordered_runs(axis):
+        groups[s.group_key(axis, run)].append(run)
+    for key, runs in groups.items():
+        for aid in s.algorithms:
+            for st in s.stages:
+                pts = sorted((s.x(axis, r), r["values"][aid][f"time_ms.{st}"]) for r in runs
+                             if aid in r["values"] and r["values"][aid].get(f"time_ms.{st}") is not None)
+                fit = power_fit([p[0] for p in pts], [p[1] for p in pts])
+                if fit:
+                    ratios = ", ".join(f"{x:.2f}" for x in nlogn_ratio([p[0] for p in pts], [p[1] for p in pts]))
+                    lines.append("| " + " | ".join(list(key) + [aid, st, f"{fit[0]:.2f}", ratios]) + " |")
+    return lines
+
+
+def report(s, directory):
+    statuses = [r.get("status", "missing") for r in s.plan["runs"]]
+    complete = [r for r in s.plan["runs"] if r.get("status") == "complete"]
+    renderers = sorted({r.get("renderer", "") for r in complete})
+    sources = sorted({r.get("stage_time_source", "") for r in complete})
+    src = "; ".join("wall clock per stage" if x == "wall" else "GPU timer queries" for x in sources)
+    lines = [f"# Sweep {s.plan['name']}", "",
+             f"- runs: {len(statuses)}, merged {statuses.count('complete')}, failed {statuses.count('failed')}, "
+             f"missing {statuses.count('missing')}",
+             f"- renderer: {', '.join(renderers)}",
+             f"- stage times: {src}, mean ms per frame",
+             "- axes: " + ("; ".join(f"`{a['name']}` ({a['scale']}): {', '.join(a['labels'])}" for a in s.axes) or "none"), ""]
+    for r in s.plan["runs"]:
+        if r.get("status") != "complete":
+            labels = " ".join(f"{k}={v}" for k, v in r["axes"].items())
+            lines.append(f"- **run {r['index']} {r['id']} ({labels}): {r.get('status', 'missing')}**")
+    for axis in s.axes:
+        lines += ["", f"## By `{axis['name']}`", ""] + axis_table(s, axis)
+    if not s.axes:
+        lines += ["", "## Results", ""] + axis_table_flat(s)
+    for ratio in s.merge.get("ratios", []):
+        lines += [""] + ratio_table(s, ratio)
+    for axis in s.axes:
+        if axis["scale"] in SIZE_SCALES:
+            lines += [""] + fit_table(s, axis)
+    with open(os.path.join(directory, "sweep.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def axis_table_flat(s):
+    """A sweep without axes is one run: its table has no axis column."""
+    head = ["id", "triangles"] + s.stages + ["memory (MiB)", "mismatch (worst frame)"]
+    lines = ["| " + " | ".join(head) + " |", "|---|" + "---:|" * (len(head) - 1)]
+    for run in s.runs.values():
+        for aid, v in run["values"].items():
+            mm = v.get("accuracy.mismatch_ratio_max")
+            lines.append("| " + " | ".join([aid, f"{run['triangles']:,}"] + [fmt(v.get(f"time_ms.{st}"), ".2f") for st in s.stages] +
+                                           [fmt(v["memory_bytes"] / 2 ** 20, ".1f"), "" if mm is None else f"{100 * mm:.4f} %"]) + " |")
+    return lines
+
+
+def plots(s, directory):
+    import matplotlib
+    matplotlib.use("Agg")  # headless: no display on CI or servers
+    import matplotlib.pyplot as plt
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plot_style
+
+    colour = plot_style.colours(s.algorithms)
+    for axis in s.axes:
+        size = axis["scale"] in SIZE_SCALES
+        groups = defaultdict(list)
+        for run in s.ordered_runs(axis):
+            groups[s.group_key(axis, run)].append(run)
+        style = plot_style.variants(groups)
+        stages = [st for st in s.stages if any(f"time_ms.{st}" in v for r in s.runs.values() for v in r["values"].values())]
+        if not stages:
+            continue
+        fig, axes = plt.subplots(1, len(stages), figsize=(4.4 * len(stages), 3.9), squeeze=False)
+        for ax, st in zip(axes[0], stages):
+            for aid in s.algorithms:
+                for key, runs in groups.items():
+                    pts = sorted((s.x(axis, r), r["values"][aid][f"time_ms.{st}"]) for r in runs
+                                 if aid in r["values"] and r["values"][aid].get(f"time_ms.{st}"))
+                    if not pts:
+                        continue
+                    label = aid + (" (" + ", ".join(key) + ")" if key else "")
+                    if size:
+                        fit = power_fit([p[0] for p in pts], [p[1] for p in pts])
+                        label += f" k={fit[0]:.2f}" if fit else ""
+                    ax.plot([p[0] for p in pts], [p[1] for p in pts], color=colour[aid], linestyle=style[key]["linestyle"],
+                            marker=style[key]["marker"], label=label)
+            if size:
+                ax.set_xscale("log")
+                ax.set_yscale("log")
+            else:
+                ax.set_xticks(range(len(axis["labels"])))
+                ax.set_xticklabels(axis["labels"], rotation=20)
+            ax.set_title(st)
+            ax.set_xlabel({"triangles": "triangles", "pixels": "pixels"}.get(axis["scale"], axis["name"]))
+            ax.set_ylabel("ms per frame")
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=7)
+        fig.suptitle(f"{s.plan['name']}: time per frame against {axis['name']}")
+        fig.tight_layout()
+        fig.savefig(os.path.join(directory, f"sweep_{axis['name']}.png"), dpi=110)
+        plt.close(fig)
+
+
+def main():
+    args = sys.argv[1:]
+    if not args or len(args) > 2 or (len(args) == 2 and args[1] != "--no-plots"):
+        sys.exit(__doc__)
+    s = Sweep(args[0])
+    report(s, args[0])
+    if len(args) == 1:
+        plots(s, args[0])
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,314 @@
+// Sweeps through the command line: validation errors (exit code 2, one line naming the axis and
+// the JSON path), stable run ids, running, failing, resuming after a kill, and merging.
+#include "framework/core/JsonNode.h"
+#include "tests/SweepTestData.h"
+#include "tests/TestSupport.h"
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string bin() { return SHADOWLAB_BINARY; }
+
+size_t countOf(const std::string& text, const std::string& what) {
+    size_t n = 0;
+    for (size_t pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + 1)) ++n;
+    return n;
+}
+
+// ---- Validation -----------------------------------------------------------------------------------
+
+struct BadSweep {
+    const char* name;
+    const char* patch;     ///< JSON merged into the small sweep (merge_patch: null removes a key)
+    const char* expected;  ///< substrings of the one-line error, separated by '|'
+};
+
+const BadSweep kBadSweeps[] = {
+    {"AxisNameNotAnIdentifier", R"({"axes": [{"name": "tri count", "values": {"frames": [1, 2]}}]})", "/axes/0/name|tri count"},
+    {"AxisNameTwice", R"({"axes": [{"name": "a", "values": {"frames": [1, 2]}}, {"name": "a", "values": {"resolution": [[8, 8]]}}]})",
+     "/axes/1/name|two axes are named \"a\""},
+    {"AxisNameIsAColumn", R"({"axes": [{"name": "measure", "values": {"frames": [1, 2]}}]})", "/axes/0/name|column"},
+    {"IndexPastTheArray", R"({"axes": [{"name": "pcf", "values": {"algorithms.5.params.pcf": [0, 1]}}]})",
+     "axis \"pcf\"|path algorithms.5.params.pcf|no element 5 in an array of 2"},
+    {"DescendIntoANumber", R"({"axes": [{"name": "f", "values": {"frames.x": [1, 2]}}]})", "axis \"f\"|path frames.x|cannot descend"},
+    {"UnknownParameter", R"({"axes": [{"name": "pcf", "values": {"algorithms.0.params.pfc": [0, 1]}}]})",
+     "axis \"pcf\"|path algorithms.0.params.pfc|/algorithms/0/params/pfc"},
+    {"ValueOutOfRange", R"({"axes": [{"name": "frames", "values": {"frames": [2, 0]}}]})",
+     "axis \"frames\"|path frames = 0|out of range"},
+    {"SceneValueOutOfRange", R"({"axes": [{"name": "tris", "values": {"scene.objects.1.triangles": [300, 0]}}]})",
+     "axis \"tris\"|path scene.objects.1.triangles = 0|/scene/objects/1/triangles"},
+    {"ZipLengthsDiffer", R"({"axes": [{"name": "z", "labels": ["a", "b"], "values": {"frames": [1, 2], "warmup_frames": [0, 1, 2]}}]})",
+     "axis \"z\"|path warmup_frames|has 3 values but frames has 2"},
+    {"ZipWithoutLabels", R"({"axes": [{"name": "z", "values": {"frames": [1, 2], "warmup_frames": [0, 1]}}]})",
+     "/axes/0/labels|required when an axis sets several paths"},
+    {"SamePathTwice", R"({"axes": [{"name": "a", "values": {"frames": [1, 2]}}, {"name": "b", "values": {"frames": [3]}}]})",
+     "axis \"b\"|path frames|another axis sets this path"},
+    {"SameRunTwice", R"({"axes": [{"name": "pcf", "values": {"algorithms.0.params.pcf": [1, 1.0]}, "labels": ["one", "also one"]}]})",
+     "/axes|resolve to the same config"},
+    {"UnknownTopLevelKey", R"({"axis": []})", "/axis|unknown"},
+    {"BadBaseOutsideAnyAxis", R"({"base": {"frames": -1}})", "/base/frames|out of range"},
+    {"NoBase", R"({"base": null})", "/base|required"},
+    {"BadRatio", R"({"merge": {"ratios": ["psv"]}})", "/merge/ratios|not ID/ID"},
+};
+
+void PrintTo(const BadSweep& c, std::ostream* os) { *os << c.name << ": " << c.patch; }
+
+class SweepValidationTest : public ::testing::TestWithParam<BadSweep> {};
+
+TEST_P(SweepValidationTest, ExitsWithCode2AndOneLineNamingThePath) {
+    const BadSweep& c = GetParam();
+    const std::string dir = test::makeTempDir("sweep-bad");
+    Json sweep = test::smallSweep();
+    sweep.merge_patch(Json::parse(c.patch));
+    const std::string file = test::writeJson(dir + "/bad.sweep.json", sweep);
+    for (const std::string& command : {"plan " + file, "run " + file + " --out " + dir + "/out"}) {
+        std::string out;
+        EXPECT_EQ(test::runCommand(bin() + " sweep " + command, out), 2) << out;
+        const std::string trimmed = out.substr(0, out.find_last_not_of('\n') + 1);
+        EXPECT_EQ(trimmed.find('\n'), std::string::npos) << out;
+        EXPECT_NE(out.find(file), std::string::npos) << out;
+        std::stringstream expected(c.expected);
+        for (std::string part; std::getline(expected, part, '|');) EXPECT_NE(out.find(part), std::string::npos) << part << " in " << out;
+    }
+    // Nothing ran: validation comes before any output.
+    EXPECT_FALSE(fs::exists(dir + "/out/runs"));
+}
+
+INSTANTIATE_TEST_SUITE_P(BadSweeps, SweepValidationTest, ::testing::ValuesIn(kBadSweeps),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(SweepTest, BadCommandLinesAreBadInput) {
+    const std::string dir = test::makeTempDir("sweep-args");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep());
+    std::string out;
+    for (const std::string& args : std::vector<std::string>{"sweep", "sweep frobnicate", "sweep run " + file + " --jobs 0", "sweep run " + file + " --shard 4/4",
+                                   "sweep run " + file + " --index 4", "sweep run " + file + " --index 1 --shard 0/2",
+                                   "sweep config " + file + " 9", "sweep merge " + dir + "/nothing", "sweep plan " + dir + "/missing.json",
+                                   "sweep slurm " + file + " --gpus-per-task x"})
+        EXPECT_EQ(test::runCommand(bin() + " " + args, out), 2) << args << ": " << out;
+}
+
+// ---- Ids --------------------------------------------------------------------------------------------
+
+/// index → id, and labels → id, of `sweep plan --json`.
+Json plan(const std::string& file) {
+    std::string out;
+    EXPECT_EQ(test::runCommand("(" + bin() + " sweep plan " + file + " --json 2>/dev/null)", out), 0) << out;
+    return Json::parse(out);
+}
+
+TEST(SweepTest, RunsKeepTheirIdsWhenAnAxisIsAdded) {
+    const std::string dir = test::makeTempDir("sweep-ids");
+    Json small = test::smallSweep();
+    const Json before = plan(test::writeJson(dir + "/a.sweep.json", small));
+    ASSERT_EQ(before["runs"].size(), 4u);
+    std::set<std::string> ids;
+    for (const Json& r : before["runs"]) ids.insert(r["id"].get<std::string>());
+    EXPECT_EQ(ids.size(), 4u) << "every run has its own id";
+
+    // A third axis whose first value is the base's own (a point light): those runs are the old ones.
+    small["axes"].push_back({{"name", "light"}, {"values", {{"light.type", {"point", "directional"}}}}});
+    // Moving the output and writing a default explicitly change no run either.
+    small["output"] = {{"dir", "elsewhere"}};
+    small["base"]["camera"]["fov_y_deg"] = 60;
+    const Json after = plan(test::writeJson(dir + "/b.sweep.json", small));
+    ASSERT_EQ(after["runs"].size(), 8u);
+    for (const Json& r : before["runs"]) {
+        size_t matches = 0;
+        for (const Json& s : after["runs"])
+            if (s["axes"]["tris"] == r["axes"]["tris"] && s["axes"]["pcf"] == r["axes"]["pcf"] && s["axes"]["light"] == "point") {
+                EXPECT_EQ(s["id"], r["id"]) << r.dump();
+                ++matches;
+            }
+        EXPECT_EQ(matches, 1u);
+    }
+    // The directional runs are new runs.
+    for (const Json& s : after["runs"])
+        if (s["axes"]["light"] == "directional") EXPECT_FALSE(ids.count(s["id"].get<std::string>())) << s.dump();
+}
+
+TEST(SweepTest, SlurmScriptRunsOneTaskPerRunOrPerShard) {
+    const std::string dir = test::makeTempDir("sweep-sbatch");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep());
+    std::string out;
+    auto script = [&](const std::string& options) {
+        EXPECT_EQ(test::runCommand(bin() + " sweep slurm " + file + " --out " + dir + "/out " + options, out), 0) << out;
+        std::ifstream in(dir + "/out/sweep.sbatch");
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    };
+    const std::string perRun = script("--partition debug --time 00:05:00 --max-parallel 2");
+    for (const char* line : {"#SBATCH --array=0-3%2\n", "#SBATCH --partition=debug\n", "#SBATCH --time=00:05:00\n",
+                             "/shadowlab' sweep run '", "/out/sweep.json' --out '", " --index \"$SLURM_ARRAY_TASK_ID\"\n"})
+        EXPECT_NE(perRun.find(line), std::string::npos) << line << " in\n" << perRun;
+    EXPECT_EQ(perRun.find("--gpus-per-task"), std::string::npos) << perRun;
+    EXPECT_TRUE(fs::exists(dir + "/out/sweep.json"));
+    EXPECT_TRUE(fs::is_directory(dir + "/out/slurm")) << "Slurm does not create the folder of --output itself";
+#ifdef SHADOWLAB_EGL_BINARY
+    // GPU nodes have no display: the EGL runner.
+    const std::string gpu = script("--gpus-per-task 1 --cpus-per-task 4 --shards 3");
+    for (const char* line : {"#SBATCH --array=0-2\n", "#SBATCH --gpus-per-task=1\n", "#SBATCH --cpus-per-task=4\n", "/shadowlab-egl' sweep run",
+                             " --shard \"$SLURM_ARRAY_TASK_ID/3\"\n"})
+        EXPECT_NE(gpu.find(line), std::string::npos) << line << " in\n" << gpu;
+#endif
+}
+
+// ---- Running ----------------------------------------------------------------------------------------
+
+/// Starts `command` in its own process group (so it can be killed with everything it started).
+pid_t startGroup(const std::string& command) {
+    pid_t pid = fork();
+    if (pid == 0) {
+        setpgid(0, 0);
+        execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    setpgid(pid, pid);
+    return pid;
+}
+
+size_t completeRuns(const std::string& dir) {
+    size_t n = 0;
+    if (!fs::exists(dir + "/runs")) return 0;
+    for (const auto& e : fs::directory_iterator(dir + "/runs")) n += fs::exists(e.path() / "summary.json");
+    return n;
+}
+
+TEST(SweepTest, KilledMidwayThenRestartedRunsOnlyTheMissingRuns) {
+    const std::string dir = test::makeTempDir("sweep-kill");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";
+    const std::string command = bin() + " sweep run " + file + " --out " + out + " --jobs 1 > " + dir + "/first.log 2>&1";
+
+    // The whole process group dies at once (a node lost, kill -9): no run gets to clean up.
+    const pid_t pid = startGroup(command);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (completeRuns(out) < 2 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    kill(-pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+    const size_t done = completeRuns(out);
+    ASSERT_GE(done, 2u);
+    ASSERT_LT(done, 4u) << "the sweep finished before it could be killed";
+    std::map<std::string, fs::file_time_type> before;
+    for (const auto& e : fs::directory_iterator(out + "/runs"))
+        if (fs::exists(e.path() / "summary.json")) before[e.path().filename()] = fs::last_write_time(e.path() / "summary.json");
+
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out + " --jobs 2", log), 0) << log;
+    EXPECT_EQ(countOf(log, "] skip"), done) << log;
+    EXPECT_EQ(countOf(log, "] done"), 4 - done) << log;
+    EXPECT_EQ(completeRuns(out), 4u);
+    for (const auto& [id, time] : before) EXPECT_EQ(fs::last_write_time(out + "/runs/" + id + "/summary.json"), time) << id << " ran again";
+
+    // A third start has nothing left to do.
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    EXPECT_EQ(countOf(log, "] skip"), 4u) << log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 0) << log;
+    EXPECT_EQ(test::runIds(out + "/sweep.csv").size(), 4u);
+}
+
+TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {
+    const std::string dir = test::makeTempDir("sweep-term");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";
+    // What scancel and Ctrl-C send: only the sweep process gets it, and it stops its runs itself.
+    const pid_t pid = startGroup("exec " + bin() + " sweep run " + file + " --out " + out + " --jobs 1 > " + dir + "/first.log 2>&1");
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (completeRuns(out) < 1 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    kill(pid, SIGTERM);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    const size_t done = completeRuns(out);
+    if (done < 4) {
+        ASSERT_TRUE(WIFEXITED(status));
+        EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+    }
+    // Nothing left running (the sweep waited for its runs), and no half-written run folder left.
+    const bool groupGone = kill(-pid, 0) != 0 && errno == ESRCH;
+    EXPECT_TRUE(groupGone) << "a run outlived the sweep";
+    if (!groupGone) kill(-pid, SIGKILL);
+    for (const auto& e : fs::directory_iterator(out + "/runs"))
+        EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out + " --jobs 2", log), 0) << log;
+    EXPECT_EQ(countOf(log, "] skip"), done) << log;
+    EXPECT_EQ(countOf(log, "] done"), 4 - done) << log;
+}
+
+TEST(SweepTest, AFailedRunLeavesAnErrorRecordAndTheOthersGoOn) {
+    const std::string dir = test::makeTempDir("sweep-fail");
+    Json sweep = test::smallSweep();
+    // A malformed glTF file passes the sweep's checks (files are not loaded then) and fails its run.
+    const std::string bad = test::kAssimpGltf + "/IndexOutOfRange/IndexOutOfRange.gltf";
+    sweep["axes"] = Json::parse(R"([
+      {"name": "object", "labels": ["sphere", "broken"],
+       "values": {"scene.objects.1": [{"procedural": "sphere", "radius": 0.5}, {"gltf": ")" + bad + R"("}]}},
+      {"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
+    std::string log;
+    EXPECT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out + " --jobs 2", log), 1) << log;
+    EXPECT_EQ(countOf(log, "] done"), 2u) << log;
+    EXPECT_EQ(countOf(log, "] FAILED"), 2u) << log;
+    const Json p = plan(file);
+    for (const Json& r : p["runs"]) {
+        const std::string base = out + "/runs/" + r["id"].get<std::string>();
+        if (r["axes"]["object"] == "broken") {
+            ASSERT_TRUE(fs::exists(base + ".error.json")) << base;
+            const Json e = JsonNode::parseFile(base + ".error.json");
+            EXPECT_EQ(e["status"], "exit code 2");
+            EXPECT_NE(e["log_tail"].get<std::string>().find("IndexOutOfRange.gltf"), std::string::npos) << e.dump(2);
+            EXPECT_FALSE(fs::exists(base + "/summary.json"));
+        } else {
+            EXPECT_TRUE(fs::exists(base + "/summary.json")) << base;
+            EXPECT_FALSE(fs::exists(base + ".error.json")) << base;
+        }
+    }
+    // The merge keeps what exists, names what failed, and says so in its exit code.
+    EXPECT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 1) << log;
+    EXPECT_EQ(test::runIds(out + "/sweep.csv").size(), 2u);
+    std::ifstream md(out + "/sweep.md");
+    std::stringstream text;
+    text << md.rdbuf();
+    EXPECT_EQ(countOf(text.str(), ": failed**"), 2u) << text.str();
+}
+
+TEST(SweepTest, MergeWritesTheTidyTableReportAndPlots) {
+    const std::string dir = test::makeTempDir("sweep-merge");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out + " --shard 1/2", log), 0) << log;
+    EXPECT_EQ(countOf(log, "] done"), 2u) << log;
+    EXPECT_EQ(test::runCommand(bin() + " sweep merge " + out, log), 1) << "two runs are missing: " << log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out + " --shard 0/2", log), 0) << log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep merge " + out, log), 0) << log;
+
+    std::ifstream csv(out + "/sweep.csv");
+    std::string header;
+    std::getline(csv, header);
+    EXPECT_EQ(header, "run,index,tris,pcf,triangles,pixels,id,algorithm,measure,kind,value");
+    const auto rows = test::rowsOfKind(out + "/sweep.csv", "accuracy");
+    // 4 runs × 3 algorithms (reference, shadow_map, psv), each with its accuracy.
+    size_t accuracy = 0;
+    for (const auto& [key, value] : rows) accuracy += key.find(",accuracy.mismatch_ratio_max") != std::string::npos;
+    EXPECT_EQ(accuracy, 12u);
+    std::ifstream mdFile(out + "/sweep.md");
+    std::stringstream md;
+    md << mdFile.rdbuf();
+    for (const char* part : {"## By `tris`", "## By `pcf`", "## psv / shadow_map", "## Power-law fits along `tris`"})
+        EXPECT_NE(md.str().find(part), std::string::npos) << part << "\n" << md.str();
+    EXPECT_TRUE(fs::exists(out + "/sweep_tris.png"));
+    EXPECT_TRUE(fs::exists(out + "/sweep_pcf.png"));
+}
+
+} // namespace
+} // namespace shadowlab
