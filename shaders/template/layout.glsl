@@ -1,0 +1,8 @@
+// Bindings and counter slots of the template plugin: #defines only, included by C++ and GLSL.
+#define TEMPLATE_ORDER_BINDING 3
+#define TEMPLATE_SAMPLE_BINDING 4
+#define TEMPLATE_COUNTER_BINDING 5
+#define TEMPLATE_C_PIXELS 0
+#define TEMPLATE_C_TESTS_LO 1
+#define TEMPLATE_C_TESTS_HI 2
+#define TEMPLATE_COUNTER_WORDS 3
