@@ -2,7 +2,8 @@
 """Plots of an experiment directory (frames.csv): frame time along the fly-through per algorithm
 (as in the metric-tree paper's Figure 11) and accuracy against the reference along the fly-through.
 
-Usage: plot_results.py DIR   (writes DIR/plot_frame_time.png, DIR/plot_stages.png, DIR/plot_accuracy.png)
+Usage: plot_results.py DIR [gpu|wall]   (writes DIR/plot_frame_time.png, DIR/plot_stages.png, DIR/plot_accuracy.png;
+       "wall": stage times from the cpu_ms column, as summary.json's stage_time_source says for CPU rasterisers)
 """
 import csv
 import os
@@ -19,7 +20,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import plot_style  # noqa: E402
 
 
-def load(path):
+def load(path, wall):
     total = defaultdict(dict)     # id -> frame -> row of the "total" stage
     stages = defaultdict(lambda: defaultdict(list))  # id -> stage -> [ms per frame]
     with open(path, newline="") as f:
@@ -27,13 +28,14 @@ def load(path):
             if row["stage"] == "total":
                 total[row["id"]][int(row["frame"])] = row
             else:
-                ms = row["gpu_ms"] or row["cpu_ms"]
+                # "wall": a CPU rasteriser's timer queries are unreliable, its stages' wall clocks are not
+                ms = row["cpu_ms"] if wall else (row["gpu_ms"] or row["cpu_ms"])
                 stages[row["id"]][row["stage"]].append(float(ms))
     return total, stages
 
 
-def main(directory):
-    total, stages = load(f"{directory}/frames.csv")
+def main(directory, time_source="gpu"):
+    total, stages = load(f"{directory}/frames.csv", time_source == "wall")
     ids = list(total)
     colour = plot_style.colours(ids)
 
@@ -95,6 +97,6 @@ def main(directory):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
+    if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
-    main(sys.argv[1])
+    main(*sys.argv[1:])

@@ -46,12 +46,13 @@ void writeImages(const std::string& dir, const std::string& id, int frame, glm::
     }
 }
 
-void runPlots(const std::string& dir, const std::string& finalDir) {
+/// `timeSource` is summary.json's stage_time_source: which column of frames.csv the stage plot uses.
+void runPlots(const std::string& dir, const std::string& finalDir, const std::string& timeSource) {
     // SHADOWLAB_PYTHON picks another interpreter (one with matplotlib) than the one found at build time.
     const char* python = std::getenv("SHADOWLAB_PYTHON");
     std::string script = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/plot_results.py";
     std::string log = dir + "/plots.log";
-    if (runChildProcess({python && *python ? python : SHADOWLAB_PLOT_PYTHON, script, dir}, log) != 0)
+    if (runChildProcess({python && *python ? python : SHADOWLAB_PLOT_PYTHON, script, dir, timeSource}, log) != 0)
         std::fprintf(stderr, "warning: plotting failed (see %s/plots.log); tables and images are complete\n", finalDir.c_str());
     else
         std::filesystem::remove(log);
@@ -201,7 +202,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     results.writeFramesCsv(dir + "/frames.csv");
     Json summary = results.summary();
     results.writeReport(dir + "/report.md", summary);
-    if (cfg.plots) runPlots(dir, finalDir);
+    if (cfg.plots) runPlots(dir, finalDir, results.meta["stage_time_source"].get<std::string>());
     throwIfInterrupted();
     writeFileAtomic(dir + "/summary.json", summary.dump(2) + "\n");
     place->commit();
