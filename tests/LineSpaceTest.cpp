@@ -158,7 +158,17 @@ TEST(LineSpaceTest, PoolsHaveThePaperLayout) {
             }
         }
         EXPECT_EQ(t.tree.size(), groups * size_t(n * n * n));
-        EXPECT_EQ(t.poolBytes(), t.nodes.size() * 32 + t.tree.size() * 4 + t.nodes.size() * words * 4);
+        // The occupancy bits say what the tree pool says, wherever there is a children group.
+        const size_t occWords = ls::occupancyWords(n);
+        ASSERT_EQ(t.occupancy.size(), t.nodes.size() * occWords);
+        for (size_t i = 0; i < t.nodes.size(); ++i) {
+            if (t.nodes[i].children == LS_NO_CHILDREN) continue;
+            for (int c = 0; c < n * n * n; ++c) {
+                const bool bit = (t.occupancy[i * occWords + size_t(c >> 5)] >> (c & 31)) & 1u;
+                EXPECT_EQ(bit, t.tree[t.nodes[i].children + size_t(c)] != LS_EMPTY) << "node " << i << " child " << c;
+            }
+        }
+        EXPECT_EQ(t.poolBytes(), t.nodes.size() * 32 + t.tree.size() * 4 + t.nodes.size() * (words + occWords) * 4);
     }
 }
 
@@ -167,6 +177,7 @@ TEST(LineSpaceTest, BuildIsIndependentOfTheThreadCount) {
     ls::NTree a = ls::buildNTree(s, 4, 3, 1), b = ls::buildNTree(s, 4, 3, 3);
     EXPECT_EQ(a.tree, b.tree);
     EXPECT_EQ(a.bits, b.bits);
+    EXPECT_EQ(a.occupancy, b.occupancy);
     ASSERT_EQ(a.nodes.size(), b.nodes.size());
     EXPECT_EQ(0, std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(ls::NodeGpu)));
 }
@@ -298,6 +309,7 @@ TEST_F(LineSpaceCacheTest, RoundTripAndKeys) {
     ASSERT_TRUE(back.has_value()) << why;
     EXPECT_EQ(back->tree, t.tree);
     EXPECT_EQ(back->bits, t.bits);
+    EXPECT_EQ(back->occupancy, t.occupancy);
     EXPECT_EQ(back->nodesPerLevel, t.nodesPerLevel);
     EXPECT_EQ(back->buildMs, t.buildMs);
     EXPECT_EQ(back->margin, t.margin);

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -41,7 +42,22 @@ const ParamSchema& lineSpaceSchema() {
                  ParamChange::Rebuild)
         // Same key, default and unit as the reference's: the rays are the reference's rays.
         .real("ray_offset", 1e-4, 0.0, 1e-2, "× scene radius",
-              "shadow ray origin offset along the surface normal, against self-shadowing", ParamChange::Update);
+              "shadow ray origin offset along the surface normal, against self-shadowing", ParamChange::Update)
+        // "node" is Algorithm 1 as published: its start region (the last-level node holding the
+        // origin) is too short, the next node's shaft holds the receiver's own surface and lit
+        // surfaces shadow themselves (docs/algorithms/line_space.md, "Where the error comes from").
+        .choice("start_region", "distance", {"distance", "node"},
+                "geometry the rays ignore next to the receiver: distance = the first start_cells leaf widths of "
+                "height above the receiver's tangent plane (the rest conservative: leaf occupancy, then shafts); "
+                "node = the paper's, the last-level node holding the origin",
+                ParamChange::Rebuild)
+        .real("start_cells", 3.0, 0.0, 64.0, "leaf widths",
+              "start_region distance: height above the receiver's tangent plane (in leaf widths along its normal) "
+              "at which a ray's start region ends",
+              ParamChange::Update)
+        .real("start_max_cells", 16.0, 0.0, 1024.0, "leaf widths",
+              "start_region distance: most leaf widths along the ray a start region spans (grazing rays)",
+              ParamChange::Update);
     return s;
 }
 
@@ -52,14 +68,16 @@ public:
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
         tracer_.reset();
-        nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(); // free the old pools first
+        nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(), occBuf_ = GlBuffer(); // free the old pools first
         for (GlBuffer& b : bitsBuf_) b = GlBuffer();
         const int n = params_.getInt("n"), d = params_.getInt("d");
         const size_t cap = size_t(params_.getInt("max_block_mib")) << 20;
         const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
         tree_ = obtainTree(scene.cpu(), n, d, limit);
+        // The occupancy pool is read (and counted) only by the distance start region.
+        const bool occupancy = startDistance();
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
-                      tree_.bits.size() * sizeof(uint32_t)};
+                      tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0};
         // Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
         // up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a
         // GPU with a larger limit is caught here.
@@ -78,6 +96,7 @@ public:
                                std::to_string(LS_BIT_CHUNKS));
         nodesBuf_ = GlBuffer::fromVector(tree_.nodes, 0);
         treeBuf_ = GlBuffer::fromVector(tree_.tree, 0);
+        if (occupancy) occBuf_ = GlBuffer::fromVector(tree_.occupancy, 0);
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
             // Unused chunks get a 4-byte buffer so every binding the shader declares is valid.
             const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
@@ -95,6 +114,7 @@ public:
         // The GPU holds the pools now; the CPU keeps only the node pool (start-node boxes for classify).
         tree_.tree = {};
         tree_.bits = {};
+        tree_.occupancy = {};
         classes_.reset();
     }
 
@@ -106,6 +126,7 @@ public:
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         params_ = p;
         // setScene() follows a Rebuild (ShadowAlgorithm.h) and compiles for the new tree's block count.
+        // (start_region, a Rebuild, changes a define too.)
         if (change == ParamChange::Rebuild) bitChunks_ = 0;
     }
 
@@ -127,8 +148,13 @@ public:
         p.set("uSampleCount", sampleCount);
         p.set("uNodeCount", unsigned(tree_.nodes.size()));
         p.set("uNodesPerChunk", unsigned(nodesPerChunk_));
+        const ls::StartRegion region = startRegion();
+        p.set("uLeafCell", region.leafCell);
+        p.set("uStartCells", region.cells);
+        p.set("uStartMaxCells", region.maxCells);
         nodesBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_NODE_BINDING);
         treeBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_TREE_BINDING);
+        if (region.distance) occBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_OCC_BINDING);
         const GLuint bitBindings[LS_BIT_CHUNKS] = {LS_BITS_BINDING, LS_BITS_BINDING_1, LS_BITS_BINDING_2, LS_BITS_BINDING_3};
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) bitsBuf_[c].bindBase(GL_SHADER_STORAGE_BUFFER, bitBindings[c]);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
@@ -153,6 +179,7 @@ public:
                                     {"nodes_visited_max", double(c[LS_C_VISITED_MAX])},
                                     {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
                                     {"cells_stepped_mean", perRay(wide(LS_C_CELLS_LO))},
+                                    {"leaf_cells_mean", perRay(wide(LS_C_LEAVES_LO))},
                                     {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
                                     {"rays", rays},
                                     {"traced_pixels", double(c[LS_C_PIXELS])},
@@ -161,7 +188,8 @@ public:
                                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
                                     {"node_pool_bytes", double(poolBytes_[0])},
                                     {"tree_pool_bytes", double(poolBytes_[1])},
-                                    {"line_space_pool_bytes", double(poolBytes_[2])}};
+                                    {"line_space_pool_bytes", double(poolBytes_[2])},
+                                    {"occupancy_pool_bytes", double(poolBytes_[3])}};
         for (size_t l = 0; l < tree_.nodesPerLevel.size(); ++l)
             out.push_back({"nodes_level_" + std::to_string(l), double(tree_.nodesPerLevel[l])});
         if (params_.getBool("classify") && pendingG_.width > 0) {
@@ -181,9 +209,10 @@ public:
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}};
     }
 
-    /// The three pools (the paper's Table 1 size): no geometry is held at all. Not counted: the
-    /// sample list, the per-pixel heat map and the classify buffer (debug only).
-    size_t memoryBytes() const override { return poolBytes_[0] + poolBytes_[1] + poolBytes_[2]; }
+    /// The three pools (the paper's Table 1 size), plus the occupancy pool when the start region
+    /// reads it: no geometry is held at all. Not counted: the sample list, the per-pixel heat map and
+    /// the classify buffer (debug only).
+    size_t memoryBytes() const override { return poolBytes_[0] + poolBytes_[1] + poolBytes_[2] + poolBytes_[3]; }
 
     /// Traversal stack overflows: one frame per level always suffices, so this is 0 unless the
     /// pools are corrupt (an overflowing ray is counted occluded, never lit).
@@ -194,7 +223,24 @@ private:
         return {{"LS_N", std::to_string(params_.getInt("n"))},
                 {"LS_DEPTH", std::to_string(params_.getInt("d"))},
                 {"LS_CLASSIFY", classify ? "1" : "0"},
-                {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)}};
+                {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)},
+                {"LS_START_DISTANCE", startDistance() ? "1" : "0"}};
+    }
+
+    bool startDistance() const { return params_.getEnum("start_region") == "distance"; }
+
+    /// The start region the shader uses (valid after setScene()); leaf cells from the root's size.
+    ls::StartRegion startRegion() const {
+        ls::StartRegion r;
+        r.distance = startDistance();
+        r.cells = float(params_.getFloat("start_cells"));
+        r.maxCells = float(params_.getFloat("start_max_cells"));
+        if (!tree_.nodes.empty()) {
+            const ls::NodeGpu& root = tree_.nodes[0];
+            const float leaves = std::pow(float(tree_.n), float(tree_.d));
+            r.leafCell = glm::vec3(root.size[0], root.size[1], root.size[2]) / leaves;
+        }
+        return r;
     }
 
     void compile() {
@@ -223,7 +269,7 @@ private:
             if (!tracer_) tracer_ = std::make_unique<EmbreeTracer>(scene_->cpu());
             std::vector<uint32_t> perPixel = classifyBuf_.read<uint32_t>(
                 size_t(pendingG_.width) * size_t(pendingG_.height) * ls::classifyStride(pendingLight_.samplePoints().size()));
-            classes_ = ls::classifySamples(*tracer_, pendingG_, pendingLight_, rayOffset(), tree_.nodes, perPixel);
+            classes_ = ls::classifySamples(*tracer_, pendingG_, pendingLight_, rayOffset(), tree_.nodes, perPixel, startRegion());
         }
         return *classes_;
     }
@@ -234,8 +280,8 @@ private:
     ShaderProgram trace_, classifyProgram_;
     ls::NTree tree_; ///< node pool and statistics (the tree and line-space pools live on the GPU only)
     bool cacheHit_ = false;
-    std::array<size_t, 3> poolBytes_{}; ///< node, tree and line-space pools (a GlBuffer rounds empty ones up to 4 bytes)
-    GlBuffer nodesBuf_, treeBuf_, samples_, classifyBuf_;
+    std::array<size_t, 4> poolBytes_{}; ///< node, tree, line-space and (if read) occupancy pools (a GlBuffer rounds empty ones up to 4 bytes)
+    GlBuffer nodesBuf_, treeBuf_, occBuf_, samples_, classifyBuf_;
     GpuCounters<LS_COUNTER_WORDS> counters_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
     size_t nodesPerChunk_ = 1;

@@ -39,6 +39,7 @@ constexpr int kMaxDepth = 5; ///< d: N^d leaf cells per axis
 
 constexpr size_t wordsPerNode(int n) { return size_t(LS_WORDS_PER_NODE(n)); }
 static_assert(wordsPerNode(4) == 120 && wordsPerNode(8) == 1920, "15 N^4 bits, packed in 32-bit words");
+constexpr size_t occupancyWords(int n) { return size_t(LS_OCC_WORDS_PER_NODE(n)); }
 
 /// Bit of the shaft between sub-face `subA` of face `fa` and `subB` of face `fb` (fa != fb, any order).
 inline uint32_t shaftBit(int n, int fa, int subA, int fb, int subB) {
@@ -53,12 +54,16 @@ struct NTree {
     std::vector<NodeGpu> nodes;   ///< node pool, breadth first (node 0 is the root, if any geometry)
     std::vector<uint32_t> tree;   ///< tree pool: N³ entries per children group: node index or LS_EMPTY
     std::vector<uint32_t> bits;   ///< line-space pool: wordsPerNode(n) words per node
+    /// Occupancy pool: occupancyWords(n) words per node, bit (z × N + y) × N + x set when a triangle
+    /// touches that child (the widened box, as for the tree pool). The walk of the start region's
+    /// last node reads the leaves' bits; the tree pool says the same above the last level.
+    std::vector<uint32_t> occupancy;
     std::vector<uint64_t> nodesPerLevel; ///< subdivided nodes per level 0 .. d-1
     double buildMs = 0;           ///< CPU time of the build (kept when loaded from the disk cache)
 
     bool bit(size_t node, uint32_t b) const { return (bits[node * wordsPerNode(n) + (b >> 5)] >> (b & 31)) & 1u; }
     size_t poolBytes() const {
-        return nodes.size() * sizeof(NodeGpu) + tree.size() * sizeof(uint32_t) + bits.size() * sizeof(uint32_t);
+        return nodes.size() * sizeof(NodeGpu) + (tree.size() + bits.size() + occupancy.size()) * sizeof(uint32_t);
     }
 };
 

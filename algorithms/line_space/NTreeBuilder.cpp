@@ -140,6 +140,7 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
         const size_t bitLimit = maxBlockBytes == SIZE_MAX ? SIZE_MAX : perChunk * LS_BIT_CHUNKS * words * sizeof(uint32_t);
         check("line-space", t.nodes.size() * words * sizeof(uint32_t), bitLimit);
         check("node", t.nodes.size() * sizeof(NodeGpu), maxBlockBytes);
+        check("occupancy", t.nodes.size() * occupancyWords(n) * sizeof(uint32_t), maxBlockBytes);
         check("tree", (t.tree.size() + (l + 1 < d ? level.size() * size_t(n3) : 0)) * sizeof(uint32_t), maxBlockBytes);
         const bool last = l == d - 1;
         t.nodesPerLevel[size_t(l)] = level.size();
@@ -151,10 +152,14 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
             fillLineSpace(n, level[i].lo, level[i].size, results[i].occupied, t.margin, results[i].words.data());
         });
         t.bits.resize(t.nodes.size() * words);
+        t.occupancy.resize(t.nodes.size() * occupancyWords(n));
         std::vector<Pending> next;
         for (size_t i = 0; i < level.size(); ++i) {
             NodeResult& r = results[i];
             std::copy(r.words.begin(), r.words.end(), t.bits.begin() + std::ptrdiff_t((base + i) * words));
+            uint32_t* occ = t.occupancy.data() + (base + i) * occupancyWords(n);
+            for (int c = 0; c < n3; ++c)
+                if (r.occupied[size_t(c)]) occ[c >> 5] |= 1u << (c & 31);
             if (last) continue; // children are leaves: nothing stored below
             t.nodes[base + i].children = uint32_t(t.tree.size());
             const glm::vec3 cell = level[i].size / float(n);

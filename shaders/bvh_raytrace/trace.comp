@@ -1,9 +1,10 @@
 #version 450
 // bvh_raytrace: one invocation per pixel traces the reference's shadow rays (EmbreeTracer.h: origin
 // p + n * offset, unit direction to each light sample, tfar = distance - offset) through a BVH built
-// on the CPU, with a fixed stack and any-hit early exit. Visibility = fraction of unblocked samples.
+// on the CPU: Aila & Laine's while-while traversal (inner nodes until a leaf is found, then the
+// leaves), near child first, a fixed stack whose overflow is reported, any-hit early exit.
+// Triangles are read in leaf order (no index indirection). Visibility = fraction of unblocked samples.
 #include "common/light.glsl"
-#include "common/scene.glsl"
 #include "common/counters.glsl"
 #include "bvh_raytrace/layout.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -15,7 +16,7 @@ struct BvhNode { // 64 bytes, mirrored by bvh::NodeGpu (algorithms/bvh_raytrace/
     vec3 hi1; uint count1;
 };
 layout(std430, binding = BVH_NODE_BINDING) readonly buffer BvhNodes { BvhNode bvhNodes[]; };
-layout(std430, binding = BVH_INDEX_BINDING) readonly buffer BvhIndices { uint bvhIndices[]; };
+layout(std430, binding = BVH_TRI_BINDING) readonly buffer BvhTriangles { vec4 bvhTris[]; }; // 3 per triangle, leaf order
 layout(std430, binding = BVH_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = BVH_COUNTER_BINDING) buffer BvhCounters { uint bvhCounters[]; };
 
@@ -54,7 +55,7 @@ Ray makeRay(vec3 o, vec3 d, float tfar) {
 // Woop, Benthin & Wald 2013: watertight, like Embree's robust mode the reference uses, so a ray
 // through a shared edge hits one of the two triangles and never slips between them.
 bool hitTriangle(Ray r, uint tri) {
-    vec3 A = sceneVertex(tri, 0u) - r.o, B = sceneVertex(tri, 1u) - r.o, C = sceneVertex(tri, 2u) - r.o;
+    vec3 A = bvhTris[3u * tri].xyz - r.o, B = bvhTris[3u * tri + 1u].xyz - r.o, C = bvhTris[3u * tri + 2u].xyz - r.o;
     float Ax = A[r.kx] - r.shear.x * A[r.kz], Ay = A[r.ky] - r.shear.y * A[r.kz];
     float Bx = B[r.kx] - r.shear.x * B[r.kz], By = B[r.ky] - r.shear.y * B[r.kz];
     float Cx = C[r.kx] - r.shear.x * C[r.kz], Cy = C[r.ky] - r.shear.y * C[r.kz];
@@ -87,49 +88,55 @@ struct Trace {
     uint visited, tested;
 };
 
-bool hitLeaf(Ray r, uint first, uint count, inout uint tested) {
-    for (uint i = 0u; i < count; ++i) {
-        ++tested;
-        if (hitTriangle(r, bvhIndices[first + i])) return true;
-    }
-    return false;
-}
+// A child reference on the stack: an inner node's index, or BVH_LEAF | first << 4 | (count - 1) for
+// a leaf of `count` triangles from `first` in leaf order (the builder keeps leaves <= 16 and
+// first < 2^27: BvhRaytrace.cpp checks it).
+const uint BVH_LEAF = 0x80000000u, NONE = 0xFFFFFFFFu;
+
+uint childRef(uint child, uint count) { return count > 0u ? (BVH_LEAF | (child << 4u) | (count - 1u)) : child; }
+bool isLeaf(uint ref) { return ref != NONE && (ref & BVH_LEAF) != 0u; }
 
 Trace trace(Ray r) {
     Trace res = Trace(false, false, 0u, 0u);
     uint stack[BVH_STACK_SIZE];
     int sp = 0;
-    uint node = 0u;
-    while (true) {
-        ++res.visited;
-        BvhNode n = bvhNodes[node];
-        float tn0, tn1;
-        bool h0 = n.child0 != BVH_ABSENT && hitBox(n.lo0, n.hi0, r, tn0);
-        bool h1 = n.child1 != BVH_ABSENT && hitBox(n.lo1, n.hi1, r, tn1);
-        // Any hit ends the ray: leaves are tested as soon as their box is entered.
-        if (h0 && n.count0 > 0u) {
-            if (hitLeaf(r, n.child0, n.count0, res.tested)) { res.occluded = true; break; }
-            h0 = false;
+    uint node = 0u, leaf = NONE; // the inner node to visit next, and a leaf postponed for the leaf loop
+    // pop(): the next subtree, NONE once the stack is empty.
+#define POP() (sp > 0 ? stack[--sp] : NONE)
+    while (node != NONE || leaf != NONE) {
+        // Inner loop: descend until this ray holds a leaf (or has nothing left), so that the rays of
+        // neighbouring invocations (lanes in lockstep) test their triangles together below.
+        while (node != NONE && !isLeaf(node) && leaf == NONE) {
+            ++res.visited;
+            BvhNode n = bvhNodes[node];
+            float tn0, tn1;
+            bool h0 = n.child0 != BVH_ABSENT && hitBox(n.lo0, n.hi0, r, tn0);
+            bool h1 = n.child1 != BVH_ABSENT && hitBox(n.lo1, n.hi1, r, tn1);
+            uint c0 = childRef(n.child0, n.count0), c1 = childRef(n.child1, n.count1);
+            if (h0 && h1) {
+                bool first0 = tn0 <= tn1; // near child first
+                // A full stack would drop a subtree that may hold the occluder: stop and report.
+                if (sp == BVH_STACK_SIZE) { res.overflow = true; return res; }
+                stack[sp++] = first0 ? c1 : c0;
+                node = first0 ? c0 : c1;
+            } else {
+                node = h0 ? c0 : (h1 ? c1 : POP());
+            }
+            // A leaf is postponed: its triangles are tested in the leaf loop.
+            if (isLeaf(node)) { leaf = node; node = POP(); }
         }
-        if (h1 && n.count1 > 0u) {
-            if (hitLeaf(r, n.child1, n.count1, res.tested)) { res.occluded = true; break; }
-            h1 = false;
-        }
-        if (h0 && h1) {
-            bool first0 = tn0 <= tn1;
-            // A full stack would drop a subtree that may hold the occluder: stop and report.
-            if (sp == BVH_STACK_SIZE) { res.overflow = true; break; }
-            stack[sp++] = first0 ? n.child1 : n.child0;
-            node = first0 ? n.child0 : n.child1;
-        } else if (h0) {
-            node = n.child0;
-        } else if (h1) {
-            node = n.child1;
-        } else {
-            if (sp == 0) break;
-            node = stack[--sp];
+        // Leaf loop: the postponed leaf, and any leaves that come next off the stack.
+        while (isLeaf(leaf)) {
+            uint first = (leaf & ~BVH_LEAF) >> 4u, count = (leaf & 15u) + 1u;
+            for (uint i = 0u; i < count; ++i) {
+                ++res.tested;
+                if (hitTriangle(r, first + i)) { res.occluded = true; return res; } // any hit ends the ray
+            }
+            leaf = NONE;
+            if (isLeaf(node)) { leaf = node; node = POP(); }
         }
     }
+#undef POP
     return res;
 }
 

@@ -5,11 +5,14 @@
 //   * a node the ray crosses is looked up by the shaft between its entry and exit sub-faces:
 //     empty → skipped whole; non-empty on the last subdivided level (d - 1) → the ray is occluded;
 //     otherwise its children are visited front to back (3D DDA) and the non-empty ones recursed into;
-//   * a node the ray starts in cannot use its line space (the ray crosses no shaft of it): above the
-//     last level its children are visited, on the last level it is skipped (paper 4.1: the loss of
-//     detail near the receiver).
+//   * a node of the start region cannot use its line space: its shaft holds the part of the ray next
+//     to the receiver, whose own surface fills the leaves there. Above the last level its children
+//     are visited. On the last level, LS_START_DISTANCE 0 (the paper's Algorithm 1, start region =
+//     the node holding the origin) skips it (paper 4.1: the loss of detail near the receiver);
+//     LS_START_DISTANCE 1 (start region = the first tS of the ray, tS from the receiver's normal and
+//     the leaf size, see startRegionEnd) walks its leaves from tS with the node's occupancy mask.
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
-// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans).
+// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_DISTANCE.
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "line_space/layout.glsl"
@@ -25,6 +28,9 @@ layout(std430, binding = LS_BITS_BINDING) readonly buffer LsBits0 { uint lsBits0
 layout(std430, binding = LS_BITS_BINDING_1) readonly buffer LsBits1 { uint lsBits1[]; };
 layout(std430, binding = LS_BITS_BINDING_2) readonly buffer LsBits2 { uint lsBits2[]; };
 layout(std430, binding = LS_BITS_BINDING_3) readonly buffer LsBits3 { uint lsBits3[]; };
+#if LS_START_DISTANCE
+layout(std430, binding = LS_OCC_BINDING) readonly buffer LsOccupancy { uint lsOcc[]; };
+#endif
 layout(std430, binding = LS_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = LS_COUNTER_BINDING) buffer LsCounters { uint lsCounters[]; };
 #if LS_CLASSIFY
@@ -39,12 +45,16 @@ uniform float uRayOffset; // world units, the reference's
 uniform int uSampleCount; // entries of lightSamples (1 for point and spot lights)
 uniform uint uNodeCount;  // 0: no geometry, nothing occludes
 uniform uint uNodesPerChunk; // nodes per line-space pool chunk (see layout.glsl)
+uniform vec3 uLeafCell;      // world size of a leaf cell (level d)
+uniform float uStartCells;   // start_cells
+uniform float uStartMaxCells; // start_max_cells
 
 #ifndef LS_BIT_CHUNK_COUNT
 #define LS_BIT_CHUNK_COUNT LS_BIT_CHUNKS
 #endif
 const uint N2 = uint(LS_N * LS_N), N4 = N2 * N2;
 const uint WORDS = uint(LS_WORDS_PER_NODE(LS_N));
+const uint OCC_WORDS = uint(LS_OCC_WORDS_PER_NODE(LS_N));
 const uint LS_NONE = 0xFFFFFFFFu;
 const float kInf = uintBitsToFloat(0x7F800000u);
 
@@ -91,6 +101,47 @@ uint lineSpaceWord(uint index, uint w) {
 #endif
 }
 
+// End of the start region of a ray leaving a receiver of unit normal `nu` in unit direction `d`
+// (twin of ls::StartRegion::end): far enough that the ray has risen `uStartCells` leaf widths
+// (measured along the normal) above the receiver's tangent plane, so no shaft crossed later holds
+// the leaves the receiver's own surface fills; at most `uStartMaxCells` leaf widths along the ray,
+// which bounds the blockers it may miss near grazing directions. A ray going into the receiver
+// (sin <= 0) has no start region: the leaves it enters there block it.
+float startRegionEnd(vec3 nu, vec3 d) {
+    float sinAngle = dot(nu, d);
+    if (!(sinAngle > 0.0)) return 0.0;
+    return min(uStartCells * dot(abs(nu), uLeafCell) / sinAngle, uStartMaxCells * dot(abs(d), uLeafCell));
+}
+
+uint leafCells = 0u; // leaf cells read by leafWalk (counter)
+
+#if LS_START_DISTANCE
+// Does the segment [t0, t1] of the ray pass through an occupied leaf of last-level node `index`?
+// A 3D DDA over the node's N³ leaves; the occupancy bits are conservative (widened leaf boxes), so
+// a blocker the segment touches is never missed. Leaves stand for their geometry, like a shaft
+// but one leaf wide: finer than the node's shaft, which is why it is only used where the shaft
+// cannot be (the node the start region ends in).
+bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1) {
+    ivec3 c = cellOf(r.o + r.d * t0, lo, cellSize);
+    ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
+    vec3 tNext = (lo + vec3(c + up) * cellSize - r.o) * r.invD;
+    uint base = index * OCC_WORDS;
+    for (int i = 0; i < 3 * LS_N; ++i) { // a line crosses at most 3N - 2 cells of an N³ grid
+        ++leafCells;
+        uint leaf = uint((c.z * LS_N + c.y) * LS_N + c.x);
+        if (((lsOcc[base + (leaf >> 5u)] >> (leaf & 31u)) & 1u) != 0u) return true;
+        float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
+        if (cellEnd > t1) return false;
+        bvec3 axis = equal(tNext, vec3(cellEnd));
+        axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+        c += ivec3(axis) * stepDir;
+        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(LS_N)))) return false;
+        tNext = mix(tNext, (lo + vec3(c + up) * cellSize - r.o) * r.invD, axis);
+    }
+    return false;
+}
+#endif
+
 // One subdivided node being walked: its children along the ray (3D DDA over the N³ cells).
 struct Frame {
     uint children; // tree pool offset of its children group
@@ -112,7 +163,9 @@ uint rayVisited = 0u, sumShafts = 0u, startNode = LS_NONE;
 
 // Enters node `index` (on the last subdivided level if `last`): decides it, or prepares the walk
 // over its children in `f`. `root`: node 0, whose start flag and segment test are decided here.
-int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
+// `start`: the node holds the ray origin (the first cell of a start node's walk); a node entered
+// before `tS` (the end of the start region, -inf for the paper's) is in the start region too.
+int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Frame f) {
     LsNode n = lsNodes[index];
     float tIn, tOut;
     int ia, oa;
@@ -121,16 +174,25 @@ int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
         if (max(tIn, 0.0) > min(tOut, r.tEnd)) return ENTER_SKIP; // the segment misses the scene box
         start = tIn <= 0.0;
     }
+    start = start || tIn < tS;
     ++rayVisited; // a ray that misses the scene box visits nothing
+    vec3 cellSize = n.size / float(LS_N);
+    // Where the walk of a start-region node begins: the start region's end, or the node's entry.
+    float tFrom = max(max(tIn, tS), 0.0);
     if (start && last) {
+#if LS_START_DISTANCE
+        float tTo = min(tOut, r.tEnd);
+        if (tFrom > tTo) return ENTER_SKIP; // the whole node lies in the start region
+        return leafWalk(index, n.lo, cellSize, r, tFrom, tTo) ? ENTER_OCCLUDED : ENTER_SKIP;
+#else
         startNode = index; // the ray starts among this node's leaves: nothing can be said
         return ENTER_SKIP;
+#endif
     }
-    vec3 cellSize = n.size / float(LS_N);
     // The entry point's cell serves the DDA and the entry sub-face. A start node walks from the
-    // segment's start; any other node from where the line enters it (the same point unless
+    // end of the start region; any other node from where the line enters it (the same point unless
     // rounding puts tIn a hair below 0, where the walk then starts one cell early: a superset).
-    ivec3 cIn = cellOf(r.o + r.d * (start ? max(tIn, 0.0) : tIn), n.lo, cellSize);
+    ivec3 cIn = cellOf(r.o + r.d * (start ? tFrom : tIn), n.lo, cellSize);
     if (!start) {
         ++sumShafts;
         int fa = 2 * ia + (r.d[ia] >= 0.0 ? 0 : 1); // moving up an axis enters through its min face
@@ -153,7 +215,7 @@ int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
     f.children = n.children;
     f.lo = n.lo;
     f.cellSize = cellSize;
-    f.t = max(tIn, 0.0);
+    f.t = start ? tFrom : max(tIn, 0.0);
     f.tEnd = min(tOut, r.tEnd);
     f.start = start;
     f.cell = cIn;
@@ -185,12 +247,12 @@ int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
 #define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
 #endif
 
-shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 
 void main() {
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = 0u;
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(uVisibility);
@@ -213,6 +275,8 @@ void main() {
                 int count = directional ? 1 : uSampleCount;
                 uint unblocked = 0u, cells = 0u, occluded = 0u, maxVisited = 0u, overflow = 0u;
                 sumShafts = 0u;
+                leafCells = 0u;
+                vec3 nu = normalize(n);
 #if LS_CLASSIFY
                 startNode = LS_NONE;
 #endif
@@ -241,8 +305,13 @@ void main() {
                     ivec3 childStep = stepDir * ivec3(1, LS_N, LS_N * LS_N);
                     rayVisited = 0u;
                     bool blocked = false;
+#if LS_START_DISTANCE
+                    float tS = startRegionEnd(nu, r.d);
+#else
+                    float tS = -kInf;
+#endif
                     Frame f;
-                    int e = uNodeCount == 0u ? ENTER_SKIP : enter(0u, true, LS_DEPTH == 1, false, r, f);
+                    int e = uNodeCount == 0u ? ENTER_SKIP : enter(0u, true, LS_DEPTH == 1, false, tS, r, f);
                     if (e == ENTER_OCCLUDED) blocked = true;
                     if (e == ENTER_DESCEND) {
                         cur = f;
@@ -282,7 +351,7 @@ void main() {
                                 if (child != LS_EMPTY) { node = child; break; } // Algorithm 1, line 8: empty children are skipped
                             }
                             if (node == LS_NONE) break; // walked past the root: the ray is free
-                            e = enter(node, false, level + 1 == LS_DEPTH - 1, nodeStart, r, f);
+                            e = enter(node, false, level + 1 == LS_DEPTH - 1, nodeStart, tS, r, f);
                             if (e == ENTER_OCCLUDED) { blocked = true; break; }
                             if (e == ENTER_DESCEND) {
                                 // One frame per level above the last suffices by construction. Checked
@@ -317,6 +386,7 @@ void main() {
                 atomicMax(sVisitedMax, maxVisited);
                 atomicAdd(sShafts, shafts);
                 atomicAdd(sCells, cells);
+                atomicAdd(sLeaves, leafCells);
                 atomicAdd(sOccluded, occluded);
                 if (overflow != 0u) atomicAdd(sOverflow, overflow);
             }
@@ -335,6 +405,7 @@ void main() {
         atomicMax(lsCounters[LS_C_VISITED_MAX], sVisitedMax);
         addWide(LS_C_SHAFTS_LO, sShafts);
         addWide(LS_C_CELLS_LO, sCells);
+        addWide(LS_C_LEAVES_LO, sLeaves);
         addWide(LS_C_OCCLUDED_LO, sOccluded);
         if (sOverflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], sOverflow);
     }
