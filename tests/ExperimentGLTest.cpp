@@ -81,13 +81,13 @@ const AccuracyCase kAccuracy[] = {
     {"configs/smoke.json", "metric_tree", 0.001},
     {kDemoSmall, "metric_tree", 0.001},
     // line_space is approximate by design: a ray crossing a non-empty shaft counts as blocked even
-    // when it passes beside the geometry (paper Fig. 5), so shadows grow by up to a leaf cell and lit
-    // surfaces next to geometry self-shadow. With (N, d) = (6, 3) on these scenes that flips
-    // 13-17 % of lit pixels, all towards shadow (measured worst frames: 16.5 % hard, 17.3 % soft);
-    // 20 % bounds regressions. That every miss lies in the skipped start node (the method's one way
-    // to err towards light) is checked sample by sample in tests/LineSpaceGLTest.cpp.
-    {"configs/smoke.json", "line_space", 0.20},
-    {"configs/line_space/soft_smoke.json", "line_space", 0.20},
+    // when it passes beside the geometry (paper Fig. 5), so shadows grow by up to a leaf cell, all
+    // towards shadow. With (N, d) = (6, 3) and the default exact start region that flips 2-4.4 % of
+    // lit pixels on these scenes (measured worst frames: 4.3 % hard, 4.4 % soft); 6 % bounds
+    // regressions (the paper's start node, start_region = node, flips 13-17 %). RMSE and the
+    // over-/under-occluded shares per scene are checked in tests/LineSpaceGLTest.cpp.
+    {"configs/smoke.json", "line_space", 0.06},
+    {"configs/line_space/soft_smoke.json", "line_space", 0.06},
 };
 
 void PrintTo(const AccuracyCase& c, std::ostream* os) { *os << c.config << " / " << c.id << " ≤ " << c.maxMismatchPerFrame; }

@@ -156,12 +156,16 @@ TEST_F(LineSpaceGLTest, ExtremeDepthsKeepTheGuarantees) {
     }
 }
 
-// Small blockers inside the start node are missed: the one way the method errs towards light.
+// Small blockers inside the start node are missed by the paper's Algorithm 1: the one way it errs
+// towards light. The exact start region tests them.
 TEST_F(LineSpaceGLTest, BlockersInsideTheStartNodeAreMissed) {
-    AlgorithmRun o = run(pebbleShot());
+    AlgorithmRun o = run(pebbleShot(), {{"start_region", "node"}});
     print("pebbles (start node)", o);
     EXPECT_GT(o.counters["under_occluded_start_node_share"], 0.0);
     EXPECT_EQ(o.counters["under_occluded_start_node_share"], o.counters["under_occluded_share"]);
+    AlgorithmRun exact = run(pebbleShot());
+    print("pebbles (exact start)", exact);
+    EXPECT_EQ(exact.counters["under_occluded_share"], 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Table, LineSpaceErrGLTest, ::testing::ValuesIn(kErrCases),
@@ -180,19 +184,26 @@ struct SoftCase {
 
 void PrintTo(const SoftCase& c, std::ostream* os) { printCase(*os, c.name, c.params); }
 
+// Measured at 64², 25 samples (llvmpipe; the images do not depend on the driver's timing). Every
+// row's under-occluded bound is 0: the exact start region ignores no geometry and the line space
+// beyond it is conservative. The over-occluded bound is the requirement's 3 % of samples; the RMSE
+// bound is the requirement's 0.08 where the measurement leaves room, else the measured value plus
+// ~10 % (commented). What remains is the method's approximation: a non-empty shaft blocks every ray
+// through it, so penumbrae grow outwards by up to a shaft (one leaf) wide.
 const SoftCase kSoftCases[] = {
-    // Smooth convex objects, small light (0.5 × 0.5): @SHAPES_SMALL@
-    {"shapes_small_light_7_3", [] { return shapesShot(0.5f); }, {{"n", 7}, {"d", 3}}, @R1@},
-    // The same under a large light (2 × 2), so penumbrae are wide: @SHAPES_LARGE@
-    {"shapes_large_light_7_3", [] { return shapesShot(2.0f); }, {{"n", 7}, {"d", 3}}, @R2@},
-    // Coarser sets: leaves are larger, so shafts are wider and the start region longer: @SHAPES_COARSE@
-    {"shapes_4_4", [] { return shapesShot(1.5f); }, {{"n", 4}, {"d", 4}}, @R3@},
-    {"shapes_6_3", [] { return shapesShot(1.5f); }, {{"n", 6}, {"d", 3}}, @R4@},
-    // A thin dense mesh and thin posts: their shafts are much wider than the tube, so shadows grow
-    // by up to a leaf on each side (the method's approximation, paper Fig. 5): @THIN@
-    {"thin_mesh_7_3", thinMeshShot, {{"n", 7}, {"d", 3}}, @R5@},
-    // The smoke scene (sphere, torus, fence) under its 1.5 × 1.5 light: @SMOKE@
-    {"smoke_area_7_3", [] { return smokeAreaShot(25, 1.5f); }, {{"n", 7}, {"d", 3}}, @R6@},
+    // Smooth convex objects, small light (0.5 × 0.5): measured RMSE 0.072, over 1.45 %. Narrow
+    // penumbrae: the leaf-wide growth is a large part of them.
+    {"shapes_small_light_7_3", [] { return shapesShot(0.5f); }, {{"n", 7}, {"d", 3}}, 0.08, 0.03, 0.0},
+    // The same under a large light (2 × 2), wide penumbrae: measured RMSE 0.045, over 1.32 %.
+    {"shapes_large_light_7_3", [] { return shapesShot(2.0f); }, {{"n", 7}, {"d", 3}}, 0.08, 0.03, 0.0},
+    // Coarser sets, larger leaves and shafts: measured RMSE 0.063 (4, 4), 0.070 (6, 3); over 1.8 %, 2.1 %.
+    {"shapes_4_4", [] { return shapesShot(1.5f); }, {{"n", 4}, {"d", 4}}, 0.08, 0.03, 0.0},
+    {"shapes_6_3", [] { return shapesShot(1.5f); }, {{"n", 6}, {"d", 3}}, 0.08, 0.03, 0.0},
+    // A thin dense mesh and thin posts: the tube (0.06 across) is narrower than the shafts around
+    // it, so its shadow grows by up to a leaf on each side: measured RMSE 0.081, over 2.1 %; 0.09.
+    {"thin_mesh_7_3", thinMeshShot, {{"n", 7}, {"d", 3}}, 0.09, 0.03, 0.0},
+    // The smoke scene (sphere, torus, fence) under its 1.5 × 1.5 light: measured RMSE 0.057, over 1.55 %.
+    {"smoke_area_7_3", [] { return smokeAreaShot(25, 1.5f); }, {{"n", 7}, {"d", 3}}, 0.08, 0.03, 0.0},
 };
 
 class LineSpaceSoftGLTest : public LineSpaceGLTest, public ::testing::WithParamInterface<SoftCase> {};
@@ -216,10 +227,10 @@ INSTANTIATE_TEST_SUITE_P(Table, LineSpaceSoftGLTest, ::testing::ValuesIn(kSoftCa
 // start node shadowed most of them: the next node's shaft holds the sphere's own surface).
 TEST_F(LineSpaceGLTest, SphereFacingTheLightIsLit) {
     Shot s = smokeAreaShot(25, 0.5f);
-    s.scene = makeSphere(0.6f, 4000, Material{});
+    s.scene = makeSphere(0.6f, 2000, Material{});
     s.light.position = {0.0f, 3.0f, 0.0f}, s.light.target = {0, 0, 0};
-    s.camera = lookAt({0.0f, 2.5f, 1.5f}, {0, 0, 0}, 55.0f);
-    AlgorithmRun o = run(s, {{"n", 7}, {"d", 3}});
+    s.camera = lookAt({0.0f, 1.6f, 0.9f}, {0, 0, 0}, 55.0f);
+    AlgorithmRun o = run(s, {{"n", 6}, {"d", 3}});
     print("sphere facing the light", o);
     size_t fullyLit = 0, dark = 0;
     for (size_t i = 0; i < o.reference.size(); ++i) {
@@ -227,9 +238,15 @@ TEST_F(LineSpaceGLTest, SphereFacingTheLightIsLit) {
         ++fullyLit;
         dark += o.visibility[i] < 1.0f;
     }
-    ASSERT_GT(fullyLit, 500u);
+    ASSERT_GT(fullyLit, 1000u);
     EXPECT_EQ(dark, 0u) << "of " << fullyLit << " pixels lit by every sample";
-    EXPECT_EQ(o.counters["over_occluded_share"], 0.0);
+    // With the paper's start node the same view is mostly dark.
+    AlgorithmRun paper = run(s, {{"n", 6}, {"d", 3}, {"start_region", "node"}});
+    print("sphere facing the light (paper)", paper);
+    size_t paperDark = 0;
+    for (size_t i = 0; i < o.reference.size(); ++i) paperDark += o.lit[i] && o.reference[i] >= 1.0f && paper.visibility[i] < 1.0f;
+    std::printf("[line_space] pixels lit by every sample: %zu, dark: %zu (exact start), %zu (paper's start node)\n", fullyLit,
+                dark, paperDark);
 }
 
 // Ablation: the paper's Algorithm 1 as published (start_region = node) on the same soft-shadow
@@ -240,7 +257,7 @@ TEST_F(LineSpaceGLTest, PaperStartNodeShadowsLitSurfaces) {
     AlgorithmRun paper = run(s, {{"n", 7}, {"d", 3}, {"start_region", "node"}});
     AlgorithmRun distance = run(s, {{"n", 7}, {"d", 3}});
     print("paper start node 7_3", paper);
-    print("distance 7_3", distance);
+    print("exact start 7_3", distance);
     EXPECT_EQ(paper.counters["under_occluded_elsewhere"], 0.0);
     EXPECT_GT(paper.counters["over_occluded_share"], 5.0 * distance.counters["over_occluded_share"]);
     EXPECT_GT(paper.accuracy.rmse, 3.0 * distance.accuracy.rmse);
@@ -273,7 +290,8 @@ TEST_F(LineSpaceGLTest, LargerBranchingFactorOverOccludesLess) {
 
 TEST_F(LineSpaceGLTest, MemoryIsThePools) {
     Shot s = smokePointShot();
-    AlgorithmRun o = run(s, {{"n", 4}, {"d", 3}});
+    // The paper's method: the three pools and nothing else (no geometry).
+    AlgorithmRun o = run(s, {{"n", 4}, {"d", 3}, {"start_region", "node"}});
     const double nodes = o.counters["subdivided_nodes"];
     EXPECT_EQ(o.counters["nodes_level_0"], 1.0);
     EXPECT_EQ(o.counters["nodes_level_0"] + o.counters["nodes_level_1"] + o.counters["nodes_level_2"], nodes);
@@ -282,6 +300,14 @@ TEST_F(LineSpaceGLTest, MemoryIsThePools) {
     // Children groups (4³ entries) for the nodes above the last level only.
     EXPECT_EQ(o.counters["tree_pool_bytes"], 4 * 64 * (o.counters["nodes_level_0"] + o.counters["nodes_level_1"]));
     EXPECT_EQ(double(o.memory), o.counters["node_pool_bytes"] + o.counters["tree_pool_bytes"] + o.counters["line_space_pool_bytes"]);
+    EXPECT_EQ(o.counters["occupancy_pool_bytes"], 0.0);
+    EXPECT_EQ(o.counters["exact_start_bytes"], 0.0);
+    // The exact start region adds the occupancy pool (4³ bits = 2 words per node), the leaf lists
+    // and the scene's triangle positions (36 bytes per triangle).
+    AlgorithmRun x = run(s, {{"n", 4}, {"d", 3}, {"start_region", "exact"}});
+    EXPECT_EQ(x.counters["occupancy_pool_bytes"], 4 * 2 * nodes);
+    EXPECT_GT(x.counters["exact_start_bytes"], 36.0 * double(s.scene.triangleCount()));
+    EXPECT_EQ(double(x.memory), double(o.memory) + x.counters["occupancy_pool_bytes"] + x.counters["exact_start_bytes"]);
 }
 
 // The line-space pool is split over several SSBOs when it outgrows one: same image; beyond the

@@ -172,6 +172,40 @@ TEST(LineSpaceTest, PoolsHaveThePaperLayout) {
     }
 }
 
+// The exact start region's leaf lists: a leaf has triangles exactly where its occupancy bit is set
+// (the shader finds a leaf's list by counting the bits below it), each triangle touches its leaf.
+TEST(LineSpaceTest, LeafListsFollowTheOccupancy) {
+    Scene s = smallScene();
+    for (auto [n, d] : {std::pair{4, 3}, {3, 2}, {5, 1}}) {
+        ls::NTree t = ls::buildNTree(s, n, d);
+        ls::LeafLists lists = ls::buildLeafLists(s, t, 2);
+        ASSERT_EQ(lists.nodeBase.size(), t.nodes.size());
+        const size_t occWords = ls::occupancyWords(n);
+        size_t leaf = 0;
+        for (size_t i = 0; i < t.nodes.size(); ++i) {
+            if (int(t.nodes[i].level) != d - 1) continue;
+            EXPECT_EQ(lists.nodeBase[i], leaf) << "node " << i;
+            const glm::dvec3 lo(t.nodes[i].lo[0], t.nodes[i].lo[1], t.nodes[i].lo[2]);
+            const glm::dvec3 cell = glm::dvec3(t.nodes[i].size[0], t.nodes[i].size[1], t.nodes[i].size[2]) / double(n);
+            for (int c = 0; c < n * n * n; ++c) {
+                if (!((t.occupancy[i * occWords + size_t(c >> 5)] >> (c & 31)) & 1u)) continue;
+                ASSERT_LT(leaf + 1, lists.prefix.size());
+                EXPECT_LT(lists.prefix[leaf], lists.prefix[leaf + 1]) << "an occupied leaf without triangles";
+                const glm::dvec3 clo = lo + glm::dvec3(c % n, (c / n) % n, c / (n * n)) * cell;
+                const ls::DBox box{clo - double(t.margin) - 1e-6, clo + cell + double(t.margin) + 1e-6};
+                for (uint32_t k = lists.prefix[leaf]; k < lists.prefix[leaf + 1]; ++k) {
+                    const uint32_t tri = lists.tris[k];
+                    EXPECT_TRUE(ls::triangleOverlapsBox(glm::dvec3(s.positions[3 * tri]), glm::dvec3(s.positions[3 * tri + 1]),
+                                                        glm::dvec3(s.positions[3 * tri + 2]), box));
+                }
+                ++leaf;
+            }
+        }
+        EXPECT_EQ(leaf + 1, lists.prefix.size());
+        EXPECT_EQ(lists.prefix.back(), lists.tris.size());
+    }
+}
+
 TEST(LineSpaceTest, BuildIsIndependentOfTheThreadCount) {
     Scene s = smallScene();
     ls::NTree a = ls::buildNTree(s, 4, 3, 1), b = ls::buildNTree(s, 4, 3, 3);

@@ -46,17 +46,19 @@ const ParamSchema& lineSpaceSchema() {
         // "node" is Algorithm 1 as published: its start region (the last-level node holding the
         // origin) is too short, the next node's shaft holds the receiver's own surface and lit
         // surfaces shadow themselves (docs/algorithms/line_space.md, "Where the error comes from").
-        .choice("start_region", "distance", {"distance", "node"},
-                "geometry the rays ignore next to the receiver: distance = the first start_cells leaf widths of "
-                "height above the receiver's tangent plane (the rest conservative: leaf occupancy, then shafts); "
-                "node = the paper's, the last-level node holding the origin",
+        .choice("start_region", "exact", {"exact", "distance", "node"},
+                "where the line space is not used next to the receiver: the last-level nodes a ray enters before "
+                "rising start_cells leaf widths above the receiver's tangent plane, tested against their triangles "
+                "(exact: a hybrid that keeps the scene's triangles on the GPU) or with geometry before that height "
+                "ignored and the rest of those nodes by leaf occupancy (distance); node = the paper's Algorithm 1, "
+                "the last-level node holding the origin skipped",
                 ParamChange::Rebuild)
-        .real("start_cells", 3.0, 0.0, 64.0, "leaf widths",
-              "start_region distance: height above the receiver's tangent plane (in leaf widths along its normal) "
-              "at which a ray's start region ends",
+        .real("start_cells", 6.0, 0.0, 64.0, "leaf widths",
+              "start_region exact/distance: height above the receiver's tangent plane (in leaf widths along its "
+              "normal) at which a ray's start region ends",
               ParamChange::Update)
-        .real("start_max_cells", 16.0, 0.0, 1024.0, "leaf widths",
-              "start_region distance: most leaf widths along the ray a start region spans (grazing rays)",
+        .real("start_max_cells", 64.0, 0.0, 1024.0, "leaf widths",
+              "start_region exact/distance: most leaf widths along the ray a start region spans (grazing rays)",
               ParamChange::Update);
     return s;
 }
@@ -74,10 +76,16 @@ public:
         const size_t cap = size_t(params_.getInt("max_block_mib")) << 20;
         const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
         tree_ = obtainTree(scene.cpu(), n, d, limit);
-        // The occupancy pool is read (and counted) only by the distance start region.
-        const bool occupancy = startDistance();
+        // The occupancy pool is read (and counted) only by the distance and exact start regions; the
+        // leaf lists and the scene's triangles only by the exact one.
+        const ls::StartMode mode = startMode();
+        const bool occupancy = mode != ls::StartMode::Node, exact = mode == ls::StartMode::Exact;
+        leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer();
+        ls::LeafLists lists;
+        if (exact) lists = ls::buildLeafLists(scene.cpu(), tree_);
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
-                      tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0};
+                      tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0,
+                      exact ? lists.bytes() + scene.positions().size() : 0};
         // Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
         // up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a
         // GPU with a larger limit is caught here.
@@ -97,6 +105,16 @@ public:
         nodesBuf_ = GlBuffer::fromVector(tree_.nodes, 0);
         treeBuf_ = GlBuffer::fromVector(tree_.tree, 0);
         if (occupancy) occBuf_ = GlBuffer::fromVector(tree_.occupancy, 0);
+        if (exact) {
+            for (auto [what, bytes] : {std::pair{"leaf triangle lists", lists.tris.size() * sizeof(uint32_t)},
+                                       std::pair{"scene positions", scene.positions().size()}})
+                if (bytes > limit)
+                    throw RuntimeError(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
+                                       " MiB; one SSBO may hold " + mib(limit) + " MiB here");
+            leafBase_ = GlBuffer::fromVector(lists.nodeBase, 0);
+            leafPrefix_ = GlBuffer::fromVector(lists.prefix, 0);
+            leafTris_ = GlBuffer::fromVector(lists.tris, 0);
+        }
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
             // Unused chunks get a 4-byte buffer so every binding the shader declares is valid.
             const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
@@ -154,7 +172,13 @@ public:
         p.set("uStartMaxCells", region.maxCells);
         nodesBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_NODE_BINDING);
         treeBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_TREE_BINDING);
-        if (region.distance) occBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_OCC_BINDING);
+        if (region.mode != ls::StartMode::Node) occBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_OCC_BINDING);
+        if (region.mode == ls::StartMode::Exact) {
+            scene_->bindStorage();
+            leafBase_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_BASE_BINDING);
+            leafPrefix_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_PREFIX_BINDING);
+            leafTris_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_TRIS_BINDING);
+        }
         const GLuint bitBindings[LS_BIT_CHUNKS] = {LS_BITS_BINDING, LS_BITS_BINDING_1, LS_BITS_BINDING_2, LS_BITS_BINDING_3};
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) bitsBuf_[c].bindBase(GL_SHADER_STORAGE_BUFFER, bitBindings[c]);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
@@ -180,6 +204,7 @@ public:
                                     {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
                                     {"cells_stepped_mean", perRay(wide(LS_C_CELLS_LO))},
                                     {"leaf_cells_mean", perRay(wide(LS_C_LEAVES_LO))},
+                                    {"triangles_tested_mean", perRay(wide(LS_C_TRIS_LO))},
                                     {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
                                     {"rays", rays},
                                     {"traced_pixels", double(c[LS_C_PIXELS])},
@@ -189,7 +214,8 @@ public:
                                     {"node_pool_bytes", double(poolBytes_[0])},
                                     {"tree_pool_bytes", double(poolBytes_[1])},
                                     {"line_space_pool_bytes", double(poolBytes_[2])},
-                                    {"occupancy_pool_bytes", double(poolBytes_[3])}};
+                                    {"occupancy_pool_bytes", double(poolBytes_[3])},
+                                    {"exact_start_bytes", double(poolBytes_[4])}};
         for (size_t l = 0; l < tree_.nodesPerLevel.size(); ++l)
             out.push_back({"nodes_level_" + std::to_string(l), double(tree_.nodesPerLevel[l])});
         if (params_.getBool("classify") && pendingG_.width > 0) {
@@ -210,9 +236,14 @@ public:
     }
 
     /// The three pools (the paper's Table 1 size), plus the occupancy pool when the start region
-    /// reads it: no geometry is held at all. Not counted: the sample list, the per-pixel heat map and
-    /// the classify buffer (debug only).
-    size_t memoryBytes() const override { return poolBytes_[0] + poolBytes_[1] + poolBytes_[2] + poolBytes_[3]; }
+    /// reads it, plus the leaf lists and the scene's triangle positions for the exact start region
+    /// (the paper's method, start_region node, holds no geometry at all). Not counted: the sample
+    /// list, the per-pixel heat map and the classify buffer (debug only).
+    size_t memoryBytes() const override {
+        size_t sum = 0;
+        for (size_t b : poolBytes_) sum += b;
+        return sum;
+    }
 
     /// Traversal stack overflows: one frame per level always suffices, so this is 0 unless the
     /// pools are corrupt (an overflowing ray is counted occluded, never lit).
@@ -224,15 +255,18 @@ private:
                 {"LS_DEPTH", std::to_string(params_.getInt("d"))},
                 {"LS_CLASSIFY", classify ? "1" : "0"},
                 {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)},
-                {"LS_START_DISTANCE", startDistance() ? "1" : "0"}};
+                {"LS_START_MODE", std::to_string(int(startMode()))}};
     }
 
-    bool startDistance() const { return params_.getEnum("start_region") == "distance"; }
+    ls::StartMode startMode() const {
+        const std::string& m = params_.getEnum("start_region");
+        return m == "exact" ? ls::StartMode::Exact : m == "distance" ? ls::StartMode::Distance : ls::StartMode::Node;
+    }
 
     /// The start region the shader uses (valid after setScene()); leaf cells from the root's size.
     ls::StartRegion startRegion() const {
         ls::StartRegion r;
-        r.distance = startDistance();
+        r.mode = startMode();
         r.cells = float(params_.getFloat("start_cells"));
         r.maxCells = float(params_.getFloat("start_max_cells"));
         if (!tree_.nodes.empty()) {
@@ -280,8 +314,10 @@ private:
     ShaderProgram trace_, classifyProgram_;
     ls::NTree tree_; ///< node pool and statistics (the tree and line-space pools live on the GPU only)
     bool cacheHit_ = false;
-    std::array<size_t, 4> poolBytes_{}; ///< node, tree, line-space and (if read) occupancy pools (a GlBuffer rounds empty ones up to 4 bytes)
-    GlBuffer nodesBuf_, treeBuf_, occBuf_, samples_, classifyBuf_;
+    /// Node, tree, line-space pools; (if read) occupancy pool; (exact) leaf lists + scene positions.
+    /// A GlBuffer rounds empty ones up to 4 bytes; these are the bytes the shader uses.
+    std::array<size_t, 5> poolBytes_{};
+    GlBuffer nodesBuf_, treeBuf_, occBuf_, leafBase_, leafPrefix_, leafTris_, samples_, classifyBuf_;
     GpuCounters<LS_COUNTER_WORDS> counters_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
     size_t nodesPerChunk_ = 1;

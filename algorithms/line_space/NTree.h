@@ -75,6 +75,21 @@ struct NTree {
 /// instead of after the whole build.
 NTree buildNTree(const Scene& scene, int n, int d, int threads = 0, size_t maxBlockBytes = SIZE_MAX);
 
+/// Triangles of the leaves of the last subdivided level, for start_region = exact (the start region
+/// tested against the triangles themselves). Occupied leaves are numbered in node order, then child
+/// order; leaf g of node i is leaf nodeBase[i] + (occupied leaves of i before it), and its triangles
+/// are tris[prefix[g] .. prefix[g + 1]) (scene triangle indices).
+struct LeafLists {
+    std::vector<uint32_t> nodeBase; ///< per node (0 above the last level)
+    std::vector<uint32_t> prefix;   ///< per occupied leaf, plus one
+    std::vector<uint32_t> tris;
+    size_t bytes() const { return (nodeBase.size() + prefix.size() + tris.size()) * sizeof(uint32_t); }
+};
+
+/// The leaf lists of `tree` (built from `scene`): the build's descent replayed with the same
+/// triangle–box tests on the same boxes, so a leaf has triangles exactly where its occupancy bit is set.
+LeafLists buildLeafLists(const Scene& scene, const NTree& tree, int threads = 0);
+
 /// Nodes per line-space pool chunk for SSBOs of at most `maxBlockBytes`.
 inline size_t nodesPerChunk(int n, size_t maxBlockBytes) {
     return std::max<size_t>(1, maxBlockBytes / (wordsPerNode(n) * sizeof(uint32_t)));

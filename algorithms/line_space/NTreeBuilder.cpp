@@ -182,4 +182,55 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
     return t;
 }
 
+LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
+    LeafLists out;
+    out.nodeBase.assign(t.nodes.size(), 0);
+    out.prefix.push_back(0);
+    if (t.nodes.empty()) return out;
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    const int n = t.n, n3 = n * n * n;
+    Builder builder(scene, n, t.margin);
+    auto box = [&](uint32_t i) {
+        const NodeGpu& node = t.nodes[i];
+        return Pending{{node.lo[0], node.lo[1], node.lo[2]}, {node.size[0], node.size[1], node.size[2]}, {}};
+    };
+    std::vector<uint32_t> index{0}; // the nodes of the level being replayed
+    std::vector<Pending> level{box(0)};
+    level[0].tris.resize(scene.triangleCount());
+    for (uint32_t i = 0; i < uint32_t(level[0].tris.size()); ++i) level[0].tris[i] = i;
+    for (int l = 0; l < t.d && !level.empty(); ++l) {
+        std::vector<NodeResult> results(level.size());
+        parallelFor(level.size(), threads, [&](size_t i) {
+            builder.occupancy(level[i], true, results[i]);
+            level[i].tris = {};
+        });
+        std::vector<uint32_t> nextIndex;
+        std::vector<Pending> next;
+        for (size_t i = 0; i < level.size(); ++i) {
+            const NodeGpu& node = t.nodes[index[i]];
+            if (int(node.level) == t.d - 1) { // leaves: append the occupied ones, in child order
+                out.nodeBase[index[i]] = uint32_t(out.prefix.size() - 1);
+                for (int c = 0; c < n3; ++c) {
+                    const auto& tris = results[i].childTris[size_t(c)];
+                    if (tris.empty()) continue;
+                    out.tris.insert(out.tris.end(), tris.begin(), tris.end());
+                    out.prefix.push_back(uint32_t(out.tris.size()));
+                }
+                continue;
+            }
+            for (int c = 0; c < n3; ++c) {
+                const uint32_t child = t.tree[node.children + size_t(c)];
+                if (child == LS_EMPTY) continue;
+                nextIndex.push_back(child);
+                next.push_back(box(child));
+                next.back().tris = std::move(results[i].childTris[size_t(c)]);
+            }
+        }
+        // Last-level nodes come in node order (breadth first), so the numbering is node order too.
+        index = std::move(nextIndex);
+        level = std::move(next);
+    }
+    return out;
+}
+
 } // namespace shadowlab::ls

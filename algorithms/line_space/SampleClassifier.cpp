@@ -66,7 +66,9 @@ SampleClasses classifySamples(const EmbreeTracer& tracer, const CpuGBuffer& g, c
                     if (!ls && exact) {
                         ++c.under;
                         bool elsewhere = true;
-                        if (region.distance) {
+                        if (region.mode == StartMode::Exact) {
+                            elsewhere = true; // nothing is ignored: every miss is one
+                        } else if (region.mode == StartMode::Distance) {
                             // Traced again from just past the region's end: the float end the shader
                             // computed may differ in its last bit.
                             const float t = region.end(glm::normalize(n), dir) * (1.0f + 1e-5f);

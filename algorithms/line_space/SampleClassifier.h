@@ -18,18 +18,22 @@
 
 namespace shadowlab::ls {
 
+/// start_region, in the values of the shader's LS_START_MODE.
+enum class StartMode { Node = 0, Distance = 1, Exact = 2 };
+
 /// The start region of line_space's rays (twin of startRegionEnd in shaders/line_space/trace.comp).
-/// `distance` false: the paper's, the last-level node holding the origin (the shader reports it per
-/// pixel). True: the first end(n, d) of the ray, geometry beyond it answered conservatively.
+/// Node: the paper's, the last-level node holding the origin (the shader reports it per pixel).
+/// Distance: the first end(n, d) of the ray, geometry beyond it answered conservatively. Exact: the
+/// same nodes tested against their triangles, so no sample may be under-occluded at all.
 struct StartRegion {
-    bool distance = false;
+    StartMode mode = StartMode::Node;
     float cells = 0, maxCells = 0; ///< schema: start_cells, start_max_cells
     glm::vec3 leafCell{0.0f};      ///< world size of a leaf cell
     /// End of the region for unit normal `nu` and unit direction `d`, float for float the shader's.
     float end(glm::vec3 nu, glm::vec3 d) const {
-        const float sinAngle = glm::dot(nu, d);
-        if (!(sinAngle > 0.0f)) return 0.0f;
-        return std::min(cells * glm::dot(glm::abs(nu), leafCell) / sinAngle, maxCells * glm::dot(glm::abs(d), leafCell));
+        const float sinAngle = glm::dot(nu, d), longest = maxCells * glm::dot(glm::abs(d), leafCell);
+        if (!(sinAngle > 0.0f)) return mode == StartMode::Exact ? longest : 0.0f;
+        return std::min(cells * glm::dot(glm::abs(nu), leafCell) / sinAngle, longest);
     }
 };
 

@@ -6,6 +6,7 @@
 // Triangles are read in leaf order (no index indirection). Visibility = fraction of unblocked samples.
 #include "common/light.glsl"
 #include "common/counters.glsl"
+#include "common/watertight.glsl"
 #include "bvh_raytrace/layout.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -33,8 +34,7 @@ const float kInf = uintBitsToFloat(0x7F800000u);
 struct Ray {
     vec3 o, d, invD;
     float tfar;
-    int kx, ky, kz; // watertight test: kz = dominant axis of d
-    vec3 shear;
+    WatertightRay w; // the triangle test's frame
 };
 
 Ray makeRay(vec3 o, vec3 d, float tfar) {
@@ -43,34 +43,12 @@ Ray makeRay(vec3 o, vec3 d, float tfar) {
     // A zero component would give 0 * inf = NaN in the slab test; 1e-30 keeps the slab infinite.
     vec3 safe = mix(d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(d, vec3(0.0))), lessThan(abs(d), vec3(1e-30)));
     r.invD = 1.0 / safe;
-    vec3 a = abs(d);
-    r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
-    r.kx = (r.kz + 1) % 3;
-    r.ky = (r.kx + 1) % 3;
-    if (d[r.kz] < 0.0) { int t = r.kx; r.kx = r.ky; r.ky = t; } // keep the winding
-    r.shear = vec3(d[r.kx] / d[r.kz], d[r.ky] / d[r.kz], 1.0 / d[r.kz]);
+    r.w = watertightRay(o, d, tfar);
     return r;
 }
 
-// Woop, Benthin & Wald 2013: watertight, like Embree's robust mode the reference uses, so a ray
-// through a shared edge hits one of the two triangles and never slips between them.
 bool hitTriangle(Ray r, uint tri) {
-    vec3 A = bvhTris[3u * tri].xyz - r.o, B = bvhTris[3u * tri + 1u].xyz - r.o, C = bvhTris[3u * tri + 2u].xyz - r.o;
-    float Ax = A[r.kx] - r.shear.x * A[r.kz], Ay = A[r.ky] - r.shear.y * A[r.kz];
-    float Bx = B[r.kx] - r.shear.x * B[r.kz], By = B[r.ky] - r.shear.y * B[r.kz];
-    float Cx = C[r.kx] - r.shear.x * C[r.kz], Cy = C[r.ky] - r.shear.y * C[r.kz];
-    float U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
-    if (U == 0.0 || V == 0.0 || W == 0.0) { // on an edge in float: decide it in double
-        U = float(double(Cx) * double(By) - double(Cy) * double(Bx));
-        V = float(double(Ax) * double(Cy) - double(Ay) * double(Cx));
-        W = float(double(Bx) * double(Ay) - double(By) * double(Ax));
-    }
-    if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
-    float det = U + V + W;
-    if (det == 0.0) return false;
-    float T = U * (r.shear.z * A[r.kz]) + V * (r.shear.z * B[r.kz]) + W * (r.shear.z * C[r.kz]);
-    // t = T / det must lie in (0, tfar]
-    return det > 0.0 ? (T > 0.0 && T <= r.tfar * det) : (T < 0.0 && T >= r.tfar * det);
+    return watertightHit(r.w, bvhTris[3u * tri].xyz, bvhTris[3u * tri + 1u].xyz, bvhTris[3u * tri + 2u].xyz);
 }
 
 // Slab test on [0, tfar]; tnear is where the ray enters (for near-first ordering). The far end

@@ -18,6 +18,10 @@
 #define LS_BITS_BINDING_2 10
 #define LS_BITS_BINDING_3 11
 #define LS_OCC_BINDING 12       // occupancy pool: LS_OCC_WORDS_PER_NODE(N) words per node, node order
+// start_region exact: the leaf lists (ls::LeafLists); the triangles' vertices are the scene's (binding 0).
+#define LS_LEAF_BASE_BINDING 13
+#define LS_LEAF_PREFIX_BINDING 14
+#define LS_LEAF_TRIS_BINDING 15
 
 // Node pool entry: vec3 lo; uint children; vec3 size; uint level (32 bytes, std430).
 #define LS_NODE_BYTES 32
@@ -38,7 +42,7 @@
 #define LS_OCC_WORDS_PER_NODE(n) (((n) * (n) * (n) + 31) / 32)
 
 // Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words.
-#define LS_COUNTER_WORDS 16
+#define LS_COUNTER_WORDS 18
 #define LS_C_RAYS_LO 0          // shadow rays (lit pixels × samples)
 #define LS_C_RAYS_HI 1
 #define LS_C_VISITED_LO 2       // nodes entered, summed over rays
@@ -54,4 +58,6 @@
 #define LS_C_CELLS_HI 12
 #define LS_C_LEAVES_LO 13       // leaf cells read by the start region's leaf walks, summed over rays
 #define LS_C_LEAVES_HI 14
-// Word 15 is reserved.
+#define LS_C_TRIS_LO 15         // triangles tested by the exact start region, summed over rays
+#define LS_C_TRIS_HI 16
+// Word 17 is reserved.

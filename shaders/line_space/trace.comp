@@ -7,15 +7,26 @@
 //     otherwise its children are visited front to back (3D DDA) and the non-empty ones recursed into;
 //   * a node of the start region cannot use its line space: its shaft holds the part of the ray next
 //     to the receiver, whose own surface fills the leaves there. Above the last level its children
-//     are visited. On the last level, LS_START_DISTANCE 0 (the paper's Algorithm 1, start region =
-//     the node holding the origin) skips it (paper 4.1: the loss of detail near the receiver);
-//     LS_START_DISTANCE 1 (start region = the first tS of the ray, tS from the receiver's normal and
-//     the leaf size, see startRegionEnd) walks its leaves from tS with the node's occupancy mask.
+//     are visited. On the last level, by LS_START_MODE:
+//       LS_START_NODE (the paper's Algorithm 1: the start region is the node holding the origin):
+//         skipped (paper 4.1: the loss of detail near the receiver);
+//       LS_START_DISTANCE (the start region ends at tS, from the receiver's normal and the leaf
+//         size, see startRegionEnd): geometry before tS ignored, its leaves walked from tS with the
+//         node's occupancy mask (an occupied leaf blocks);
+//       LS_START_EXACT (the same region, no geometry ignored): its occupied leaves' triangles are
+//         tested exactly against the ray (a hybrid: the start region exact, the rest line space).
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
-// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_DISTANCE.
+// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE.
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "line_space/layout.glsl"
+#define LS_START_NODE 0
+#define LS_START_DISTANCE 1
+#define LS_START_EXACT 2
+#if LS_START_MODE == LS_START_EXACT
+#include "common/scene.glsl"
+#include "common/watertight.glsl"
+#endif
 layout(local_size_x = 8, local_size_y = 8) in;
 
 struct LsNode { // 32 bytes, mirrored by ls::NodeGpu (algorithms/line_space/NTree.h)
@@ -28,8 +39,15 @@ layout(std430, binding = LS_BITS_BINDING) readonly buffer LsBits0 { uint lsBits0
 layout(std430, binding = LS_BITS_BINDING_1) readonly buffer LsBits1 { uint lsBits1[]; };
 layout(std430, binding = LS_BITS_BINDING_2) readonly buffer LsBits2 { uint lsBits2[]; };
 layout(std430, binding = LS_BITS_BINDING_3) readonly buffer LsBits3 { uint lsBits3[]; };
-#if LS_START_DISTANCE
+#if LS_START_MODE != LS_START_NODE
 layout(std430, binding = LS_OCC_BINDING) readonly buffer LsOccupancy { uint lsOcc[]; };
+#endif
+#if LS_START_MODE == LS_START_EXACT
+// The leaf lists (ls::LeafLists): per node the number of its first occupied leaf, per occupied leaf
+// the start of its triangles (plus one end), the triangles (scene indices, vertices at binding 0).
+layout(std430, binding = LS_LEAF_BASE_BINDING) readonly buffer LsLeafBase { uint lsLeafBase[]; };
+layout(std430, binding = LS_LEAF_PREFIX_BINDING) readonly buffer LsLeafPrefix { uint lsLeafPrefix[]; };
+layout(std430, binding = LS_LEAF_TRIS_BINDING) readonly buffer LsLeafTris { uint lsLeafTris[]; };
 #endif
 layout(std430, binding = LS_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = LS_COUNTER_BINDING) buffer LsCounters { uint lsCounters[]; };
@@ -105,22 +123,43 @@ uint lineSpaceWord(uint index, uint w) {
 // (twin of ls::StartRegion::end): far enough that the ray has risen `uStartCells` leaf widths
 // (measured along the normal) above the receiver's tangent plane, so no shaft crossed later holds
 // the leaves the receiver's own surface fills; at most `uStartMaxCells` leaf widths along the ray,
-// which bounds the blockers it may miss near grazing directions. A ray going into the receiver
-// (sin <= 0) has no start region: the leaves it enters there block it.
+// which bounds the blockers it may miss near grazing directions. A ray below the horizon of the
+// (interpolated) normal (sin <= 0) may still leave a faceted receiver unblocked, as the reference
+// finds: the exact start region then takes its longest length; the distance one, which ignores
+// geometry, none (the leaves the ray enters there block it).
 float startRegionEnd(vec3 nu, vec3 d) {
-    float sinAngle = dot(nu, d);
-    if (!(sinAngle > 0.0)) return 0.0;
-    return min(uStartCells * dot(abs(nu), uLeafCell) / sinAngle, uStartMaxCells * dot(abs(d), uLeafCell));
+    float sinAngle = dot(nu, d), longest = uStartMaxCells * dot(abs(d), uLeafCell);
+    if (!(sinAngle > 0.0)) return LS_START_MODE == LS_START_EXACT ? longest : 0.0;
+    return min(uStartCells * dot(abs(nu), uLeafCell) / sinAngle, longest);
 }
 
-uint leafCells = 0u; // leaf cells read by leafWalk (counter)
+uint leafCells = 0u, trianglesTested = 0u; // read by leafWalk (counters)
 
-#if LS_START_DISTANCE
-// Does the segment [t0, t1] of the ray pass through an occupied leaf of last-level node `index`?
-// A 3D DDA over the node's N³ leaves; the occupancy bits are conservative (widened leaf boxes), so
-// a blocker the segment touches is never missed. Leaves stand for their geometry, like a shaft
-// but one leaf wide: finer than the node's shaft, which is why it is only used where the shaft
-// cannot be (the node the start region ends in).
+#if LS_START_MODE == LS_START_EXACT
+WatertightRay exactRay = WatertightRay(vec3(0.0), 0.0, 2, false, vec3(0.0)); // the current ray, in the triangle test's frame
+
+// Does the ray hit a triangle of occupied leaf `leaf` (child order) of node `index`? The whole
+// segment is tested, as the reference does: a hit anywhere on it is a hit.
+bool leafBlocks(uint index, uint leaf) {
+    uint rank = lsLeafBase[index];
+    for (uint w = 0u; w < (leaf >> 5u); ++w) rank += uint(bitCount(lsOcc[index * OCC_WORDS + w]));
+    uint below = (1u << (leaf & 31u)) - 1u;
+    rank += uint(bitCount(lsOcc[index * OCC_WORDS + (leaf >> 5u)] & below));
+    uint end = lsLeafPrefix[rank + 1u];
+    for (uint i = lsLeafPrefix[rank]; i < end; ++i) {
+        ++trianglesTested;
+        uint tri = lsLeafTris[i];
+        if (watertightHit(exactRay, sceneVertex(tri, 0u), sceneVertex(tri, 1u), sceneVertex(tri, 2u))) return true;
+    }
+    return false;
+}
+#endif
+
+#if LS_START_MODE != LS_START_NODE
+// Does the segment [t0, t1] of the ray pass through an occupied leaf of last-level node `index`
+// (distance), or hit a triangle of one (exact)? A 3D DDA over the node's N³ leaves. The occupancy
+// bits are conservative (widened leaf boxes), so a blocker the segment touches is never missed;
+// an occupied leaf stands for its geometry like a shaft one leaf wide, finer than the node's shaft.
 bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1) {
     ivec3 c = cellOf(r.o + r.d * t0, lo, cellSize);
     ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
@@ -129,7 +168,13 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1) {
     for (int i = 0; i < 3 * LS_N; ++i) { // a line crosses at most 3N - 2 cells of an N³ grid
         ++leafCells;
         uint leaf = uint((c.z * LS_N + c.y) * LS_N + c.x);
-        if (((lsOcc[base + (leaf >> 5u)] >> (leaf & 31u)) & 1u) != 0u) return true;
+        if (((lsOcc[base + (leaf >> 5u)] >> (leaf & 31u)) & 1u) != 0u) {
+#if LS_START_MODE == LS_START_EXACT
+            if (leafBlocks(index, leaf)) return true;
+#else
+            return true;
+#endif
+        }
         float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
         if (cellEnd > t1) return false;
         bvec3 axis = equal(tNext, vec3(cellEnd));
@@ -177,10 +222,15 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
     start = start || tIn < tS;
     ++rayVisited; // a ray that misses the scene box visits nothing
     vec3 cellSize = n.size / float(LS_N);
-    // Where the walk of a start-region node begins: the start region's end, or the node's entry.
+    // Where the walk of a start-region node begins: the start region's end (geometry before it is
+    // ignored), or, when the start region is tested exactly, the node's entry.
+#if LS_START_MODE == LS_START_EXACT
+    float tFrom = max(tIn, 0.0);
+#else
     float tFrom = max(max(tIn, tS), 0.0);
+#endif
     if (start && last) {
-#if LS_START_DISTANCE
+#if LS_START_MODE != LS_START_NODE
         float tTo = min(tOut, r.tEnd);
         if (tFrom > tTo) return ENTER_SKIP; // the whole node lies in the start region
         return leafWalk(index, n.lo, cellSize, r, tFrom, tTo) ? ENTER_OCCLUDED : ENTER_SKIP;
@@ -247,12 +297,12 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
 #endif
 
-shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 
 void main() {
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = 0u;
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(uVisibility);
@@ -276,6 +326,7 @@ void main() {
                 uint unblocked = 0u, cells = 0u, occluded = 0u, maxVisited = 0u, overflow = 0u;
                 sumShafts = 0u;
                 leafCells = 0u;
+                trianglesTested = 0u;
                 vec3 nu = normalize(n);
 #if LS_CLASSIFY
                 startNode = LS_NONE;
@@ -305,8 +356,11 @@ void main() {
                     ivec3 childStep = stepDir * ivec3(1, LS_N, LS_N * LS_N);
                     rayVisited = 0u;
                     bool blocked = false;
-#if LS_START_DISTANCE
+#if LS_START_MODE != LS_START_NODE
                     float tS = startRegionEnd(nu, r.d);
+#if LS_START_MODE == LS_START_EXACT
+                    exactRay = watertightRay(r.o, r.d, r.tEnd);
+#endif
 #else
                     float tS = -kInf;
 #endif
@@ -387,6 +441,7 @@ void main() {
                 atomicAdd(sShafts, shafts);
                 atomicAdd(sCells, cells);
                 atomicAdd(sLeaves, leafCells);
+                atomicAdd(sTris, trianglesTested);
                 atomicAdd(sOccluded, occluded);
                 if (overflow != 0u) atomicAdd(sOverflow, overflow);
             }
@@ -406,6 +461,7 @@ void main() {
         addWide(LS_C_SHAFTS_LO, sShafts);
         addWide(LS_C_CELLS_LO, sCells);
         addWide(LS_C_LEAVES_LO, sLeaves);
+        addWide(LS_C_TRIS_LO, sTris);
         addWide(LS_C_OCCLUDED_LO, sOccluded);
         if (sOverflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], sOverflow);
     }
