@@ -102,6 +102,22 @@ TEST_F(BvhRaytraceGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
         if (o.lit[i]) EXPECT_LE(o.visibility[i], o.reference[i] + 1e-6f) << "pixel " << i << " lit by overflow";
 }
 
+// The register short stack (short_stack) traverses in the same order: the same image, the same
+// counters; with a stack smaller than the register part it still reports overflow.
+TEST_F(BvhRaytraceGLTest, ShortStackGivesTheSameImage) {
+    const Shot s = areaShot(16, "stratified");
+    AlgorithmRun memory = run(s), registers = run(s, {{"short_stack", true}});
+    EXPECT_EQ(registers.visibility, memory.visibility);
+    EXPECT_EQ(registers.counters["nodes_visited_mean"], memory.counters["nodes_visited_mean"]);
+    EXPECT_EQ(registers.overflow, 0u);
+    // 20 entries: 16 in registers, 4 spilled to memory, on a tree of depth 13.
+    AlgorithmRun spilled = run(s, {{"short_stack", true}, {"stack_size", 20}});
+    EXPECT_EQ(spilled.visibility, memory.visibility);
+    AlgorithmRun tiny = run(areaShot(4, "grid"), {{"short_stack", true}, {"stack_size", 1}});
+    EXPECT_GT(tiny.counters["stack_overflow_pixels"], 0.0);
+    expectOverflowedPixelsShadowed(tiny, tiny.counters["stack_overflow_pixels"]);
+}
+
 TEST_F(BvhRaytraceGLTest, CountersAndMemoryDescribeTheTree) {
     Shot s = pointShot();
     AlgorithmRun o = run(s);

@@ -179,15 +179,15 @@ TEST(LineSpaceTest, LeafListsFollowTheOccupancy) {
     for (auto [n, d] : {std::pair{4, 3}, {3, 2}, {5, 1}}) {
         ls::NTree t = ls::buildNTree(s, n, d);
         ls::LeafLists lists = ls::buildLeafLists(s, t, 2);
-        ASSERT_EQ(lists.nodeBase.size(), t.nodes.size());
         const size_t occWords = ls::occupancyWords(n);
+        ASSERT_EQ(lists.wordRank.size(), t.nodes.size() * occWords);
         size_t leaf = 0;
         for (size_t i = 0; i < t.nodes.size(); ++i) {
             if (int(t.nodes[i].level) != d - 1) continue;
-            EXPECT_EQ(lists.nodeBase[i], leaf) << "node " << i;
             const glm::dvec3 lo(t.nodes[i].lo[0], t.nodes[i].lo[1], t.nodes[i].lo[2]);
             const glm::dvec3 cell = glm::dvec3(t.nodes[i].size[0], t.nodes[i].size[1], t.nodes[i].size[2]) / double(n);
             for (int c = 0; c < n * n * n; ++c) {
+                if ((c & 31) == 0) EXPECT_EQ(lists.wordRank[i * occWords + size_t(c >> 5)], leaf) << "node " << i;
                 if (!((t.occupancy[i * occWords + size_t(c >> 5)] >> (c & 31)) & 1u)) continue;
                 ASSERT_LT(leaf + 1, lists.prefix.size());
                 EXPECT_LT(lists.prefix[leaf], lists.prefix[leaf + 1]) << "an occupied leaf without triangles";

@@ -32,6 +32,11 @@ const ParamSchema& bvhSchema() {
         .integer("stack_size", 64, 1, 256, "nodes",
                  "traversal stack; a ray that overflows it counts as blocked and is reported", ParamChange::Rebuild)
         .integer("leaf_size", 4, 1, BVH_MAX_LEAF, "triangles", "most triangles per BVH leaf", ParamChange::Rebuild)
+        // Off: on llvmpipe the shifts cost more than the scratch-memory stack they avoid (~10-20 %
+        // slower on the engine scenes, docs/algorithms/line_space.md); a GPU may differ.
+        .boolean("short_stack", false,
+                 "keep the top 16 stack entries in registers (shifted on push/pop), spilling deeper ones to memory",
+                 ParamChange::Rebuild)
         .integer("sah_bins", 32, 4, 256, "bins", "SAH candidate split planes per axis in the CPU build", ParamChange::Rebuild)
         // Aila & Laine's GPU ratio is near 1: a node fetch costs about what a triangle fetch does.
         .real("traversal_cost", 1.0, 0.1, 10.0, "× triangle test",
@@ -140,7 +145,8 @@ public:
 
 private:
     void compile() {
-        const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(params_.getInt("stack_size"))}};
+        const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(params_.getInt("stack_size"))},
+                                       {"BVH_SHORT_STACK", params_.getBool("short_stack") ? "1" : "0"}};
         if (defines == compiledDefines_) return; // leaf_size only rebuilds the tree
         compiledDefines_ = defines;
         trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp", defines);

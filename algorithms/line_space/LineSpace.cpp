@@ -111,7 +111,7 @@ public:
                 if (bytes > limit)
                     throw RuntimeError(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
                                        " MiB; one SSBO may hold " + mib(limit) + " MiB here");
-            leafBase_ = GlBuffer::fromVector(lists.nodeBase, 0);
+            leafBase_ = GlBuffer::fromVector(lists.wordRank, 0);
             leafPrefix_ = GlBuffer::fromVector(lists.prefix, 0);
             leafTris_ = GlBuffer::fromVector(lists.tris, 0);
         }

@@ -77,13 +77,14 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads = 0, size_t maxBl
 
 /// Triangles of the leaves of the last subdivided level, for start_region = exact (the start region
 /// tested against the triangles themselves). Occupied leaves are numbered in node order, then child
-/// order; leaf g of node i is leaf nodeBase[i] + (occupied leaves of i before it), and its triangles
-/// are tris[prefix[g] .. prefix[g + 1]) (scene triangle indices).
+/// order; leaf c of node i (its occupancy bit set) is number wordRank[i × occupancyWords + c / 32]
+/// + (occupied leaves of word c / 32 below bit c % 32), so the shader finds it with one load and one
+/// bitCount; its triangles are tris[prefix[g] .. prefix[g + 1]) (scene triangle indices).
 struct LeafLists {
-    std::vector<uint32_t> nodeBase; ///< per node (0 above the last level)
+    std::vector<uint32_t> wordRank; ///< per node and occupancy word (0 above the last level)
     std::vector<uint32_t> prefix;   ///< per occupied leaf, plus one
     std::vector<uint32_t> tris;
-    size_t bytes() const { return (nodeBase.size() + prefix.size() + tris.size()) * sizeof(uint32_t); }
+    size_t bytes() const { return (wordRank.size() + prefix.size() + tris.size()) * sizeof(uint32_t); }
 };
 
 /// The leaf lists of `tree` (built from `scene`): the build's descent replayed with the same

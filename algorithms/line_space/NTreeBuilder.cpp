@@ -184,7 +184,7 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
 
 LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
     LeafLists out;
-    out.nodeBase.assign(t.nodes.size(), 0);
+    out.wordRank.assign(t.nodes.size() * occupancyWords(t.n), 0);
     out.prefix.push_back(0);
     if (t.nodes.empty()) return out;
     if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
@@ -209,8 +209,8 @@ LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
         for (size_t i = 0; i < level.size(); ++i) {
             const NodeGpu& node = t.nodes[index[i]];
             if (int(node.level) == t.d - 1) { // leaves: append the occupied ones, in child order
-                out.nodeBase[index[i]] = uint32_t(out.prefix.size() - 1);
                 for (int c = 0; c < n3; ++c) {
+                    if ((c & 31) == 0) out.wordRank[index[i] * occupancyWords(n) + size_t(c >> 5)] = uint32_t(out.prefix.size() - 1);
                     const auto& tris = results[i].childTris[size_t(c)];
                     if (tris.empty()) continue;
                     out.tris.insert(out.tris.end(), tris.begin(), tris.end());

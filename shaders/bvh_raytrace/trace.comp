@@ -74,13 +74,46 @@ const uint BVH_LEAF = 0x80000000u, NONE = 0xFFFFFFFFu;
 uint childRef(uint child, uint count) { return count > 0u ? (BVH_LEAF | (child << 4u) | (count - 1u)) : child; }
 bool isLeaf(uint ref) { return ref != NONE && (ref & BVH_LEAF) != 0u; }
 
+#if BVH_SHORT_STACK
+// The traversal stack's top BVH_SHORT_ENTRIES entries live in four uvec4 registers, shifted on
+// every push and pop (no variable index: llvmpipe keeps a variably indexed local array in scratch
+// memory); deeper entries spill to `stack`, which only a push onto a full short stack or a pop
+// that refills it index. sp counts all entries.
+#define BVH_SHORT_ENTRIES 16
+#define STACK_SPILL max(1, BVH_STACK_SIZE - BVH_SHORT_ENTRIES)
+#define PUSH(x)                                                                               \
+    {                                                                                         \
+        if (sp >= BVH_SHORT_ENTRIES) stack[sp - BVH_SHORT_ENTRIES] = st3.w;                   \
+        st3 = uvec4(st2.w, st3.xyz), st2 = uvec4(st1.w, st2.xyz), st1 = uvec4(st0.w, st1.xyz); \
+        st0 = uvec4((x), st0.xyz);                                                            \
+        ++sp;                                                                                 \
+    }
+#define POP_INTO(v)                                                                                  \
+    {                                                                                                \
+        if (sp == 0) {                                                                               \
+            v = NONE;                                                                                \
+        } else {                                                                                     \
+            v = st0.x;                                                                               \
+            --sp;                                                                                    \
+            uint refill_ = sp >= BVH_SHORT_ENTRIES ? stack[sp - BVH_SHORT_ENTRIES] : NONE;           \
+            st0 = uvec4(st0.yzw, st1.x), st1 = uvec4(st1.yzw, st2.x), st2 = uvec4(st2.yzw, st3.x);  \
+            st3 = uvec4(st3.yzw, refill_);                                                           \
+        }                                                                                            \
+    }
+#else
+#define STACK_SPILL BVH_STACK_SIZE
+#define PUSH(x) stack[sp++] = (x)
+#define POP_INTO(v) v = sp > 0 ? stack[--sp] : NONE
+#endif
+
 Trace trace(Ray r) {
     Trace res = Trace(false, false, 0u, 0u);
-    uint stack[BVH_STACK_SIZE];
+    uint stack[STACK_SPILL];
+#if BVH_SHORT_STACK
+    uvec4 st0 = uvec4(NONE), st1 = uvec4(NONE), st2 = uvec4(NONE), st3 = uvec4(NONE);
+#endif
     int sp = 0;
     uint node = 0u, leaf = NONE; // the inner node to visit next, and a leaf postponed for the leaf loop
-    // pop(): the next subtree, NONE once the stack is empty.
-#define POP() (sp > 0 ? stack[--sp] : NONE)
     while (node != NONE || leaf != NONE) {
         // Inner loop: descend until this ray holds a leaf (or has nothing left), so that the rays of
         // neighbouring invocations (lanes in lockstep) test their triangles together below.
@@ -95,13 +128,14 @@ Trace trace(Ray r) {
                 bool first0 = tn0 <= tn1; // near child first
                 // A full stack would drop a subtree that may hold the occluder: stop and report.
                 if (sp == BVH_STACK_SIZE) { res.overflow = true; return res; }
-                stack[sp++] = first0 ? c1 : c0;
+                PUSH(first0 ? c1 : c0);
                 node = first0 ? c0 : c1;
             } else {
-                node = h0 ? c0 : (h1 ? c1 : POP());
+                if (h0 || h1) node = h0 ? c0 : c1;
+                else POP_INTO(node);
             }
             // A leaf is postponed: its triangles are tested in the leaf loop.
-            if (isLeaf(node)) { leaf = node; node = POP(); }
+            if (isLeaf(node)) { leaf = node; POP_INTO(node); }
         }
         // Leaf loop: the postponed leaf, and any leaves that come next off the stack.
         while (isLeaf(leaf)) {
@@ -111,10 +145,9 @@ Trace trace(Ray r) {
                 if (hitTriangle(r, first + i)) { res.occluded = true; return res; } // any hit ends the ray
             }
             leaf = NONE;
-            if (isLeaf(node)) { leaf = node; node = POP(); }
+            if (isLeaf(node)) { leaf = node; POP_INTO(node); }
         }
     }
-#undef POP
     return res;
 }
 
