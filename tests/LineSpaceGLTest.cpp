@@ -123,6 +123,9 @@ const ErrCase kErrCases[] = {
     {"directional_6_3", smokeDirectionalShot, {}},
     {"area16_6_3", [] { return areaShot(16); }, {}},
     {"pebbles_6_3", pebbleShot, {}},
+    // The paper's Algorithm 1 as published keeps its guarantee too.
+    {"point_6_3_paper", smokePointShot, {{"start_region", "node"}, {"last_level", "shaft"}}},
+    {"area16_6_3_paper", [] { return areaShot(16); }, {{"start_region", "node"}, {"last_level", "shaft"}}},
 };
 
 class LineSpaceErrGLTest : public LineSpaceGLTest, public ::testing::WithParamInterface<ErrCase> {};
@@ -159,7 +162,7 @@ TEST_F(LineSpaceGLTest, ExtremeDepthsKeepTheGuarantees) {
 // Small blockers inside the start node are missed by the paper's Algorithm 1: the one way it errs
 // towards light. The exact start region tests them.
 TEST_F(LineSpaceGLTest, BlockersInsideTheStartNodeAreMissed) {
-    AlgorithmRun o = run(pebbleShot(), {{"start_region", "node"}});
+    AlgorithmRun o = run(pebbleShot(), {{"start_region", "node"}, {"last_level", "shaft"}});
     print("pebbles (start node)", o);
     EXPECT_GT(o.counters["under_occluded_start_node_share"], 0.0);
     EXPECT_EQ(o.counters["under_occluded_start_node_share"], o.counters["under_occluded_share"]);
@@ -184,26 +187,27 @@ struct SoftCase {
 
 void PrintTo(const SoftCase& c, std::ostream* os) { printCase(*os, c.name, c.params); }
 
-// Measured at 64², 25 samples (llvmpipe; the images do not depend on the driver's timing). Every
-// row's under-occluded bound is 0: the exact start region ignores no geometry and the line space
-// beyond it is conservative. The over-occluded bound is the requirement's 3 % of samples; the RMSE
-// bound is the requirement's 0.08 where the measurement leaves room, else the measured value plus
-// ~10 % (commented). What remains is the method's approximation: a non-empty shaft blocks every ray
-// through it, so penumbrae grow outwards by up to a shaft (one leaf) wide.
+// Measured at 64², 25 samples (llvmpipe; the images do not depend on the driver's timing), with
+// the defaults (exact start region, leaves deciding on the last level). Every row's under-occluded
+// bound is 0: the exact start region ignores no geometry and the rest is conservative. What remains
+// is over-occlusion beside occluders: a ray through a non-empty shaft is decided by the occupied
+// leaves it crosses, so shadows grow by up to one leaf (plus the build's margin). Bounds: the
+// measured value plus ~25 % (RMSE) and 1.5 % of samples (over; measured ≤ 1.14 %), well inside the
+// requirement's 0.08 and 3 %.
 const SoftCase kSoftCases[] = {
-    // Smooth convex objects, small light (0.5 × 0.5): measured RMSE 0.072, over 1.45 %. Narrow
-    // penumbrae: the leaf-wide growth is a large part of them.
-    {"shapes_small_light_7_3", [] { return shapesShot(0.5f); }, {{"n", 7}, {"d", 3}}, 0.08, 0.03, 0.0},
-    // The same under a large light (2 × 2), wide penumbrae: measured RMSE 0.045, over 1.32 %.
-    {"shapes_large_light_7_3", [] { return shapesShot(2.0f); }, {{"n", 7}, {"d", 3}}, 0.08, 0.03, 0.0},
-    // Coarser sets, larger leaves and shafts: measured RMSE 0.063 (4, 4), 0.070 (6, 3); over 1.8 %, 2.1 %.
-    {"shapes_4_4", [] { return shapesShot(1.5f); }, {{"n", 4}, {"d", 4}}, 0.08, 0.03, 0.0},
-    {"shapes_6_3", [] { return shapesShot(1.5f); }, {{"n", 6}, {"d", 3}}, 0.08, 0.03, 0.0},
-    // A thin dense mesh and thin posts: the tube (0.06 across) is narrower than the shafts around
-    // it, so its shadow grows by up to a leaf on each side: measured RMSE 0.081, over 2.1 %; 0.09.
-    {"thin_mesh_7_3", thinMeshShot, {{"n", 7}, {"d", 3}}, 0.09, 0.03, 0.0},
-    // The smoke scene (sphere, torus, fence) under its 1.5 × 1.5 light: measured RMSE 0.057, over 1.55 %.
-    {"smoke_area_7_3", [] { return smokeAreaShot(25, 1.5f); }, {{"n", 7}, {"d", 3}}, 0.08, 0.03, 0.0},
+    // Smooth convex objects, small light (0.5 × 0.5): narrow penumbrae, where a leaf of growth
+    // weighs most. Measured RMSE 0.044, over 0.80 %.
+    {"shapes_small_light_7_3", [] { return shapesShot(0.5f); }, {{"n", 7}, {"d", 3}}, 0.055, 0.015, 0.0},
+    // The same under a large light (2 × 2), wide penumbrae. Measured RMSE 0.027, over 0.71 %.
+    {"shapes_large_light_7_3", [] { return shapesShot(2.0f); }, {{"n", 7}, {"d", 3}}, 0.035, 0.015, 0.0},
+    // Coarser sets, larger leaves. Measured RMSE 0.035 (4, 4), 0.041 (6, 3); over 0.96 %, 1.12 %.
+    {"shapes_4_4", [] { return shapesShot(1.5f); }, {{"n", 4}, {"d", 4}}, 0.045, 0.015, 0.0},
+    {"shapes_6_3", [] { return shapesShot(1.5f); }, {{"n", 6}, {"d", 3}}, 0.05, 0.015, 0.0},
+    // A thin dense mesh and thin posts: the tube (0.06 across) is about a leaf wide, so its shadow
+    // can double in width. Measured RMSE 0.049, over 1.14 %.
+    {"thin_mesh_7_3", thinMeshShot, {{"n", 7}, {"d", 3}}, 0.06, 0.015, 0.0},
+    // The smoke scene (sphere, torus, fence) under its 1.5 × 1.5 light. Measured RMSE 0.031, over 0.84 %.
+    {"smoke_area_7_3", [] { return smokeAreaShot(25, 1.5f); }, {{"n", 7}, {"d", 3}}, 0.04, 0.015, 0.0},
 };
 
 class LineSpaceSoftGLTest : public LineSpaceGLTest, public ::testing::WithParamInterface<SoftCase> {};
@@ -241,7 +245,7 @@ TEST_F(LineSpaceGLTest, SphereFacingTheLightIsLit) {
     ASSERT_GT(fullyLit, 1000u);
     EXPECT_EQ(dark, 0u) << "of " << fullyLit << " pixels lit by every sample";
     // With the paper's start node the same view is mostly dark.
-    AlgorithmRun paper = run(s, {{"n", 6}, {"d", 3}, {"start_region", "node"}});
+    AlgorithmRun paper = run(s, {{"n", 6}, {"d", 3}, {"start_region", "node"}, {"last_level", "shaft"}});
     print("sphere facing the light (paper)", paper);
     size_t paperDark = 0;
     for (size_t i = 0; i < o.reference.size(); ++i) paperDark += o.lit[i] && o.reference[i] >= 1.0f && paper.visibility[i] < 1.0f;
@@ -249,12 +253,12 @@ TEST_F(LineSpaceGLTest, SphereFacingTheLightIsLit) {
                 dark, paperDark);
 }
 
-// Ablation: the paper's Algorithm 1 as published (start_region = node) on the same soft-shadow
-// scene. Its start region ends where the ray leaves the last-level node it starts in, so the next
+// Ablation: the paper's Algorithm 1 as published (start_region = node, last_level = shaft) on the
+// same soft-shadow scene. Its start region ends where the ray leaves the last-level node it starts in, so the next
 // node's shaft holds the leaves of the receiver's own surface: lit surfaces shadow themselves.
 TEST_F(LineSpaceGLTest, PaperStartNodeShadowsLitSurfaces) {
     const Shot s = shapesShot(1.5f);
-    AlgorithmRun paper = run(s, {{"n", 7}, {"d", 3}, {"start_region", "node"}});
+    AlgorithmRun paper = run(s, {{"n", 7}, {"d", 3}, {"start_region", "node"}, {"last_level", "shaft"}});
     AlgorithmRun distance = run(s, {{"n", 7}, {"d", 3}});
     print("paper start node 7_3", paper);
     print("exact start 7_3", distance);
@@ -291,7 +295,7 @@ TEST_F(LineSpaceGLTest, LargerBranchingFactorOverOccludesLess) {
 TEST_F(LineSpaceGLTest, MemoryIsThePools) {
     Shot s = smokePointShot();
     // The paper's method: the three pools and nothing else (no geometry).
-    AlgorithmRun o = run(s, {{"n", 4}, {"d", 3}, {"start_region", "node"}});
+    AlgorithmRun o = run(s, {{"n", 4}, {"d", 3}, {"start_region", "node"}, {"last_level", "shaft"}});
     const double nodes = o.counters["subdivided_nodes"];
     EXPECT_EQ(o.counters["nodes_level_0"], 1.0);
     EXPECT_EQ(o.counters["nodes_level_0"] + o.counters["nodes_level_1"] + o.counters["nodes_level_2"], nodes);

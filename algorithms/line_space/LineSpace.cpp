@@ -53,6 +53,12 @@ const ParamSchema& lineSpaceSchema() {
                 "ignored and the rest of those nodes by leaf occupancy (distance); node = the paper's Algorithm 1, "
                 "the last-level node holding the origin skipped",
                 ParamChange::Rebuild)
+        // "shaft" is Algorithm 1's "deep enough": the shaft of a last-level node stands for its
+        // leaves, so shadows grow by up to a shaft's width around every occluder.
+        .choice("last_level", "leaves", {"leaves", "shaft"},
+                "a non-empty shaft of a last-level node: leaves = the leaves the ray crosses there decide "
+                "(occupancy mask); shaft = the ray is blocked (the paper's)",
+                ParamChange::Rebuild)
         .real("start_cells", 6.0, 0.0, 64.0, "leaf widths",
               "start_region exact/distance: height above the receiver's tangent plane (in leaf widths along its "
               "normal) at which a ray's start region ends",
@@ -79,7 +85,7 @@ public:
         // The occupancy pool is read (and counted) only by the distance and exact start regions; the
         // leaf lists and the scene's triangles only by the exact one.
         const ls::StartMode mode = startMode();
-        const bool occupancy = mode != ls::StartMode::Node, exact = mode == ls::StartMode::Exact;
+        const bool occupancy = mode != ls::StartMode::Node || lastLeaves(), exact = mode == ls::StartMode::Exact;
         leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer();
         ls::LeafLists lists;
         if (exact) lists = ls::buildLeafLists(scene.cpu(), tree_);
@@ -172,7 +178,7 @@ public:
         p.set("uStartMaxCells", region.maxCells);
         nodesBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_NODE_BINDING);
         treeBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_TREE_BINDING);
-        if (region.mode != ls::StartMode::Node) occBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_OCC_BINDING);
+        if (region.mode != ls::StartMode::Node || lastLeaves()) occBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_OCC_BINDING);
         if (region.mode == ls::StartMode::Exact) {
             scene_->bindStorage();
             leafBase_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_BASE_BINDING);
@@ -255,8 +261,11 @@ private:
                 {"LS_DEPTH", std::to_string(params_.getInt("d"))},
                 {"LS_CLASSIFY", classify ? "1" : "0"},
                 {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)},
-                {"LS_START_MODE", std::to_string(int(startMode()))}};
+                {"LS_START_MODE", std::to_string(int(startMode()))},
+                {"LS_LAST_LEAVES", lastLeaves() ? "1" : "0"}};
     }
+
+    bool lastLeaves() const { return params_.getEnum("last_level") == "leaves"; }
 
     ls::StartMode startMode() const {
         const std::string& m = params_.getEnum("start_region");

@@ -15,8 +15,10 @@
 //         node's occupancy mask (an occupied leaf blocks);
 //       LS_START_EXACT (the same region, no geometry ignored): its occupied leaves' triangles are
 //         tested exactly against the ray (a hybrid: the start region exact, the rest line space).
+//   * a non-empty shaft of a last-level node ("deep enough") blocks the ray (Algorithm 1), or with
+//     LS_LAST_LEAVES the leaves the ray crosses in that node decide, by the node's occupancy mask.
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
-// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE.
+// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE, LS_LAST_LEAVES.
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "line_space/layout.glsl"
@@ -39,7 +41,7 @@ layout(std430, binding = LS_BITS_BINDING) readonly buffer LsBits0 { uint lsBits0
 layout(std430, binding = LS_BITS_BINDING_1) readonly buffer LsBits1 { uint lsBits1[]; };
 layout(std430, binding = LS_BITS_BINDING_2) readonly buffer LsBits2 { uint lsBits2[]; };
 layout(std430, binding = LS_BITS_BINDING_3) readonly buffer LsBits3 { uint lsBits3[]; };
-#if LS_START_MODE != LS_START_NODE
+#if LS_START_MODE != LS_START_NODE || LS_LAST_LEAVES
 layout(std430, binding = LS_OCC_BINDING) readonly buffer LsOccupancy { uint lsOcc[]; };
 #endif
 #if LS_START_MODE == LS_START_EXACT
@@ -140,7 +142,7 @@ uint leafCells = 0u, trianglesTested = 0u; // read by leafWalk (counters)
 WatertightRay exactRay = WatertightRay(vec3(0.0), 0.0, 2, false, vec3(0.0)); // the current ray, in the triangle test's frame
 #endif
 
-#if LS_START_MODE != LS_START_NODE
+#if LS_START_MODE != LS_START_NODE || LS_LAST_LEAVES
 // Does the segment [t0, t1] of the ray pass through an occupied leaf of last-level node `index`
 // (distance), or hit a triangle of one (exact)? A 3D DDA over the node's N³ leaves. The occupancy
 // bits are conservative (widened leaf boxes), so a blocker the segment touches is never missed;
@@ -270,7 +272,15 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
             nonEmpty = ((lineSpaceWord(index, bit >> 5u) >> (bit & 31u)) & 1u) != 0u;
         }
         if (!nonEmpty) return ENTER_SKIP;
-        if (last) return ENTER_OCCLUDED; // "deep enough": the shaft stands for its leaves
+        if (last) { // "deep enough"
+#if LS_LAST_LEAVES
+            // The shaft is non-empty; the leaves the ray itself crosses decide (occupancy, one leaf
+            // wide instead of the shaft's union of all lines between two sub-faces).
+            return leafWalk(index, n.lo, cellSize, r, max(tIn, 0.0), min(tOut, r.tEnd), -kInf) ? ENTER_OCCLUDED : ENTER_SKIP;
+#else
+            return ENTER_OCCLUDED; // the shaft stands for its leaves (Algorithm 1)
+#endif
+        }
     }
     f.children = n.children;
     f.lo = n.lo;
