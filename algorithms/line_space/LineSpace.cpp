@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -88,7 +89,19 @@ public:
         const bool occupancy = mode != ls::StartMode::Node || lastLeaves(), exact = mode == ls::StartMode::Exact;
         leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer();
         ls::LeafLists lists;
-        if (exact) lists = ls::buildLeafLists(scene.cpu(), tree_);
+        if (exact) {
+            lists = ls::buildLeafLists(scene.cpu(), tree_);
+            // The shader numbers a leaf by the occupancy bits below it: one occupied leaf without a list
+            // (or the reverse) would shift every later list, so the two must agree exactly.
+            size_t occupied = 0;
+            const size_t words = ls::occupancyWords(n);
+            for (size_t i = 0; i < tree_.nodes.size(); ++i)
+                if (int(tree_.nodes[i].level) == d - 1)
+                    for (size_t w = 0; w < words; ++w) occupied += size_t(std::popcount(tree_.occupancy[i * words + w]));
+            if (occupied + 1 != lists.prefix.size())
+                throw RuntimeError("line_space: the leaf lists (" + std::to_string(lists.prefix.size() - 1) +
+                                   " leaves) disagree with the occupancy pool (" + std::to_string(occupied) + " leaves)");
+        }
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
                       tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0,
                       exact ? lists.bytes() + scene.positions().size() : 0};
