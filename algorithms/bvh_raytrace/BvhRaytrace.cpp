@@ -122,6 +122,7 @@ public:
                 {"traced_pixels", double(c[BVH_C_PIXELS])},
                 {"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
                 {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
+                {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
                 {"bvh_nodes", double(nodeCount_)},
                 {"bvh_leaves", double(leaves_)},
                 {"bvh_depth", double(depth_)},
@@ -140,8 +141,12 @@ public:
     /// information in addition"). Per-pixel debug images and the sample list are not counted.
     size_t memoryBytes() const override { return nodes_.size() + triangles_.size(); }
 
-    /// Pixels with a ray whose stack overflowed (written shadowed): 0 means the image is exact.
-    uint64_t overflowCount() const override { return counters_.read()[BVH_C_OVERFLOW_PIXELS]; }
+    /// Pixels with a ray whose stack overflowed, or whose sample loop the driver cut short (both
+    /// written shadowed): 0 means the image is exact.
+    uint64_t overflowCount() const override {
+        const auto& c = counters_.read();
+        return uint64_t(c[BVH_C_OVERFLOW_PIXELS]) + c[BVH_C_TRUNCATED_PIXELS];
+    }
 
 private:
     void compile() {

@@ -227,6 +227,7 @@ public:
                                     {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
                                     {"rays", rays},
                                     {"traced_pixels", double(c[LS_C_PIXELS])},
+                                    {"truncated_pixels", double(c[LS_C_TRUNCATED])},
                                     {"subdivided_nodes", double(tree_.nodes.size())},
                                     {"build_ms", tree_.buildMs},
                                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
@@ -264,9 +265,13 @@ public:
         return sum;
     }
 
-    /// Traversal stack overflows: one frame per level always suffices, so this is 0 unless the
-    /// pools are corrupt (an overflowing ray is counted occluded, never lit).
-    uint64_t overflowCount() const override { return counters_.read()[LS_C_OVERFLOW]; }
+    /// Traversal stack overflows (one frame per level always suffices, so 0 unless the pools are
+    /// corrupt; such a ray is counted occluded) plus pixels whose sample loop the driver cut short
+    /// (written shadowed): never lit by mistake.
+    uint64_t overflowCount() const override {
+        const auto& c = counters_.read();
+        return uint64_t(c[LS_C_OVERFLOW]) + c[LS_C_TRUNCATED];
+    }
 
 private:
     ShaderDefines defines(bool classify) const {

@@ -32,7 +32,8 @@
 #define BVH_C_OVERFLOW_RAYS 7     // rays whose traversal stack overflowed (counted as blocked)
 #define BVH_C_OVERFLOW_PIXELS 8   // pixels with at least one such ray (written shadowed)
 #define BVH_C_PIXELS 9            // pixels that traced rays (covered, facing and reached by the light)
-// Words 10..11 are reserved.
+#define BVH_C_TRUNCATED_PIXELS 10 // pixels whose sample loop the driver cut short (written shadowed)
+// Word 11 is reserved.
 
 // Child reference of an absent child (only the root of a tree of fewer than two leaves has one).
 #define BVH_ABSENT 0xFFFFFFFFu

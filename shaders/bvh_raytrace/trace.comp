@@ -151,18 +151,19 @@ Trace trace(Ray r) {
     return res;
 }
 
-shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels, sTruncated;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(bvhCounters, lo, value)
 
 void main() {
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = sTruncated = 0u;
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)
         uint visited = 0u, overflowRays = 0u;
+        bool truncated = false;
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
@@ -171,7 +172,7 @@ void main() {
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
                 int count = directional ? 1 : uSampleCount;
                 float unblocked = 0.0;
-                uint tested = 0u, maxVisited = 0u;
+                uint tested = 0u, maxVisited = 0u, done = 0u;
                 for (int s = 0; s < count; ++s) {
                     Ray r;
                     if (directional) {
@@ -179,7 +180,7 @@ void main() {
                     } else {
                         vec3 d = lightSamples[s].xyz - o;
                         float dist = length(d);
-                        if (!(dist > 0.0)) { unblocked += 1.0; continue; } // origin on the sample
+                        if (!(dist > 0.0)) { unblocked += 1.0; ++done; continue; } // origin on the sample
                         r = makeRay(o, d / dist, max(0.0, dist - uRayOffset));
                     }
                     Trace t = trace(r);
@@ -188,7 +189,11 @@ void main() {
                     maxVisited = max(maxVisited, t.visited);
                     if (t.overflow) ++overflowRays;
                     else if (!t.occluded) unblocked += 1.0;
+                    ++done;
                 }
+                // Fewer samples done than taken: llvmpipe's code generator (gallivm) stops the loops of
+                // an invocation after a fixed budget of iterations, silently. Treated like an overflow.
+                if (done != uint(count)) { truncated = true; ++overflowRays; }
                 // An overflowed ray counts as blocked, and its pixel is written fully shadowed, so a
                 // stack too small shows as dark pixels and in overflowCount(), never as light.
                 visibility = overflowRays > 0u ? 0.0 : unblocked / float(count);
@@ -197,7 +202,8 @@ void main() {
                 atomicAdd(sVisited, visited);
                 atomicMax(sVisitedMax, maxVisited);
                 atomicAdd(sTested, tested);
-                if (overflowRays > 0u) { atomicAdd(sOverflowRays, overflowRays); atomicAdd(sOverflowPixels, 1u); }
+                if (truncated) atomicAdd(sTruncated, 1u);
+                else if (overflowRays > 0u) { atomicAdd(sOverflowRays, overflowRays); atomicAdd(sOverflowPixels, 1u); }
             }
         }
         imageStore(uVisibility, px, vec4(visibility));
@@ -211,6 +217,7 @@ void main() {
         addWide(BVH_C_VISITED_LO, sVisited);
         atomicMax(bvhCounters[BVH_C_VISITED_MAX], sVisitedMax);
         addWide(BVH_C_TRIS_LO, sTested);
+        if (sTruncated != 0u) atomicAdd(bvhCounters[BVH_C_TRUNCATED_PIXELS], sTruncated);
         if (sOverflowRays != 0u) {
             atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], sOverflowRays);
             atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], sOverflowPixels);

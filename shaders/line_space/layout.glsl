@@ -60,4 +60,4 @@
 #define LS_C_LEAVES_HI 14
 #define LS_C_TRIS_LO 15         // triangles tested by the exact start region, summed over rays
 #define LS_C_TRIS_HI 16
-// Word 17 is reserved.
+#define LS_C_TRUNCATED 17       // pixels whose sample loop the driver cut short (written shadowed)

@@ -317,12 +317,12 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
 #endif
 
-shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 
 void main() {
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = 0u;
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(uVisibility);
@@ -453,7 +453,18 @@ void main() {
                 // The start node depends only on the origin: every sample reports the same one.
                 if (startNode != LS_NONE) pixelStartNode = startNode;
 #endif
-                visibility = float(unblocked) / float(count);
+                // Every sample's iteration ends counted as unblocked or occluded. Fewer means the loop
+                // was cut short: llvmpipe's code generator (gallivm) stops the loops of an invocation
+                // after a fixed budget of iterations, silently, and a sample never traced would count
+                // as lit. Such a pixel is written shadowed and reported (overflowCount()), like an
+                // overflow, never as light.
+                bool truncated = unblocked + occluded != uint(count);
+                visibility = truncated ? 0.0 : float(unblocked) / float(count);
+#if LS_CLASSIFY
+                if (truncated)
+                    for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0xFFFFFFFFu; // every sample blocked
+#endif
+                if (truncated) atomicAdd(sTruncated, 1u);
                 atomicAdd(sPixels, 1u);
                 atomicAdd(sRays, uint(count));
                 atomicAdd(sVisited, visited);
@@ -484,5 +495,6 @@ void main() {
         addWide(LS_C_TRIS_LO, sTris);
         addWide(LS_C_OCCLUDED_LO, sOccluded);
         if (sOverflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], sOverflow);
+        if (sTruncated != 0u) atomicAdd(lsCounters[LS_C_TRUNCATED], sTruncated);
     }
 }
