@@ -60,6 +60,8 @@ const ParamSchema& lineSpaceSchema() {
                 "a non-empty shaft of a last-level node: leaves = the leaves the ray crosses there decide "
                 "(occupancy mask); shaft = the ray is blocked (the paper's)",
                 ParamChange::Rebuild)
+        // 6 and 64 by measurement: fewer leaf widths leave self-shadowing, more cost nothing but
+        // leave the error where it is (docs/algorithms/line_space.md, Parameters).
         .real("start_cells", 6.0, 0.0, 64.0, "leaf widths",
               "start_region exact/distance: height above the receiver's tangent plane (in leaf widths along its "
               "normal) at which a ray's start region ends",
