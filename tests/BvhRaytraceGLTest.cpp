@@ -102,6 +102,22 @@ TEST_F(BvhRaytraceGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
         if (o.lit[i]) EXPECT_LE(o.visibility[i], o.reference[i] + 1e-6f) << "pixel " << i << " lit by overflow";
 }
 
+// The register short stack (short_stack) traverses in the same order: the same image, the same
+// counters; with a stack smaller than the register part it still reports overflow.
+TEST_F(BvhRaytraceGLTest, ShortStackGivesTheSameImage) {
+    const Shot s = areaShot(16, "stratified");
+    AlgorithmRun memory = run(s), registers = run(s, {{"short_stack", true}});
+    EXPECT_EQ(registers.visibility, memory.visibility);
+    EXPECT_EQ(registers.counters["nodes_visited_mean"], memory.counters["nodes_visited_mean"]);
+    EXPECT_EQ(registers.overflow, 0u);
+    // 20 entries: 16 in registers, 4 spilled to memory, on a tree of depth 13.
+    AlgorithmRun spilled = run(s, {{"short_stack", true}, {"stack_size", 20}});
+    EXPECT_EQ(spilled.visibility, memory.visibility);
+    AlgorithmRun tiny = run(areaShot(4, "grid"), {{"short_stack", true}, {"stack_size", 1}});
+    EXPECT_GT(tiny.counters["stack_overflow_pixels"], 0.0);
+    expectOverflowedPixelsShadowed(tiny, tiny.counters["stack_overflow_pixels"]);
+}
+
 TEST_F(BvhRaytraceGLTest, CountersAndMemoryDescribeTheTree) {
     Shot s = pointShot();
     AlgorithmRun o = run(s);
@@ -109,7 +125,8 @@ TEST_F(BvhRaytraceGLTest, CountersAndMemoryDescribeTheTree) {
     // Leaves of at most 4 triangles: at least n / 4 leaves, one fewer inner node than leaves.
     EXPECT_GE(o.counters["bvh_leaves"], n / 4);
     EXPECT_EQ(o.counters["bvh_nodes"], o.counters["bvh_leaves"] - 1);
-    EXPECT_EQ(o.memory, size_t(o.counters["bvh_nodes"]) * 64 + size_t(n) * 4 + size_t(n) * 36);
+    // Nodes and the leaf-ordered triangles (three vec4 each); no index buffer, no scene positions.
+    EXPECT_EQ(o.memory, size_t(o.counters["bvh_nodes"]) * 64 + size_t(n) * 48);
     // Any-hit early exit and the SAH keep a ray far below the tree size.
     EXPECT_LT(o.counters["nodes_visited_mean"], 0.05 * o.counters["bvh_nodes"]);
     EXPECT_GE(o.counters["nodes_visited_max"], o.counters["nodes_visited_mean"]);

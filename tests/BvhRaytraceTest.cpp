@@ -84,6 +84,17 @@ TEST(BvhRaytraceTest, TreeIsAValidBvh) {
     }
 }
 
+// The shader reads a leaf's triangles contiguously: triangle i of the leaf order is the scene's
+// triangle triIndices[i], vertex for vertex.
+TEST(BvhRaytraceTest, TrianglesAreInLeafOrder) {
+    Scene s = objects();
+    bvh::Bvh t = bvh::buildBvh(s);
+    ASSERT_EQ(t.triangles.size(), 3 * s.triangleCount());
+    for (size_t i = 0; i < t.triIndices.size(); ++i)
+        for (size_t k = 0; k < 3; ++k)
+            ASSERT_EQ(glm::vec3(t.triangles[3 * i + k]), s.positions[3 * size_t(t.triIndices[i]) + k]) << "triangle " << i;
+}
+
 TEST(BvhRaytraceTest, DegenerateInputs) {
     // Nothing, one triangle, and 50 copies of one triangle (identical centroids: split by count).
     Scene empty;

@@ -80,14 +80,14 @@ const AccuracyCase kAccuracy[] = {
     // ≤ 0.0006 % on the full demo).
     {"configs/smoke.json", "metric_tree", 0.001},
     {kDemoSmall, "metric_tree", 0.001},
-    // line_space is approximate by design: a ray crossing a non-empty shaft counts as blocked even
-    // when it passes beside the geometry (paper Fig. 5), so shadows grow by up to a leaf cell and lit
-    // surfaces next to geometry self-shadow. With (N, d) = (6, 3) on these scenes that flips
-    // 13-17 % of lit pixels, all towards shadow (measured worst frames: 16.5 % hard, 17.3 % soft);
-    // 20 % bounds regressions. That every miss lies in the skipped start node (the method's one way
-    // to err towards light) is checked sample by sample in tests/LineSpaceGLTest.cpp.
-    {"configs/smoke.json", "line_space", 0.20},
-    {"configs/line_space/soft_smoke.json", "line_space", 0.20},
+    // line_space is approximate by design: a ray through a non-empty shaft is decided by the
+    // occupied leaves it crosses, so shadows grow by up to a leaf, all towards shadow. With (N, d) =
+    // (6, 3) and the defaults (exact start region, leaves on the last level) that flips 1.1-2.6 % of
+    // lit pixels on these scenes (measured worst frames: 2.3 % hard, 2.6 % soft); 4 % bounds
+    // regressions (the paper's Algorithm 1, start_region = node and last_level = shaft, flips
+    // 13-17 %). RMSE and the over-/under-occluded shares per scene: tests/LineSpaceGLTest.cpp.
+    {"configs/smoke.json", "line_space", 0.04},
+    {"configs/line_space/soft_smoke.json", "line_space", 0.04},
 };
 
 void PrintTo(const AccuracyCase& c, std::ostream* os) { *os << c.config << " / " << c.id << " ≤ " << c.maxMismatchPerFrame; }

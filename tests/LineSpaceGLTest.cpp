@@ -1,8 +1,11 @@
 // line_space on OSMesa, against the Embree reference with the same samples: every sample is also
 // traced exactly (the `classify` parameter) to show where the method errs: towards shadow
-// (non-empty shafts a ray passes) everywhere, towards light only inside the node the ray starts in.
-// Also: soft shadows hide the approximation better than hard ones (the paper's Figure 7), a larger
-// N errs less, and the disk cache returns the same image (and rebuilds a corrupt file).
+// (non-empty shafts a ray passes) everywhere, towards light only inside the start region (the
+// paper's start node, or the receiver-dependent distance of start_region = distance).
+// Also: a table of soft-shadow scenes with RMSE and over-/under-occlusion bounds per row, a sphere
+// facing the light comes out lit, the paper's start node self-shadows (ablation), soft shadows hide
+// the approximation better than hard ones (the paper's Figure 7), a larger N errs less, and the
+// disk cache returns the same image (and rebuilds a corrupt file).
 #include "algorithms/line_space/LineSpace.h"
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "framework/scene/Procedural.h"
@@ -37,6 +40,26 @@ Shot pebbleShot() {
     s.scene.updateBounds();
     s.camera.position = {0, 2.0f, 2.5f}, s.camera.target = {0, 0, -0.2f};
     s.light.position = {1.0f, 1.2f, 1.5f};
+    return s;
+}
+
+// The smoke scene's sphere and torus on its plane, without the fence, under a square area light of
+// side `side` (25 samples: the paper's protocol).
+Shot shapesShot(float side) {
+    Shot s = smokeAreaShot(25, side);
+    s.scene = makePlane({8, 8}, 4, Material{});
+    s.scene.append(makeSphere(0.6f, 2000, Material{}), translate({-0.8f, 0.8f, 0}));
+    s.scene.append(makeTorus(0.5f, 0.15f, 1500, Material{}), translate({0.9f, 0.6f, 0.3f}) * rotate(60, {1, 0, 0}));
+    return s;
+}
+
+// A thin, dense mesh: a torus whose tube (radius 0.03) is thinner than a leaf row is tall, in
+// 12,000 triangles, tilted over the plane, next to a fence of thin posts.
+Shot thinMeshShot() {
+    Shot s = smokeAreaShot(25, 1.0f);
+    s.scene = makePlane({8, 8}, 4, Material{});
+    s.scene.append(makeTorus(0.7f, 0.03f, 12000, Material{}), translate({0.0f, 0.8f, 0.0f}) * rotate(70, {1, 0, 0}));
+    s.scene.append(makeFence(6, 0.35f, 1.0f, 0.03f, 2, 32, Material{}), translate({0, 0, -1.2f}));
     return s;
 }
 
@@ -100,6 +123,9 @@ const ErrCase kErrCases[] = {
     {"directional_6_3", smokeDirectionalShot, {}},
     {"area16_6_3", [] { return areaShot(16); }, {}},
     {"pebbles_6_3", pebbleShot, {}},
+    // The paper's Algorithm 1 as published keeps its guarantee too.
+    {"point_6_3_paper", smokePointShot, {{"start_region", "node"}, {"last_level", "shaft"}}},
+    {"area16_6_3_paper", [] { return areaShot(16); }, {{"start_region", "node"}, {"last_level", "shaft"}}},
 };
 
 class LineSpaceErrGLTest : public LineSpaceGLTest, public ::testing::WithParamInterface<ErrCase> {};
@@ -133,16 +159,113 @@ TEST_F(LineSpaceGLTest, ExtremeDepthsKeepTheGuarantees) {
     }
 }
 
-// Small blockers inside the start node are missed: the one way the method errs towards light.
+// Small blockers inside the start node are missed by the paper's Algorithm 1: the one way it errs
+// towards light. The exact start region tests them.
 TEST_F(LineSpaceGLTest, BlockersInsideTheStartNodeAreMissed) {
-    AlgorithmRun o = run(pebbleShot());
+    AlgorithmRun o = run(pebbleShot(), {{"start_region", "node"}, {"last_level", "shaft"}});
     print("pebbles (start node)", o);
     EXPECT_GT(o.counters["under_occluded_start_node_share"], 0.0);
     EXPECT_EQ(o.counters["under_occluded_start_node_share"], o.counters["under_occluded_share"]);
+    AlgorithmRun exact = run(pebbleShot());
+    print("pebbles (exact start)", exact);
+    EXPECT_EQ(exact.counters["under_occluded_share"], 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Table, LineSpaceErrGLTest, ::testing::ValuesIn(kErrCases),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// Soft shadows against the same-sample reference: one row per scene, light size and (N, d), with
+// the bounds of that row. Rows run the schema's defaults (start_region = distance) unless they say.
+struct SoftCase {
+    const char* name;
+    Shot (*make)();
+    std::map<std::string, ParamValue> params;
+    double maxRmse;  ///< visibility RMSE over lit pixels
+    double maxOver;  ///< share of samples blocked by the line space, free in the scene
+    double maxUnder; ///< share of samples free in the line space, blocked in the scene
+};
+
+void PrintTo(const SoftCase& c, std::ostream* os) { printCase(*os, c.name, c.params); }
+
+// Measured at 64², 25 samples (llvmpipe; the images do not depend on the driver's timing), with
+// the defaults (exact start region, leaves deciding on the last level). Every row's under-occluded
+// bound is 0: the exact start region ignores no geometry and the rest is conservative. What remains
+// is over-occlusion beside occluders: a ray through a non-empty shaft is decided by the occupied
+// leaves it crosses, so shadows grow by up to one leaf (plus the build's margin). Bounds: the
+// measured value plus ~25 % (RMSE) and 1.5 % of samples (over; measured ≤ 1.14 %), well inside the
+// requirement's 0.08 and 3 %.
+const SoftCase kSoftCases[] = {
+    // Smooth convex objects, small light (0.5 × 0.5): narrow penumbrae, where a leaf of growth
+    // weighs most. Measured RMSE 0.044, over 0.80 %.
+    {"shapes_small_light_7_3", [] { return shapesShot(0.5f); }, {{"n", 7}, {"d", 3}}, 0.055, 0.015, 0.0},
+    // The same under a large light (2 × 2), wide penumbrae. Measured RMSE 0.027, over 0.71 %.
+    {"shapes_large_light_7_3", [] { return shapesShot(2.0f); }, {{"n", 7}, {"d", 3}}, 0.035, 0.015, 0.0},
+    // Coarser sets, larger leaves. Measured RMSE 0.035 (4, 4), 0.041 (6, 3); over 0.96 %, 1.12 %.
+    {"shapes_4_4", [] { return shapesShot(1.5f); }, {{"n", 4}, {"d", 4}}, 0.045, 0.015, 0.0},
+    {"shapes_6_3", [] { return shapesShot(1.5f); }, {{"n", 6}, {"d", 3}}, 0.05, 0.015, 0.0},
+    // A thin dense mesh and thin posts: the tube (0.06 across) is about a leaf wide, so its shadow
+    // can double in width. Measured RMSE 0.049, over 1.14 %.
+    {"thin_mesh_7_3", thinMeshShot, {{"n", 7}, {"d", 3}}, 0.06, 0.015, 0.0},
+    // The smoke scene (sphere, torus, fence) under its 1.5 × 1.5 light. Measured RMSE 0.031, over 0.84 %.
+    {"smoke_area_7_3", [] { return smokeAreaShot(25, 1.5f); }, {{"n", 7}, {"d", 3}}, 0.04, 0.015, 0.0},
+};
+
+class LineSpaceSoftGLTest : public LineSpaceGLTest, public ::testing::WithParamInterface<SoftCase> {};
+
+TEST_P(LineSpaceSoftGLTest, SoftShadowsMatchTheReference) {
+    const SoftCase& c = GetParam();
+    AlgorithmRun o = run(c.make(), c.params);
+    print(c.name, o);
+    EXPECT_LE(o.accuracy.rmse, c.maxRmse);
+    EXPECT_LE(o.counters["over_occluded_share"], c.maxOver);
+    EXPECT_LE(o.counters["under_occluded_share"], c.maxUnder);
+    EXPECT_EQ(o.counters["under_occluded_elsewhere"], 0.0) << "a blocker beyond the start region was missed";
+    EXPECT_EQ(o.overflow, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, LineSpaceSoftGLTest, ::testing::ValuesIn(kSoftCases),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// A sphere alone, the area light straight above it and the camera beside the light: every pixel
+// whose samples all lie above its horizon is lit in the scene, and must be lit here (the paper's
+// start node shadowed most of them: the next node's shaft holds the sphere's own surface).
+TEST_F(LineSpaceGLTest, SphereFacingTheLightIsLit) {
+    Shot s = smokeAreaShot(25, 0.5f);
+    s.scene = makeSphere(0.6f, 2000, Material{});
+    s.light.position = {0.0f, 3.0f, 0.0f}, s.light.target = {0, 0, 0};
+    s.camera = lookAt({0.0f, 1.6f, 0.9f}, {0, 0, 0}, 55.0f);
+    AlgorithmRun o = run(s, {{"n", 6}, {"d", 3}});
+    print("sphere facing the light", o);
+    size_t fullyLit = 0, dark = 0;
+    for (size_t i = 0; i < o.reference.size(); ++i) {
+        if (!o.lit[i] || o.reference[i] < 1.0f) continue;
+        ++fullyLit;
+        dark += o.visibility[i] < 1.0f;
+    }
+    ASSERT_GT(fullyLit, 1000u);
+    EXPECT_EQ(dark, 0u) << "of " << fullyLit << " pixels lit by every sample";
+    // With the paper's start node the same view is mostly dark.
+    AlgorithmRun paper = run(s, {{"n", 6}, {"d", 3}, {"start_region", "node"}, {"last_level", "shaft"}});
+    print("sphere facing the light (paper)", paper);
+    size_t paperDark = 0;
+    for (size_t i = 0; i < o.reference.size(); ++i) paperDark += o.lit[i] && o.reference[i] >= 1.0f && paper.visibility[i] < 1.0f;
+    std::printf("[line_space] pixels lit by every sample: %zu, dark: %zu (exact start), %zu (paper's start node)\n", fullyLit,
+                dark, paperDark);
+}
+
+// Ablation: the paper's Algorithm 1 as published (start_region = node, last_level = shaft) on the
+// same soft-shadow scene. Its start region ends where the ray leaves the last-level node it starts in, so the next
+// node's shaft holds the leaves of the receiver's own surface: lit surfaces shadow themselves.
+TEST_F(LineSpaceGLTest, PaperStartNodeShadowsLitSurfaces) {
+    const Shot s = shapesShot(1.5f);
+    AlgorithmRun paper = run(s, {{"n", 7}, {"d", 3}, {"start_region", "node"}, {"last_level", "shaft"}});
+    AlgorithmRun distance = run(s, {{"n", 7}, {"d", 3}});
+    print("paper start node 7_3", paper);
+    print("exact start 7_3", distance);
+    EXPECT_EQ(paper.counters["under_occluded_elsewhere"], 0.0);
+    EXPECT_GT(paper.counters["over_occluded_share"], 5.0 * distance.counters["over_occluded_share"]);
+    EXPECT_GT(paper.accuracy.rmse, 3.0 * distance.accuracy.rmse);
+}
 
 // Figure 7 of the paper: one shadow ray shows the approximation (a coarse silhouette); averaging an
 // area light's samples hides most of it.
@@ -171,7 +294,8 @@ TEST_F(LineSpaceGLTest, LargerBranchingFactorOverOccludesLess) {
 
 TEST_F(LineSpaceGLTest, MemoryIsThePools) {
     Shot s = smokePointShot();
-    AlgorithmRun o = run(s, {{"n", 4}, {"d", 3}});
+    // The paper's method: the three pools and nothing else (no geometry).
+    AlgorithmRun o = run(s, {{"n", 4}, {"d", 3}, {"start_region", "node"}, {"last_level", "shaft"}});
     const double nodes = o.counters["subdivided_nodes"];
     EXPECT_EQ(o.counters["nodes_level_0"], 1.0);
     EXPECT_EQ(o.counters["nodes_level_0"] + o.counters["nodes_level_1"] + o.counters["nodes_level_2"], nodes);
@@ -180,6 +304,14 @@ TEST_F(LineSpaceGLTest, MemoryIsThePools) {
     // Children groups (4³ entries) for the nodes above the last level only.
     EXPECT_EQ(o.counters["tree_pool_bytes"], 4 * 64 * (o.counters["nodes_level_0"] + o.counters["nodes_level_1"]));
     EXPECT_EQ(double(o.memory), o.counters["node_pool_bytes"] + o.counters["tree_pool_bytes"] + o.counters["line_space_pool_bytes"]);
+    EXPECT_EQ(o.counters["occupancy_pool_bytes"], 0.0);
+    EXPECT_EQ(o.counters["exact_start_bytes"], 0.0);
+    // The exact start region adds the occupancy pool (4³ bits = 2 words per node), the leaf lists
+    // and the scene's triangle positions (36 bytes per triangle).
+    AlgorithmRun x = run(s, {{"n", 4}, {"d", 3}, {"start_region", "exact"}});
+    EXPECT_EQ(x.counters["occupancy_pool_bytes"], 4 * 2 * nodes);
+    EXPECT_GT(x.counters["exact_start_bytes"], 36.0 * double(s.scene.triangleCount()));
+    EXPECT_EQ(double(x.memory), double(o.memory) + x.counters["occupancy_pool_bytes"] + x.counters["exact_start_bytes"]);
 }
 
 // The line-space pool is split over several SSBOs when it outgrows one: same image; beyond the

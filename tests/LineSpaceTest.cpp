@@ -158,7 +158,51 @@ TEST(LineSpaceTest, PoolsHaveThePaperLayout) {
             }
         }
         EXPECT_EQ(t.tree.size(), groups * size_t(n * n * n));
-        EXPECT_EQ(t.poolBytes(), t.nodes.size() * 32 + t.tree.size() * 4 + t.nodes.size() * words * 4);
+        // The occupancy bits say what the tree pool says, wherever there is a children group.
+        const size_t occWords = ls::occupancyWords(n);
+        ASSERT_EQ(t.occupancy.size(), t.nodes.size() * occWords);
+        for (size_t i = 0; i < t.nodes.size(); ++i) {
+            if (t.nodes[i].children == LS_NO_CHILDREN) continue;
+            for (int c = 0; c < n * n * n; ++c) {
+                const bool bit = (t.occupancy[i * occWords + size_t(c >> 5)] >> (c & 31)) & 1u;
+                EXPECT_EQ(bit, t.tree[t.nodes[i].children + size_t(c)] != LS_EMPTY) << "node " << i << " child " << c;
+            }
+        }
+        EXPECT_EQ(t.poolBytes(), t.nodes.size() * 32 + t.tree.size() * 4 + t.nodes.size() * (words + occWords) * 4);
+    }
+}
+
+// The exact start region's leaf lists: a leaf has triangles exactly where its occupancy bit is set
+// (the shader finds a leaf's list by counting the bits below it), each triangle touches its leaf.
+TEST(LineSpaceTest, LeafListsFollowTheOccupancy) {
+    Scene s = smallScene();
+    for (auto [n, d] : {std::pair{4, 3}, {3, 2}, {5, 1}}) {
+        ls::NTree t = ls::buildNTree(s, n, d);
+        ls::LeafLists lists = ls::buildLeafLists(s, t, 2);
+        const size_t occWords = ls::occupancyWords(n);
+        ASSERT_EQ(lists.wordRank.size(), t.nodes.size() * occWords);
+        size_t leaf = 0;
+        for (size_t i = 0; i < t.nodes.size(); ++i) {
+            if (int(t.nodes[i].level) != d - 1) continue;
+            const glm::dvec3 lo(t.nodes[i].lo[0], t.nodes[i].lo[1], t.nodes[i].lo[2]);
+            const glm::dvec3 cell = glm::dvec3(t.nodes[i].size[0], t.nodes[i].size[1], t.nodes[i].size[2]) / double(n);
+            for (int c = 0; c < n * n * n; ++c) {
+                if ((c & 31) == 0) EXPECT_EQ(lists.wordRank[i * occWords + size_t(c >> 5)], leaf) << "node " << i;
+                if (!((t.occupancy[i * occWords + size_t(c >> 5)] >> (c & 31)) & 1u)) continue;
+                ASSERT_LT(leaf + 1, lists.prefix.size());
+                EXPECT_LT(lists.prefix[leaf], lists.prefix[leaf + 1]) << "an occupied leaf without triangles";
+                const glm::dvec3 clo = lo + glm::dvec3(c % n, (c / n) % n, c / (n * n)) * cell;
+                const ls::DBox box{clo - double(t.margin) - 1e-6, clo + cell + double(t.margin) + 1e-6};
+                for (uint32_t k = lists.prefix[leaf]; k < lists.prefix[leaf + 1]; ++k) {
+                    const uint32_t tri = lists.tris[k];
+                    EXPECT_TRUE(ls::triangleOverlapsBox(glm::dvec3(s.positions[3 * tri]), glm::dvec3(s.positions[3 * tri + 1]),
+                                                        glm::dvec3(s.positions[3 * tri + 2]), box));
+                }
+                ++leaf;
+            }
+        }
+        EXPECT_EQ(leaf + 1, lists.prefix.size());
+        EXPECT_EQ(lists.prefix.back(), lists.tris.size());
     }
 }
 
@@ -167,6 +211,7 @@ TEST(LineSpaceTest, BuildIsIndependentOfTheThreadCount) {
     ls::NTree a = ls::buildNTree(s, 4, 3, 1), b = ls::buildNTree(s, 4, 3, 3);
     EXPECT_EQ(a.tree, b.tree);
     EXPECT_EQ(a.bits, b.bits);
+    EXPECT_EQ(a.occupancy, b.occupancy);
     ASSERT_EQ(a.nodes.size(), b.nodes.size());
     EXPECT_EQ(0, std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(ls::NodeGpu)));
 }
@@ -298,6 +343,7 @@ TEST_F(LineSpaceCacheTest, RoundTripAndKeys) {
     ASSERT_TRUE(back.has_value()) << why;
     EXPECT_EQ(back->tree, t.tree);
     EXPECT_EQ(back->bits, t.bits);
+    EXPECT_EQ(back->occupancy, t.occupancy);
     EXPECT_EQ(back->nodesPerLevel, t.nodesPerLevel);
     EXPECT_EQ(back->buildMs, t.buildMs);
     EXPECT_EQ(back->margin, t.margin);

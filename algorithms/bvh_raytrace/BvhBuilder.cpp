@@ -46,7 +46,16 @@ public:
         for (uint32_t t = 0; t < uint32_t(n); ++t) bvh_.triIndices[t] = t;
     }
 
-    Bvh run() {
+    Bvh run(const Scene& scene) {
+        Bvh out = build();
+        out.triangles.resize(3 * out.triIndices.size());
+        for (size_t i = 0; i < out.triIndices.size(); ++i)
+            for (size_t k = 0; k < 3; ++k) out.triangles[3 * i + k] = glm::vec4(scene.positions[3 * size_t(out.triIndices[i]) + k], 0.0f);
+        return out;
+    }
+
+private:
+    Bvh build() {
         const uint32_t n = uint32_t(bvh_.triIndices.size());
         bvh_.nodes.push_back(emptyNode());
         Box all = rangeBox(0, n);
@@ -86,7 +95,6 @@ public:
         return std::move(bvh_);
     }
 
-private:
     static NodeGpu emptyNode() {
         NodeGpu n{};
         for (int a = 0; a < 3; ++a) n.lo0[a] = n.lo1[a] = kInf, n.hi0[a] = n.hi1[a] = -kInf;
@@ -175,6 +183,6 @@ private:
 
 } // namespace
 
-Bvh buildBvh(const Scene& scene, const BuildOptions& options) { return Builder(scene, options).run(); }
+Bvh buildBvh(const Scene& scene, const BuildOptions& options) { return Builder(scene, options).run(scene); }
 
 } // namespace shadowlab::bvh

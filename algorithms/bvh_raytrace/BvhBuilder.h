@@ -20,6 +20,10 @@ struct BuildOptions {
 struct Bvh {
     std::vector<NodeGpu> nodes;       ///< node 0 is the root
     std::vector<uint32_t> triIndices; ///< leaf ranges index into this; values are scene triangle ids
+    /// The triangles in leaf order, 3 vertices (w = 0) each: triangle i of a leaf range is
+    /// triangles[3i .. 3i + 2] = the scene's triangle triIndices[i], so the shader reads a leaf's
+    /// vertices contiguously with no index indirection.
+    std::vector<glm::vec4> triangles;
     int depth = 0;                    ///< most inner nodes on a root-to-leaf path (the stack a ray may need)
     size_t leaves = 0;
     double sahCost = 0;               ///< SAH cost of the tree (relative to one triangle test per ray)

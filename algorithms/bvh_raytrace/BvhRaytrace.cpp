@@ -29,6 +29,7 @@ namespace {
 struct BvhParams {
     int stackSize;       ///< traversal stack, nodes
     int leafSize;        ///< most triangles per leaf
+    bool shortStack;     ///< top of the stack in registers
     int sahBins;         ///< split candidates per axis
     float traversalCost; ///< × triangle test
     float rayOffset;     ///< × scene radius
@@ -40,7 +41,13 @@ const ParamStruct<BvhParams>& bvhParams() {
         // A binned-SAH tree over n triangles is rarely deeper than ~2 log2(n) (≈ 45 for 2 M); 64 leaves
         // headroom, and an overflow is reported, never hidden.
         .apply(stackSizeRow(&P::stackSize, 64))
-        .integer("leaf_size", &P::leafSize, 4, 1, 16, "triangles", "most triangles per BVH leaf", ParamChange::Rebuild)
+        .integer("leaf_size", &P::leafSize, 4, 1, BVH_MAX_LEAF, "triangles", "most triangles per BVH leaf",
+                 ParamChange::Rebuild)
+        // Off: on llvmpipe the shifts cost more than the scratch-memory stack they avoid (~10-20 %
+        // slower on the engine scenes, docs/algorithms/line_space.md); a GPU may differ.
+        .boolean("short_stack", &P::shortStack, false,
+                 "keep the top 16 stack entries in registers (shifted on push/pop), spilling deeper ones to memory",
+                 ParamChange::Recompile)
         .integer("sah_bins", &P::sahBins, 32, 4, 256, "bins", "SAH candidate split planes per axis in the CPU build",
                  ParamChange::Rebuild)
         // Aila & Laine's GPU ratio is near 1: a node fetch costs about what a triangle fetch does.
@@ -60,7 +67,7 @@ public:
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
-        nodes_ = GlBuffer(), indices_ = GlBuffer(); // free the old tree before building the new one
+        nodes_ = GlBuffer(), triangles_ = GlBuffer(); // free the old tree before building the new one
         auto t0 = Clock::now();
         bvh::BuildOptions opt;
         opt.maxLeafSize = p_.leafSize;
@@ -70,10 +77,12 @@ public:
         buildMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         const size_t limit = maxShaderStorageBlockBytes();
         bvh::checkStorageBlock("the BVH nodes", tree.nodes.size() * sizeof(bvh::NodeGpu), limit);
-        bvh::checkStorageBlock("the triangle indices", tree.triIndices.size() * sizeof(uint32_t), limit);
-        bvh::checkStorageBlock("the scene positions", scene.positions().size(), limit);
+        bvh::checkStorageBlock("the leaf-ordered triangles", tree.triangles.size() * sizeof(glm::vec4), limit);
+        // The shader packs a leaf's first triangle in 27 bits of a stack entry (layout.glsl).
+        if (tree.triIndices.size() >= (size_t(1) << 27))
+            throw RuntimeError("bvh_raytrace: more than 2^27 triangles cannot be addressed by the traversal stack");
         nodes_ = GlBuffer::fromVector(tree.nodes, 0);
-        indices_ = GlBuffer::fromVector(tree.triIndices, 0);
+        triangles_ = GlBuffer::fromVector(tree.triangles, 0);
         counters_.allocate();
         nodeCount_ = tree.nodes.size();
         depth_ = tree.depth;
@@ -100,9 +109,8 @@ public:
         const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
         trace_.set("uRayOffset", p_.rayOffset * radius);
         trace_.set("uSampleCount", sampleCount);
-        scene_->bindStorage();
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_NODE_BINDING);
-        indices_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_INDEX_BINDING);
+        triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_TRI_BINDING);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
         runPixelPass(f, trace_, {&nodesVisited_, &overflow_});
@@ -122,41 +130,43 @@ public:
                 {"traced_pixels", double(c[BVH_C_PIXELS])},
                 {"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
                 {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
+                {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
                 {"bvh_nodes", double(nodeCount_)},
                 {"bvh_leaves", double(leaves_)},
                 {"bvh_depth", double(depth_)},
                 {"bvh_sah_cost", sahCost_},
                 {"bvh_build_ms", buildMs_},
                 {"node_bytes", double(nodes_.size())},
-                {"index_bytes", double(indices_.size())},
-                {"geometry_bytes", double(scene_ ? scene_->positions().size() : 0)}};
+                {"triangle_bytes", double(triangles_.size())}};
     }
 
     std::vector<DebugView> debugViews() const override {
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
     }
 
-    /// Nodes + triangle indices + the triangle positions the rays read. The positions are the
-    /// framework's shared scene buffer, counted here because a ray tracer needs them and line_space
-    /// does not: the paper's Table 1 compares sizes on that basis ("the BVH needs the triangle
+    /// Nodes + the leaf-ordered triangles the rays read (a ray tracer needs them and line_space does
+    /// not: the paper's Table 1 compares sizes on that basis, "the BVH needs the triangle
     /// information in addition"). Per-pixel debug images and the sample list are not counted.
-    size_t memoryBytes() const override {
-        return nodes_.size() + indices_.size() + (scene_ ? scene_->positions().size() : 0);
-    }
+    size_t memoryBytes() const override { return nodes_.size() + triangles_.size(); }
 
-    /// Pixels with a ray whose stack overflowed (written shadowed): 0 means the image is exact.
-    uint64_t overflowCount() const override { return counters_.read()[BVH_C_OVERFLOW_PIXELS]; }
+    /// Pixels with a ray whose stack overflowed, or whose sample loop the driver cut short (both
+    /// written shadowed): 0 means the image is exact.
+    uint64_t overflowCount() const override {
+        const auto& c = counters_.read();
+        return uint64_t(c[BVH_C_OVERFLOW_PIXELS]) + c[BVH_C_TRUNCATED_PIXELS];
+    }
 
 private:
     void compile() {
-        const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(p_.stackSize)}};
+        const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(p_.stackSize)},
+                                       {"BVH_SHORT_STACK", p_.shortStack ? "1" : "0"}};
         trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp", defines);
     }
 
     BvhParams p_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram trace_;
-    GlBuffer nodes_, indices_, samples_;
+    GlBuffer nodes_, triangles_, samples_;
     GpuCounters<BVH_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
     size_t nodeCount_ = 0, leaves_ = 0;

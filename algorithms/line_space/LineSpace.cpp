@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -23,6 +25,8 @@ struct LineSpaceParams {
     bool cache, classify;
     int maxBlockMib;   ///< 0 = the context's storage block limit
     float rayOffset;   ///< × scene radius
+    std::string startRegion, lastLevel;  ///< "exact" | "distance" | "node"; "leaves" | "shaft"
+    float startCells, startMaxCells;     ///< leaf widths
 };
 
 const ParamStruct<LineSpaceParams>& lineSpaceParams() {
@@ -45,7 +49,32 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
         .integer("max_block_mib", &P::maxBlockMib, 0, 0, 1 << 16, "MiB",
                  "cap on one SSBO (0 = GL_MAX_SHADER_STORAGE_BLOCK_SIZE); the line-space pool may span 4 of them",
                  ParamChange::Rebuild)
-        .apply(rayOffsetRow(&P::rayOffset));
+        .apply(rayOffsetRow(&P::rayOffset))
+        // "node" is Algorithm 1 as published: its start region (the last-level node holding the
+        // origin) is too short, the next node's shaft holds the receiver's own surface and lit
+        // surfaces shadow themselves (docs/algorithms/line_space.md, "Where the error comes from").
+        .choice("start_region", &P::startRegion, "exact", {"exact", "distance", "node"},
+                "where the line space is not used next to the receiver: the last-level nodes a ray enters before "
+                "rising start_cells leaf widths above the receiver's tangent plane, tested against their triangles "
+                "(exact: a hybrid that keeps the scene's triangles on the GPU) or with geometry before that height "
+                "ignored and the rest of those nodes by leaf occupancy (distance); node = the paper's Algorithm 1, "
+                "the last-level node holding the origin skipped",
+                ParamChange::Rebuild)
+        // "shaft" is Algorithm 1's "deep enough": the shaft of a last-level node stands for its
+        // leaves, so shadows grow by up to a shaft's width around every occluder.
+        .choice("last_level", &P::lastLevel, "leaves", {"leaves", "shaft"},
+                "a non-empty shaft of a last-level node: leaves = the leaves the ray crosses there decide "
+                "(occupancy mask); shaft = the ray is blocked (the paper's)",
+                ParamChange::Rebuild)
+        // 6 and 64 by measurement: fewer leaf widths leave self-shadowing, more cost nothing but
+        // leave the error where it is (docs/algorithms/line_space.md, Parameters).
+        .real("start_cells", &P::startCells, 6.0, 0.0, 64.0, "leaf widths",
+              "start_region exact/distance: height above the receiver's tangent plane (in leaf widths along its "
+              "normal) at which a ray's start region ends",
+              ParamChange::Update)
+        .real("start_max_cells", &P::startMaxCells, 64.0, 0.0, 1024.0, "leaf widths",
+              "start_region exact/distance: most leaf widths along the ray a start region spans (grazing rays)",
+              ParamChange::Update);
     return s;
 }
 
@@ -58,14 +87,34 @@ public:
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
         tracer_.reset();
-        nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(); // free the old pools first
+        nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(), occBuf_ = GlBuffer(); // free the old pools first
         for (GlBuffer& b : bitsBuf_) b = GlBuffer();
         const int n = p_.n, d = p_.d;
         const size_t cap = size_t(p_.maxBlockMib) << 20;
         const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
         tree_ = obtainTree(scene.cpu(), n, d, limit);
+        // The occupancy pool is read (and counted) only by the distance and exact start regions; the
+        // leaf lists and the scene's triangles only by the exact one.
+        const ls::StartMode mode = startMode();
+        const bool occupancy = mode != ls::StartMode::Node || lastLeaves(), exact = mode == ls::StartMode::Exact;
+        leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer();
+        ls::LeafLists lists;
+        if (exact) {
+            lists = ls::buildLeafLists(scene.cpu(), tree_);
+            // The shader numbers a leaf by the occupancy bits below it: one occupied leaf without a list
+            // (or the reverse) would shift every later list, so the two must agree exactly.
+            size_t occupied = 0;
+            const size_t words = ls::occupancyWords(n);
+            for (size_t i = 0; i < tree_.nodes.size(); ++i)
+                if (int(tree_.nodes[i].level) == d - 1)
+                    for (size_t w = 0; w < words; ++w) occupied += size_t(std::popcount(tree_.occupancy[i * words + w]));
+            if (occupied + 1 != lists.prefix.size())
+                throw RuntimeError("line_space: the leaf lists (" + std::to_string(lists.prefix.size() - 1) +
+                                   " leaves) disagree with the occupancy pool (" + std::to_string(occupied) + " leaves)");
+        }
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
-                      tree_.bits.size() * sizeof(uint32_t)};
+                      tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0,
+                      exact ? lists.bytes() + scene.positions().size() : 0};
         // Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
         // up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a
         // GPU with a larger limit is caught here.
@@ -84,6 +133,17 @@ public:
                                std::to_string(LS_BIT_CHUNKS));
         nodesBuf_ = GlBuffer::fromVector(tree_.nodes, 0);
         treeBuf_ = GlBuffer::fromVector(tree_.tree, 0);
+        if (occupancy) occBuf_ = GlBuffer::fromVector(tree_.occupancy, 0);
+        if (exact) {
+            for (auto [what, bytes] : {std::pair{"leaf triangle lists", lists.tris.size() * sizeof(uint32_t)},
+                                       std::pair{"scene positions", scene.positions().size()}})
+                if (bytes > limit)
+                    throw RuntimeError(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
+                                       " MiB; one SSBO may hold " + mib(limit) + " MiB here");
+            leafBase_ = GlBuffer::fromVector(lists.wordRank, 0);
+            leafPrefix_ = GlBuffer::fromVector(lists.prefix, 0);
+            leafTris_ = GlBuffer::fromVector(lists.tris, 0);
+        }
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
             // Unused chunks get a 4-byte buffer so every binding the shader declares is valid.
             const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
@@ -101,6 +161,7 @@ public:
         // The GPU holds the pools now; the CPU keeps only the node pool (start-node boxes for classify).
         tree_.tree = {};
         tree_.bits = {};
+        tree_.occupancy = {};
         classes_.reset();
     }
 
@@ -112,6 +173,7 @@ public:
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         p_ = lineSpaceParams().read(p);
         // setScene() follows a Rebuild (ShadowAlgorithm.h) and compiles for the new tree's block count.
+        // (start_region, a Rebuild, changes a define too.)
         if (change == ParamChange::Rebuild) bitChunks_ = 0;
     }
 
@@ -131,8 +193,19 @@ public:
         p.set("uSampleCount", sampleCount);
         p.set("uNodeCount", unsigned(tree_.nodes.size()));
         p.set("uNodesPerChunk", unsigned(nodesPerChunk_));
+        const ls::StartRegion region = startRegion();
+        p.set("uLeafCell", region.leafCell);
+        p.set("uStartCells", region.cells);
+        p.set("uStartMaxCells", region.maxCells);
         nodesBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_NODE_BINDING);
         treeBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_TREE_BINDING);
+        if (region.mode != ls::StartMode::Node || lastLeaves()) occBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_OCC_BINDING);
+        if (region.mode == ls::StartMode::Exact) {
+            scene_->bindStorage();
+            leafBase_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_BASE_BINDING);
+            leafPrefix_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_PREFIX_BINDING);
+            leafTris_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_TRIS_BINDING);
+        }
         const GLuint bitBindings[LS_BIT_CHUNKS] = {LS_BITS_BINDING, LS_BITS_BINDING_1, LS_BITS_BINDING_2, LS_BITS_BINDING_3};
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) bitsBuf_[c].bindBase(GL_SHADER_STORAGE_BUFFER, bitBindings[c]);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
@@ -157,15 +230,20 @@ public:
                                     {"nodes_visited_max", double(c[LS_C_VISITED_MAX])},
                                     {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
                                     {"cells_stepped_mean", perRay(wide(LS_C_CELLS_LO))},
+                                    {"leaf_cells_mean", perRay(wide(LS_C_LEAVES_LO))},
+                                    {"triangles_tested_mean", perRay(wide(LS_C_TRIS_LO))},
                                     {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
                                     {"rays", rays},
                                     {"traced_pixels", double(c[LS_C_PIXELS])},
+                                    {"truncated_pixels", double(c[LS_C_TRUNCATED])},
                                     {"subdivided_nodes", double(tree_.nodes.size())},
                                     {"build_ms", tree_.buildMs},
                                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
                                     {"node_pool_bytes", double(poolBytes_[0])},
                                     {"tree_pool_bytes", double(poolBytes_[1])},
-                                    {"line_space_pool_bytes", double(poolBytes_[2])}};
+                                    {"line_space_pool_bytes", double(poolBytes_[2])},
+                                    {"occupancy_pool_bytes", double(poolBytes_[3])},
+                                    {"exact_start_bytes", double(poolBytes_[4])}};
         for (size_t l = 0; l < tree_.nodesPerLevel.size(); ++l)
             out.push_back({"nodes_level_" + std::to_string(l), double(tree_.nodesPerLevel[l])});
         if (p_.classify && pendingG_.width > 0) {
@@ -185,20 +263,53 @@ public:
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}};
     }
 
-    /// The three pools (the paper's Table 1 size): no geometry is held at all. Not counted: the
-    /// sample list, the per-pixel heat map and the classify buffer (debug only).
-    size_t memoryBytes() const override { return poolBytes_[0] + poolBytes_[1] + poolBytes_[2]; }
+    /// The three pools (the paper's Table 1 size), plus the occupancy pool when the start region
+    /// reads it, plus the leaf lists and the scene's triangle positions for the exact start region
+    /// (the paper's method, start_region node, holds no geometry at all). Not counted: the sample
+    /// list, the per-pixel heat map and the classify buffer (debug only).
+    size_t memoryBytes() const override {
+        size_t sum = 0;
+        for (size_t b : poolBytes_) sum += b;
+        return sum;
+    }
 
-    /// Traversal stack overflows: one frame per level always suffices, so this is 0 unless the
-    /// pools are corrupt (an overflowing ray is counted occluded, never lit).
-    uint64_t overflowCount() const override { return counters_.read()[LS_C_OVERFLOW]; }
+    /// Traversal stack overflows (one frame per level always suffices, so 0 unless the pools are
+    /// corrupt; such a ray is counted occluded) plus pixels whose sample loop the driver cut short
+    /// (written shadowed): never lit by mistake.
+    uint64_t overflowCount() const override {
+        const auto& c = counters_.read();
+        return uint64_t(c[LS_C_OVERFLOW]) + c[LS_C_TRUNCATED];
+    }
 
 private:
     ShaderDefines defines(bool classify) const {
         return {{"LS_N", std::to_string(p_.n)},
                 {"LS_DEPTH", std::to_string(p_.d)},
                 {"LS_CLASSIFY", classify ? "1" : "0"},
-                {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)}};
+                {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)},
+                {"LS_START_MODE", std::to_string(int(startMode()))},
+                {"LS_LAST_LEAVES", lastLeaves() ? "1" : "0"}};
+    }
+
+    bool lastLeaves() const { return p_.lastLevel == "leaves"; }
+
+    ls::StartMode startMode() const {
+        const std::string& m = p_.startRegion;
+        return m == "exact" ? ls::StartMode::Exact : m == "distance" ? ls::StartMode::Distance : ls::StartMode::Node;
+    }
+
+    /// The start region the shader uses (valid after setScene()); leaf cells from the root's size.
+    ls::StartRegion startRegion() const {
+        ls::StartRegion r;
+        r.mode = startMode();
+        r.cells = p_.startCells;
+        r.maxCells = p_.startMaxCells;
+        if (!tree_.nodes.empty()) {
+            const ls::NodeGpu& root = tree_.nodes[0];
+            const float leaves = std::pow(float(tree_.n), float(tree_.d));
+            r.leafCell = glm::vec3(root.size[0], root.size[1], root.size[2]) / leaves;
+        }
+        return r;
     }
 
     void compile() {
@@ -227,7 +338,7 @@ private:
             if (!tracer_) tracer_ = std::make_unique<EmbreeTracer>(scene_->cpu());
             std::vector<uint32_t> perPixel = classifyBuf_.read<uint32_t>(
                 size_t(pendingG_.width) * size_t(pendingG_.height) * ls::classifyStride(pendingLight_.samplePoints().size()));
-            classes_ = ls::classifySamples(*tracer_, pendingG_, pendingLight_, rayOffset(), tree_.nodes, perPixel);
+            classes_ = ls::classifySamples(*tracer_, pendingG_, pendingLight_, rayOffset(), tree_.nodes, perPixel, startRegion());
         }
         return *classes_;
     }
@@ -238,8 +349,10 @@ private:
     ShaderProgram trace_, classifyProgram_;
     ls::NTree tree_; ///< node pool and statistics (the tree and line-space pools live on the GPU only)
     bool cacheHit_ = false;
-    std::array<size_t, 3> poolBytes_{}; ///< node, tree and line-space pools (a GlBuffer rounds empty ones up to 4 bytes)
-    GlBuffer nodesBuf_, treeBuf_, samples_, classifyBuf_;
+    /// Node, tree, line-space pools; (if read) occupancy pool; (exact) leaf lists + scene positions.
+    /// A GlBuffer rounds empty ones up to 4 bytes; these are the bytes the shader uses.
+    std::array<size_t, 5> poolBytes_{};
+    GlBuffer nodesBuf_, treeBuf_, occBuf_, leafBase_, leafPrefix_, leafTris_, samples_, classifyBuf_;
     GpuCounters<LS_COUNTER_WORDS> counters_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
     size_t nodesPerChunk_ = 1;

@@ -19,7 +19,7 @@ struct Header {
     char magic[8];
     uint32_t version, n, d, reserved;
     uint64_t sceneHash;
-    uint64_t nodeCount, treeWords, bitWords;
+    uint64_t nodeCount, treeWords, bitWords, occupancyWords;
     uint64_t nodesPerLevel[kMaxDepth];
     float margin, pad;
     double buildMs;
@@ -32,7 +32,8 @@ using diskcache::checksum;
 uint64_t payloadChecksum(const NTree& t) {
     uint64_t h = checksum(t.nodes.data(), t.nodes.size() * sizeof(NodeGpu));
     h = checksum(t.tree.data(), t.tree.size() * sizeof(uint32_t), h);
-    return checksum(t.bits.data(), t.bits.size() * sizeof(uint32_t), h);
+    h = checksum(t.bits.data(), t.bits.size() * sizeof(uint32_t), h);
+    return checksum(t.occupancy.data(), t.occupancy.size() * sizeof(uint32_t), h);
 }
 
 } // namespace
@@ -51,7 +52,7 @@ bool saveCache(const std::string& path, uint64_t sceneHash, const NTree& t, std:
     h.version = kCacheVersion;
     h.n = uint32_t(t.n), h.d = uint32_t(t.d);
     h.sceneHash = sceneHash;
-    h.nodeCount = t.nodes.size(), h.treeWords = t.tree.size(), h.bitWords = t.bits.size();
+    h.nodeCount = t.nodes.size(), h.treeWords = t.tree.size(), h.bitWords = t.bits.size(), h.occupancyWords = t.occupancy.size();
     for (size_t l = 0; l < t.nodesPerLevel.size() && l < size_t(kMaxDepth); ++l) h.nodesPerLevel[l] = t.nodesPerLevel[l];
     h.margin = t.margin;
     h.buildMs = t.buildMs;
@@ -64,7 +65,8 @@ bool saveCache(const std::string& path, uint64_t sceneHash, const NTree& t, std:
                                       {{&h, sizeof h},
                                        {t.nodes.data(), t.nodes.size() * sizeof(NodeGpu)},
                                        {t.tree.data(), t.tree.size() * sizeof(uint32_t)},
-                                       {t.bits.data(), t.bits.size() * sizeof(uint32_t)}},
+                                       {t.bits.data(), t.bits.size() * sizeof(uint32_t)},
+                                       {t.occupancy.data(), t.occupancy.size() * sizeof(uint32_t)}},
                                       why);
 }
 
@@ -82,9 +84,10 @@ std::optional<NTree> loadCache(const std::string& path, uint64_t sceneHash, int 
     if (h.version != kCacheVersion) return bad("cache version " + std::to_string(h.version));
     if (h.sceneHash != sceneHash || h.n != uint32_t(n) || h.d != uint32_t(d))
         return bad("the file is for another scene or (N, d)");
-    if (h.bitWords != h.nodeCount * wordsPerNode(n) || h.treeWords % size_t(n * n * n) != 0)
+    if (h.bitWords != h.nodeCount * wordsPerNode(n) || h.occupancyWords != h.nodeCount * occupancyWords(n) ||
+        h.treeWords % size_t(n * n * n) != 0)
         return bad("inconsistent pool sizes");
-    const uint64_t expected = sizeof h + h.nodeCount * sizeof(NodeGpu) + (h.treeWords + h.bitWords) * sizeof(uint32_t);
+    const uint64_t expected = sizeof h + h.nodeCount * sizeof(NodeGpu) + (h.treeWords + h.bitWords + h.occupancyWords) * sizeof(uint32_t);
     std::error_code ec;
     if (fs::file_size(path, ec) != expected) return bad("file size differs from its header (truncated?)");
 
@@ -96,9 +99,11 @@ std::optional<NTree> loadCache(const std::string& path, uint64_t sceneHash, int 
     t.nodes.resize(h.nodeCount);
     t.tree.resize(h.treeWords);
     t.bits.resize(h.bitWords);
+    t.occupancy.resize(h.occupancyWords);
     in.read(reinterpret_cast<char*>(t.nodes.data()), std::streamsize(t.nodes.size() * sizeof(NodeGpu)));
     in.read(reinterpret_cast<char*>(t.tree.data()), std::streamsize(t.tree.size() * sizeof(uint32_t)));
     in.read(reinterpret_cast<char*>(t.bits.data()), std::streamsize(t.bits.size() * sizeof(uint32_t)));
+    in.read(reinterpret_cast<char*>(t.occupancy.data()), std::streamsize(t.occupancy.size() * sizeof(uint32_t)));
     if (!in) return bad("truncated pools");
     if (payloadChecksum(t) != h.payloadChecksum) return bad("pool checksum mismatch (corrupt file)");
     // Child references must stay inside the pools: a shader must never read out of bounds.

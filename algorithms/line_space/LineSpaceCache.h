@@ -11,7 +11,7 @@
 namespace shadowlab::ls {
 
 /// Bumped whenever the build's output changes (layout, margins, tests): old files then miss.
-constexpr uint32_t kCacheVersion = 1;
+constexpr uint32_t kCacheVersion = 2; ///< 2: the occupancy pool
 
 /// $XDG_CACHE_HOME/shadowlab/line_space, else $HOME/.cache/shadowlab/line_space, else "" (no cache).
 std::string cacheDirectory();

@@ -39,6 +39,7 @@ constexpr int kMaxDepth = 5; ///< d: N^d leaf cells per axis
 
 constexpr size_t wordsPerNode(int n) { return size_t(LS_WORDS_PER_NODE(n)); }
 static_assert(wordsPerNode(4) == 120 && wordsPerNode(8) == 1920, "15 N^4 bits, packed in 32-bit words");
+constexpr size_t occupancyWords(int n) { return size_t(LS_OCC_WORDS_PER_NODE(n)); }
 
 /// Bit of the shaft between sub-face `subA` of face `fa` and `subB` of face `fb` (fa != fb, any order).
 inline uint32_t shaftBit(int n, int fa, int subA, int fb, int subB) {
@@ -53,12 +54,16 @@ struct NTree {
     std::vector<NodeGpu> nodes;   ///< node pool, breadth first (node 0 is the root, if any geometry)
     std::vector<uint32_t> tree;   ///< tree pool: N³ entries per children group: node index or LS_EMPTY
     std::vector<uint32_t> bits;   ///< line-space pool: wordsPerNode(n) words per node
+    /// Occupancy pool: occupancyWords(n) words per node, bit (z × N + y) × N + x set when a triangle
+    /// touches that child (the widened box, as for the tree pool). The walk of the start region's
+    /// last node reads the leaves' bits; the tree pool says the same above the last level.
+    std::vector<uint32_t> occupancy;
     std::vector<uint64_t> nodesPerLevel; ///< subdivided nodes per level 0 .. d-1
     double buildMs = 0;           ///< CPU time of the build (kept when loaded from the disk cache)
 
     bool bit(size_t node, uint32_t b) const { return (bits[node * wordsPerNode(n) + (b >> 5)] >> (b & 31)) & 1u; }
     size_t poolBytes() const {
-        return nodes.size() * sizeof(NodeGpu) + tree.size() * sizeof(uint32_t) + bits.size() * sizeof(uint32_t);
+        return nodes.size() * sizeof(NodeGpu) + (tree.size() + bits.size() + occupancy.size()) * sizeof(uint32_t);
     }
 };
 
@@ -69,6 +74,22 @@ struct NTree {
 /// known before its line spaces are computed, so an impossible parameter set fails in seconds
 /// instead of after the whole build.
 NTree buildNTree(const Scene& scene, int n, int d, int threads = 0, size_t maxBlockBytes = SIZE_MAX);
+
+/// Triangles of the leaves of the last subdivided level, for start_region = exact (the start region
+/// tested against the triangles themselves). Occupied leaves are numbered in node order, then child
+/// order; leaf c of node i (its occupancy bit set) is number wordRank[i × occupancyWords + c / 32]
+/// + (occupied leaves of word c / 32 below bit c % 32), so the shader finds it with one load and one
+/// bitCount; its triangles are tris[prefix[g] .. prefix[g + 1]) (scene triangle indices).
+struct LeafLists {
+    std::vector<uint32_t> wordRank; ///< per node and occupancy word (0 above the last level)
+    std::vector<uint32_t> prefix;   ///< per occupied leaf, plus one
+    std::vector<uint32_t> tris;
+    size_t bytes() const { return (wordRank.size() + prefix.size() + tris.size()) * sizeof(uint32_t); }
+};
+
+/// The leaf lists of `tree` (built from `scene`): the build's descent replayed with the same
+/// triangle–box tests on the same boxes, so a leaf has triangles exactly where its occupancy bit is set.
+LeafLists buildLeafLists(const Scene& scene, const NTree& tree, int threads = 0);
 
 /// Nodes per line-space pool chunk for SSBOs of at most `maxBlockBytes`.
 inline size_t nodesPerChunk(int n, size_t maxBlockBytes) {

@@ -140,6 +140,7 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
         const size_t bitLimit = maxBlockBytes == SIZE_MAX ? SIZE_MAX : perChunk * LS_BIT_CHUNKS * words * sizeof(uint32_t);
         check("line-space", t.nodes.size() * words * sizeof(uint32_t), bitLimit);
         check("node", t.nodes.size() * sizeof(NodeGpu), maxBlockBytes);
+        check("occupancy", t.nodes.size() * occupancyWords(n) * sizeof(uint32_t), maxBlockBytes);
         check("tree", (t.tree.size() + (l + 1 < d ? level.size() * size_t(n3) : 0)) * sizeof(uint32_t), maxBlockBytes);
         const bool last = l == d - 1;
         t.nodesPerLevel[size_t(l)] = level.size();
@@ -151,10 +152,14 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
             fillLineSpace(n, level[i].lo, level[i].size, results[i].occupied, t.margin, results[i].words.data());
         });
         t.bits.resize(t.nodes.size() * words);
+        t.occupancy.resize(t.nodes.size() * occupancyWords(n));
         std::vector<Pending> next;
         for (size_t i = 0; i < level.size(); ++i) {
             NodeResult& r = results[i];
             std::copy(r.words.begin(), r.words.end(), t.bits.begin() + std::ptrdiff_t((base + i) * words));
+            uint32_t* occ = t.occupancy.data() + (base + i) * occupancyWords(n);
+            for (int c = 0; c < n3; ++c)
+                if (r.occupied[size_t(c)]) occ[c >> 5] |= 1u << (c & 31);
             if (last) continue; // children are leaves: nothing stored below
             t.nodes[base + i].children = uint32_t(t.tree.size());
             const glm::vec3 cell = level[i].size / float(n);
@@ -175,6 +180,57 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
     }
     t.buildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return t;
+}
+
+LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
+    LeafLists out;
+    out.wordRank.assign(t.nodes.size() * occupancyWords(t.n), 0);
+    out.prefix.push_back(0);
+    if (t.nodes.empty()) return out;
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    const int n = t.n, n3 = n * n * n;
+    Builder builder(scene, n, t.margin);
+    auto box = [&](uint32_t i) {
+        const NodeGpu& node = t.nodes[i];
+        return Pending{{node.lo[0], node.lo[1], node.lo[2]}, {node.size[0], node.size[1], node.size[2]}, {}};
+    };
+    std::vector<uint32_t> index{0}; // the nodes of the level being replayed
+    std::vector<Pending> level{box(0)};
+    level[0].tris.resize(scene.triangleCount());
+    for (uint32_t i = 0; i < uint32_t(level[0].tris.size()); ++i) level[0].tris[i] = i;
+    for (int l = 0; l < t.d && !level.empty(); ++l) {
+        std::vector<NodeResult> results(level.size());
+        parallelFor(level.size(), threads, [&](size_t i) {
+            builder.occupancy(level[i], true, results[i]);
+            level[i].tris = {};
+        });
+        std::vector<uint32_t> nextIndex;
+        std::vector<Pending> next;
+        for (size_t i = 0; i < level.size(); ++i) {
+            const NodeGpu& node = t.nodes[index[i]];
+            if (int(node.level) == t.d - 1) { // leaves: append the occupied ones, in child order
+                for (int c = 0; c < n3; ++c) {
+                    if ((c & 31) == 0) out.wordRank[index[i] * occupancyWords(n) + size_t(c >> 5)] = uint32_t(out.prefix.size() - 1);
+                    const auto& tris = results[i].childTris[size_t(c)];
+                    if (tris.empty()) continue;
+                    out.tris.insert(out.tris.end(), tris.begin(), tris.end());
+                    out.prefix.push_back(uint32_t(out.tris.size()));
+                }
+                continue;
+            }
+            for (int c = 0; c < n3; ++c) {
+                const uint32_t child = t.tree[node.children + size_t(c)];
+                if (child == LS_EMPTY) continue;
+                nextIndex.push_back(child);
+                next.push_back(box(child));
+                next.back().tris = std::move(results[i].childTris[size_t(c)]);
+            }
+        }
+        // Last-level nodes come in node order (breadth first), so the numbering is node order too.
+        index = std::move(nextIndex);
+        level = std::move(next);
+    }
+    return out;
 }
 
 } // namespace shadowlab::ls

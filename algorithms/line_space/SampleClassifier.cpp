@@ -27,7 +27,8 @@ void add(SampleClasses& a, const SampleClasses& b) {
 } // namespace
 
 SampleClasses classifySamples(const EmbreeTracer& tracer, const CpuGBuffer& g, const Light& light, float rayOffset,
-                              const std::vector<NodeGpu>& nodes, const std::vector<uint32_t>& perPixel, int threads) {
+                              const std::vector<NodeGpu>& nodes, const std::vector<uint32_t>& perPixel,
+                              const StartRegion& region, int threads) {
     const bool directional = light.type == LightType::Directional;
     const std::vector<glm::vec3> samples = light.samplePoints();
     const size_t count = directional ? 1 : samples.size();
@@ -65,7 +66,14 @@ SampleClasses classifySamples(const EmbreeTracer& tracer, const CpuGBuffer& g, c
                     if (!ls && exact) {
                         ++c.under;
                         bool elsewhere = true;
-                        if (start != LS_EMPTY && start < nodes.size()) {
+                        if (region.mode == StartMode::Exact) {
+                            elsewhere = true; // nothing is ignored: every miss is one
+                        } else if (region.mode == StartMode::Distance) {
+                            // Traced again from just past the region's end: the float end the shader
+                            // computed may differ in its last bit.
+                            const float t = region.end(glm::normalize(n), dir) * (1.0f + 1e-5f);
+                            elsewhere = t < tfar && tracer.occluded(o + dir * t, dir, tfar - t);
+                        } else if (start != LS_EMPTY && start < nodes.size()) {
                             const float t = exitParameter(o, dir, nodes[start]);
                             elsewhere = t < tfar && tracer.occluded(o + dir * t, dir, tfar - t);
                         }

@@ -2,18 +2,22 @@
 // (algorithms/bvh_raytrace/BvhGpuLayout.h includes this very file). #defines and comments only,
 // so it is valid in both languages and the numbers exist once.
 
-// SSBO binding points (0..2 are the scene buffers of shaders/common/scene.glsl: the triangles are
-// read from there, so the BVH adds only nodes and a triangle permutation).
+// SSBO binding points (3.. after the scene buffers 0..2 of shaders/common/scene.glsl, which the BVH
+// does not read: it holds its own copy of the triangles, in leaf order).
 #define BVH_NODE_BINDING 3
-#define BVH_INDEX_BINDING 4
+#define BVH_TRI_BINDING 4
 #define BVH_SAMPLE_BINDING 5
 #define BVH_COUNTER_BINDING 6
 
 // A node stores the bounds of both children (Aila & Laine 2009), so one 64-byte fetch decides
 // which children a ray enters. countK > 0: child K is a leaf of countK triangles starting at
-// index childK of the index buffer; countK == 0: child K is inner node childK. An absent child
+// triangle childK of the leaf-ordered triangle buffer; countK == 0: child K is inner node childK. An absent child
 // (a tree of fewer than two leaves) has an inverted box that no ray enters.
 #define BVH_NODE_BYTES 64
+// Leaf triangles: 3 vec4 vertices (w unused) in leaf order.
+#define BVH_TRI_BYTES 48
+// Leaves hold at most this many triangles (the shader packs count - 1 in 4 bits of a stack entry).
+#define BVH_MAX_LEAF 16
 
 // Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words (the shader
 // carries into HI when LO wraps).
@@ -28,7 +32,8 @@
 #define BVH_C_OVERFLOW_RAYS 7     // rays whose traversal stack overflowed (counted as blocked)
 #define BVH_C_OVERFLOW_PIXELS 8   // pixels with at least one such ray (written shadowed)
 #define BVH_C_PIXELS 9            // pixels that traced rays (covered, facing and reached by the light)
-// Words 10..11 are reserved.
+#define BVH_C_TRUNCATED_PIXELS 10 // pixels whose sample loop the driver cut short (written shadowed)
+// Word 11 is reserved.
 
 // Child reference of an absent child (only the root of a tree of fewer than two leaves has one).
 #define BVH_ABSENT 0xFFFFFFFFu

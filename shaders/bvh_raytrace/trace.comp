@@ -1,10 +1,12 @@
 #version 450
 // bvh_raytrace: one invocation per pixel traces the reference's shadow rays (EmbreeTracer.h: origin
 // p + n * offset, unit direction to each light sample, tfar = distance - offset) through a BVH built
-// on the CPU, with a fixed stack and any-hit early exit. Visibility = fraction of unblocked samples.
+// on the CPU: Aila & Laine's while-while traversal (inner nodes until a leaf is found, then the
+// leaves), near child first, a fixed stack whose overflow is reported, any-hit early exit.
+// Triangles are read in leaf order (no index indirection). Visibility = fraction of unblocked samples.
 #include "common/light.glsl"
-#include "common/scene.glsl"
 #include "common/counters.glsl"
+#include "common/watertight.glsl"
 #include "bvh_raytrace/layout.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -15,7 +17,7 @@ struct BvhNode { // 64 bytes, mirrored by bvh::NodeGpu (algorithms/bvh_raytrace/
     vec3 hi1; uint count1;
 };
 layout(std430, binding = BVH_NODE_BINDING) readonly buffer BvhNodes { BvhNode bvhNodes[]; };
-layout(std430, binding = BVH_INDEX_BINDING) readonly buffer BvhIndices { uint bvhIndices[]; };
+layout(std430, binding = BVH_TRI_BINDING) readonly buffer BvhTriangles { vec4 bvhTris[]; }; // 3 per triangle, leaf order
 layout(std430, binding = BVH_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = BVH_COUNTER_BINDING) buffer BvhCounters { uint bvhCounters[]; };
 
@@ -32,8 +34,7 @@ const float kInf = uintBitsToFloat(0x7F800000u);
 struct Ray {
     vec3 o, d, invD;
     float tfar;
-    int kx, ky, kz; // watertight test: kz = dominant axis of d
-    vec3 shear;
+    WatertightRay w; // the triangle test's frame
 };
 
 Ray makeRay(vec3 o, vec3 d, float tfar) {
@@ -42,34 +43,12 @@ Ray makeRay(vec3 o, vec3 d, float tfar) {
     // A zero component would give 0 * inf = NaN in the slab test; 1e-30 keeps the slab infinite.
     vec3 safe = mix(d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(d, vec3(0.0))), lessThan(abs(d), vec3(1e-30)));
     r.invD = 1.0 / safe;
-    vec3 a = abs(d);
-    r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
-    r.kx = (r.kz + 1) % 3;
-    r.ky = (r.kx + 1) % 3;
-    if (d[r.kz] < 0.0) { int t = r.kx; r.kx = r.ky; r.ky = t; } // keep the winding
-    r.shear = vec3(d[r.kx] / d[r.kz], d[r.ky] / d[r.kz], 1.0 / d[r.kz]);
+    r.w = watertightRay(o, d, tfar);
     return r;
 }
 
-// Woop, Benthin & Wald 2013: watertight, like Embree's robust mode the reference uses, so a ray
-// through a shared edge hits one of the two triangles and never slips between them.
 bool hitTriangle(Ray r, uint tri) {
-    vec3 A = sceneVertex(tri, 0u) - r.o, B = sceneVertex(tri, 1u) - r.o, C = sceneVertex(tri, 2u) - r.o;
-    float Ax = A[r.kx] - r.shear.x * A[r.kz], Ay = A[r.ky] - r.shear.y * A[r.kz];
-    float Bx = B[r.kx] - r.shear.x * B[r.kz], By = B[r.ky] - r.shear.y * B[r.kz];
-    float Cx = C[r.kx] - r.shear.x * C[r.kz], Cy = C[r.ky] - r.shear.y * C[r.kz];
-    float U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
-    if (U == 0.0 || V == 0.0 || W == 0.0) { // on an edge in float: decide it in double
-        U = float(double(Cx) * double(By) - double(Cy) * double(Bx));
-        V = float(double(Ax) * double(Cy) - double(Ay) * double(Cx));
-        W = float(double(Bx) * double(Ay) - double(By) * double(Ax));
-    }
-    if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
-    float det = U + V + W;
-    if (det == 0.0) return false;
-    float T = U * (r.shear.z * A[r.kz]) + V * (r.shear.z * B[r.kz]) + W * (r.shear.z * C[r.kz]);
-    // t = T / det must lie in (0, tfar]
-    return det > 0.0 ? (T > 0.0 && T <= r.tfar * det) : (T < 0.0 && T >= r.tfar * det);
+    return watertightHit(r.w, bvhTris[3u * tri].xyz, bvhTris[3u * tri + 1u].xyz, bvhTris[3u * tri + 2u].xyz);
 }
 
 // Slab test on [0, tfar]; tnear is where the ray enters (for near-first ordering). The far end
@@ -87,64 +66,104 @@ struct Trace {
     uint visited, tested;
 };
 
-bool hitLeaf(Ray r, uint first, uint count, inout uint tested) {
-    for (uint i = 0u; i < count; ++i) {
-        ++tested;
-        if (hitTriangle(r, bvhIndices[first + i])) return true;
+// A child reference on the stack: an inner node's index, or BVH_LEAF | first << 4 | (count - 1) for
+// a leaf of `count` triangles from `first` in leaf order (the builder keeps leaves <= 16 and
+// first < 2^27: BvhRaytrace.cpp checks it).
+const uint BVH_LEAF = 0x80000000u, NONE = 0xFFFFFFFFu;
+
+uint childRef(uint child, uint count) { return count > 0u ? (BVH_LEAF | (child << 4u) | (count - 1u)) : child; }
+bool isLeaf(uint ref) { return ref != NONE && (ref & BVH_LEAF) != 0u; }
+
+#if BVH_SHORT_STACK
+// The traversal stack's top BVH_SHORT_ENTRIES entries live in four uvec4 registers, shifted on
+// every push and pop (no variable index: llvmpipe keeps a variably indexed local array in scratch
+// memory); deeper entries spill to `stack`, which only a push onto a full short stack or a pop
+// that refills it index. sp counts all entries.
+#define BVH_SHORT_ENTRIES 16
+#define STACK_SPILL max(1, BVH_STACK_SIZE - BVH_SHORT_ENTRIES)
+#define PUSH(x)                                                                               \
+    {                                                                                         \
+        if (sp >= BVH_SHORT_ENTRIES) stack[sp - BVH_SHORT_ENTRIES] = st3.w;                   \
+        st3 = uvec4(st2.w, st3.xyz), st2 = uvec4(st1.w, st2.xyz), st1 = uvec4(st0.w, st1.xyz); \
+        st0 = uvec4((x), st0.xyz);                                                            \
+        ++sp;                                                                                 \
     }
-    return false;
-}
+#define POP_INTO(v)                                                                                  \
+    {                                                                                                \
+        if (sp == 0) {                                                                               \
+            v = NONE;                                                                                \
+        } else {                                                                                     \
+            v = st0.x;                                                                               \
+            --sp;                                                                                    \
+            uint refill_ = sp >= BVH_SHORT_ENTRIES ? stack[sp - BVH_SHORT_ENTRIES] : NONE;           \
+            st0 = uvec4(st0.yzw, st1.x), st1 = uvec4(st1.yzw, st2.x), st2 = uvec4(st2.yzw, st3.x);  \
+            st3 = uvec4(st3.yzw, refill_);                                                           \
+        }                                                                                            \
+    }
+#else
+#define STACK_SPILL BVH_STACK_SIZE
+#define PUSH(x) stack[sp++] = (x)
+#define POP_INTO(v) v = sp > 0 ? stack[--sp] : NONE
+#endif
 
 Trace trace(Ray r) {
     Trace res = Trace(false, false, 0u, 0u);
-    uint stack[BVH_STACK_SIZE];
+    uint stack[STACK_SPILL];
+#if BVH_SHORT_STACK
+    uvec4 st0 = uvec4(NONE), st1 = uvec4(NONE), st2 = uvec4(NONE), st3 = uvec4(NONE);
+#endif
     int sp = 0;
-    uint node = 0u;
-    while (true) {
-        ++res.visited;
-        BvhNode n = bvhNodes[node];
-        float tn0, tn1;
-        bool h0 = n.child0 != BVH_ABSENT && hitBox(n.lo0, n.hi0, r, tn0);
-        bool h1 = n.child1 != BVH_ABSENT && hitBox(n.lo1, n.hi1, r, tn1);
-        // Any hit ends the ray: leaves are tested as soon as their box is entered.
-        if (h0 && n.count0 > 0u) {
-            if (hitLeaf(r, n.child0, n.count0, res.tested)) { res.occluded = true; break; }
-            h0 = false;
+    uint node = 0u, leaf = NONE; // the inner node to visit next, and a leaf postponed for the leaf loop
+    while (node != NONE || leaf != NONE) {
+        // Inner loop: descend until this ray holds a leaf (or has nothing left), so that the rays of
+        // neighbouring invocations (lanes in lockstep) test their triangles together below.
+        while (node != NONE && !isLeaf(node) && leaf == NONE) {
+            ++res.visited;
+            BvhNode n = bvhNodes[node];
+            float tn0, tn1;
+            bool h0 = n.child0 != BVH_ABSENT && hitBox(n.lo0, n.hi0, r, tn0);
+            bool h1 = n.child1 != BVH_ABSENT && hitBox(n.lo1, n.hi1, r, tn1);
+            uint c0 = childRef(n.child0, n.count0), c1 = childRef(n.child1, n.count1);
+            if (h0 && h1) {
+                bool first0 = tn0 <= tn1; // near child first
+                // A full stack would drop a subtree that may hold the occluder: stop and report.
+                if (sp == BVH_STACK_SIZE) { res.overflow = true; return res; }
+                PUSH(first0 ? c1 : c0);
+                node = first0 ? c0 : c1;
+            } else {
+                if (h0 || h1) node = h0 ? c0 : c1;
+                else POP_INTO(node);
+            }
+            // A leaf is postponed: its triangles are tested in the leaf loop.
+            if (isLeaf(node)) { leaf = node; POP_INTO(node); }
         }
-        if (h1 && n.count1 > 0u) {
-            if (hitLeaf(r, n.child1, n.count1, res.tested)) { res.occluded = true; break; }
-            h1 = false;
-        }
-        if (h0 && h1) {
-            bool first0 = tn0 <= tn1;
-            // A full stack would drop a subtree that may hold the occluder: stop and report.
-            if (sp == BVH_STACK_SIZE) { res.overflow = true; break; }
-            stack[sp++] = first0 ? n.child1 : n.child0;
-            node = first0 ? n.child0 : n.child1;
-        } else if (h0) {
-            node = n.child0;
-        } else if (h1) {
-            node = n.child1;
-        } else {
-            if (sp == 0) break;
-            node = stack[--sp];
+        // Leaf loop: the postponed leaf, and any leaves that come next off the stack.
+        while (isLeaf(leaf)) {
+            uint first = (leaf & ~BVH_LEAF) >> 4u, count = (leaf & 15u) + 1u;
+            for (uint i = 0u; i < count; ++i) {
+                ++res.tested;
+                if (hitTriangle(r, first + i)) { res.occluded = true; return res; } // any hit ends the ray
+            }
+            leaf = NONE;
+            if (isLeaf(node)) { leaf = node; POP_INTO(node); }
         }
     }
     return res;
 }
 
-shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels, sTruncated;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(bvhCounters, lo, value)
 
 void main() {
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = sTruncated = 0u;
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)
         uint visited = 0u, overflowRays = 0u;
+        bool truncated = false;
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
@@ -153,7 +172,7 @@ void main() {
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
                 int count = directional ? 1 : uSampleCount;
                 float unblocked = 0.0;
-                uint tested = 0u, maxVisited = 0u;
+                uint tested = 0u, maxVisited = 0u, done = 0u;
                 for (int s = 0; s < count; ++s) {
                     Ray r;
                     if (directional) {
@@ -161,7 +180,7 @@ void main() {
                     } else {
                         vec3 d = lightSamples[s].xyz - o;
                         float dist = length(d);
-                        if (!(dist > 0.0)) { unblocked += 1.0; continue; } // origin on the sample
+                        if (!(dist > 0.0)) { unblocked += 1.0; ++done; continue; } // origin on the sample
                         r = makeRay(o, d / dist, max(0.0, dist - uRayOffset));
                     }
                     Trace t = trace(r);
@@ -170,7 +189,11 @@ void main() {
                     maxVisited = max(maxVisited, t.visited);
                     if (t.overflow) ++overflowRays;
                     else if (!t.occluded) unblocked += 1.0;
+                    ++done;
                 }
+                // Fewer samples done than taken: llvmpipe's code generator (gallivm) stops the loops of
+                // an invocation after a fixed budget of iterations, silently. Treated like an overflow.
+                if (done != uint(count)) { truncated = true; ++overflowRays; }
                 // An overflowed ray counts as blocked, and its pixel is written fully shadowed, so a
                 // stack too small shows as dark pixels and in overflowCount(), never as light.
                 visibility = overflowRays > 0u ? 0.0 : unblocked / float(count);
@@ -179,7 +202,8 @@ void main() {
                 atomicAdd(sVisited, visited);
                 atomicMax(sVisitedMax, maxVisited);
                 atomicAdd(sTested, tested);
-                if (overflowRays > 0u) { atomicAdd(sOverflowRays, overflowRays); atomicAdd(sOverflowPixels, 1u); }
+                if (truncated) atomicAdd(sTruncated, 1u);
+                else if (overflowRays > 0u) { atomicAdd(sOverflowRays, overflowRays); atomicAdd(sOverflowPixels, 1u); }
             }
         }
         imageStore(uVisibility, px, vec4(visibility));
@@ -193,6 +217,7 @@ void main() {
         addWide(BVH_C_VISITED_LO, sVisited);
         atomicMax(bvhCounters[BVH_C_VISITED_MAX], sVisitedMax);
         addWide(BVH_C_TRIS_LO, sTested);
+        if (sTruncated != 0u) atomicAdd(bvhCounters[BVH_C_TRUNCATED_PIXELS], sTruncated);
         if (sOverflowRays != 0u) {
             atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], sOverflowRays);
             atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], sOverflowPixels);

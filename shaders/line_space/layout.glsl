@@ -17,6 +17,11 @@
 #define LS_BITS_BINDING_1 9
 #define LS_BITS_BINDING_2 10
 #define LS_BITS_BINDING_3 11
+#define LS_OCC_BINDING 12       // occupancy pool: LS_OCC_WORDS_PER_NODE(N) words per node, node order
+// start_region exact: the leaf lists (ls::LeafLists); the triangles' vertices are the scene's (binding 0).
+#define LS_LEAF_BASE_BINDING 13
+#define LS_LEAF_PREFIX_BINDING 14
+#define LS_LEAF_TRIS_BINDING 15
 
 // Node pool entry: vec3 lo; uint children; vec3 size; uint level (32 bytes, std430).
 #define LS_NODE_BYTES 32
@@ -33,9 +38,11 @@
 #define LS_PAIR_INDEX(fa, fb) ((fa) * (11 - (fa)) / 2 + (fb) - (fa) - 1)
 #define LS_BITS_PER_NODE(n) (15 * (n) * (n) * (n) * (n))
 #define LS_WORDS_PER_NODE(n) ((LS_BITS_PER_NODE(n) + 31) / 32)
+// Occupancy of a node's N³ children, one bit each in child order (z × N + y) × N + x.
+#define LS_OCC_WORDS_PER_NODE(n) (((n) * (n) * (n) + 31) / 32)
 
 // Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words.
-#define LS_COUNTER_WORDS 14
+#define LS_COUNTER_WORDS 18
 #define LS_C_RAYS_LO 0          // shadow rays (lit pixels × samples)
 #define LS_C_RAYS_HI 1
 #define LS_C_VISITED_LO 2       // nodes entered, summed over rays
@@ -49,4 +56,8 @@
 #define LS_C_OVERFLOW 10        // traversal stack overflows (cannot happen: one frame per level)
 #define LS_C_CELLS_LO 11        // child cells the DDA stepped through (empty ones included), summed over rays
 #define LS_C_CELLS_HI 12
-// Word 13 is reserved.
+#define LS_C_LEAVES_LO 13       // leaf cells read by the start region's leaf walks, summed over rays
+#define LS_C_LEAVES_HI 14
+#define LS_C_TRIS_LO 15         // triangles tested by the exact start region, summed over rays
+#define LS_C_TRIS_HI 16
+#define LS_C_TRUNCATED 17       // pixels whose sample loop the driver cut short (written shadowed)

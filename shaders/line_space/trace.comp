@@ -5,14 +5,30 @@
 //   * a node the ray crosses is looked up by the shaft between its entry and exit sub-faces:
 //     empty → skipped whole; non-empty on the last subdivided level (d - 1) → the ray is occluded;
 //     otherwise its children are visited front to back (3D DDA) and the non-empty ones recursed into;
-//   * a node the ray starts in cannot use its line space (the ray crosses no shaft of it): above the
-//     last level its children are visited, on the last level it is skipped (paper 4.1: the loss of
-//     detail near the receiver).
+//   * a node of the start region cannot use its line space: its shaft holds the part of the ray next
+//     to the receiver, whose own surface fills the leaves there. Above the last level its children
+//     are visited. On the last level, by LS_START_MODE:
+//       LS_START_NODE (the paper's Algorithm 1: the start region is the node holding the origin):
+//         skipped (paper 4.1: the loss of detail near the receiver);
+//       LS_START_DISTANCE (the start region ends at tS, from the receiver's normal and the leaf
+//         size, see startRegionEnd): geometry before tS ignored, its leaves walked from tS with the
+//         node's occupancy mask (an occupied leaf blocks);
+//       LS_START_EXACT (the same region, no geometry ignored): its occupied leaves' triangles are
+//         tested exactly against the ray (a hybrid: the start region exact, the rest line space).
+//   * a non-empty shaft of a last-level node ("deep enough") blocks the ray (Algorithm 1), or with
+//     LS_LAST_LEAVES the leaves the ray crosses in that node decide, by the node's occupancy mask.
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
-// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans).
+// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE, LS_LAST_LEAVES.
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "line_space/layout.glsl"
+#define LS_START_NODE 0
+#define LS_START_DISTANCE 1
+#define LS_START_EXACT 2
+#if LS_START_MODE == LS_START_EXACT
+#include "common/scene.glsl"
+#include "common/watertight.glsl"
+#endif
 layout(local_size_x = 8, local_size_y = 8) in;
 
 struct LsNode { // 32 bytes, mirrored by ls::NodeGpu (algorithms/line_space/NTree.h)
@@ -25,6 +41,17 @@ layout(std430, binding = LS_BITS_BINDING) readonly buffer LsBits0 { uint lsBits0
 layout(std430, binding = LS_BITS_BINDING_1) readonly buffer LsBits1 { uint lsBits1[]; };
 layout(std430, binding = LS_BITS_BINDING_2) readonly buffer LsBits2 { uint lsBits2[]; };
 layout(std430, binding = LS_BITS_BINDING_3) readonly buffer LsBits3 { uint lsBits3[]; };
+#if LS_START_MODE != LS_START_NODE || LS_LAST_LEAVES
+layout(std430, binding = LS_OCC_BINDING) readonly buffer LsOccupancy { uint lsOcc[]; };
+#endif
+#if LS_START_MODE == LS_START_EXACT
+// The leaf lists (ls::LeafLists): per node and occupancy word the number of the occupied leaves
+// before it, per occupied leaf the start of its triangles (plus one end), the triangles (scene
+// indices, vertices at binding 0).
+layout(std430, binding = LS_LEAF_BASE_BINDING) readonly buffer LsLeafRank { uint lsLeafRank[]; };
+layout(std430, binding = LS_LEAF_PREFIX_BINDING) readonly buffer LsLeafPrefix { uint lsLeafPrefix[]; };
+layout(std430, binding = LS_LEAF_TRIS_BINDING) readonly buffer LsLeafTris { uint lsLeafTris[]; };
+#endif
 layout(std430, binding = LS_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = LS_COUNTER_BINDING) buffer LsCounters { uint lsCounters[]; };
 #if LS_CLASSIFY
@@ -39,12 +66,16 @@ uniform float uRayOffset; // world units, the reference's
 uniform int uSampleCount; // entries of lightSamples (1 for point and spot lights)
 uniform uint uNodeCount;  // 0: no geometry, nothing occludes
 uniform uint uNodesPerChunk; // nodes per line-space pool chunk (see layout.glsl)
+uniform vec3 uLeafCell;      // world size of a leaf cell (level d)
+uniform float uStartCells;   // start_cells
+uniform float uStartMaxCells; // start_max_cells
 
 #ifndef LS_BIT_CHUNK_COUNT
 #define LS_BIT_CHUNK_COUNT LS_BIT_CHUNKS
 #endif
 const uint N2 = uint(LS_N * LS_N), N4 = N2 * N2;
 const uint WORDS = uint(LS_WORDS_PER_NODE(LS_N));
+const uint OCC_WORDS = uint(LS_OCC_WORDS_PER_NODE(LS_N));
 const uint LS_NONE = 0xFFFFFFFFu;
 const float kInf = uintBitsToFloat(0x7F800000u);
 
@@ -91,6 +122,83 @@ uint lineSpaceWord(uint index, uint w) {
 #endif
 }
 
+// End of the start region of a ray leaving a receiver of unit normal `nu` in unit direction `d`
+// (twin of ls::StartRegion::end): far enough that the ray has risen `uStartCells` leaf widths
+// (measured along the normal) above the receiver's tangent plane, so no shaft crossed later holds
+// the leaves the receiver's own surface fills; at most `uStartMaxCells` leaf widths along the ray,
+// which bounds the blockers it may miss near grazing directions. A ray below the horizon of the
+// (interpolated) normal (sin <= 0) may still leave a faceted receiver unblocked, as the reference
+// finds: the exact start region then takes its longest length; the distance one, which ignores
+// geometry, none (the leaves the ray enters there block it).
+float startRegionEnd(vec3 nu, vec3 d) {
+    float sinAngle = dot(nu, d), longest = uStartMaxCells * dot(abs(d), uLeafCell);
+    if (!(sinAngle > 0.0)) return LS_START_MODE == LS_START_EXACT ? longest : 0.0;
+    return min(uStartCells * dot(abs(nu), uLeafCell) / sinAngle, longest);
+}
+
+uint leafCells = 0u, trianglesTested = 0u; // read by leafWalk (counters)
+
+#if LS_START_MODE == LS_START_EXACT
+WatertightRay exactRay = WatertightRay(vec3(0.0), 0.0, 2, false, vec3(0.0)); // the current ray, in the triangle test's frame
+#endif
+
+#if LS_START_MODE != LS_START_NODE || LS_LAST_LEAVES
+// Does the segment [t0, t1] of the ray pass through an occupied leaf of last-level node `index`
+// (distance), or hit a triangle of one (exact)? A 3D DDA over the node's N³ leaves. The occupancy
+// bits are conservative (widened leaf boxes), so a blocker the segment touches is never missed;
+// an occupied leaf stands for its geometry like a shaft one leaf wide, finer than the node's shaft.
+// Exact: only leaves entered before tS (the start region) are tested against their triangles (the
+// whole segment against each, as the reference does); an occupied leaf entered later blocks, as in
+// the distance mode. One flat loop, each pass either one triangle test or one DDA step, so that
+// neighbouring invocations (vector lanes in lockstep) stay together: nesting the triangle loop in
+// the DDA loop measured the same on llvmpipe (within the ±10 % between runs), this form is kept for
+// its single exit path.
+bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, float tS) {
+    ivec3 c = cellOf(r.o + r.d * t0, lo, cellSize);
+    ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
+    vec3 tNext = (lo + vec3(c + up) * cellSize - r.o) * r.invD;
+    uint base = index * OCC_WORDS;
+    float tEnter = t0; // where the walk entered leaf c
+    uint next = 0u, end = 0u; // the current leaf's triangles still to test (exact)
+    bool step = false;        // leaf c is done: step the DDA
+    while (true) {
+#if LS_START_MODE == LS_START_EXACT
+        if (next < end) {
+            ++trianglesTested;
+            uint tri = lsLeafTris[next++];
+            if (watertightHit(exactRay, sceneVertex(tri, 0u), sceneVertex(tri, 1u), sceneVertex(tri, 2u))) return true;
+            continue;
+        }
+#endif
+        if (step) {
+            float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
+            if (cellEnd > t1) return false;
+            tEnter = cellEnd;
+            bvec3 axis = equal(tNext, vec3(cellEnd));
+            axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+            c += ivec3(axis) * stepDir;
+            if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(LS_N)))) return false;
+            tNext = mix(tNext, (lo + vec3(c + up) * cellSize - r.o) * r.invD, axis);
+        }
+        step = true;
+        ++leafCells;
+        uint leaf = uint((c.z * LS_N + c.y) * LS_N + c.x);
+        uint word = base + (leaf >> 5u), bits = lsOcc[word];
+        if (((bits >> (leaf & 31u)) & 1u) != 0u) {
+#if LS_START_MODE == LS_START_EXACT
+            if (tEnter >= tS) return true;
+            uint rank = lsLeafRank[word] + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
+            next = lsLeafPrefix[rank];
+            end = lsLeafPrefix[rank + 1u];
+#else
+            return true;
+#endif
+        }
+    }
+    return false;
+}
+#endif
+
 // One subdivided node being walked: its children along the ray (3D DDA over the N³ cells).
 struct Frame {
     uint children; // tree pool offset of its children group
@@ -112,7 +220,9 @@ uint rayVisited = 0u, sumShafts = 0u, startNode = LS_NONE;
 
 // Enters node `index` (on the last subdivided level if `last`): decides it, or prepares the walk
 // over its children in `f`. `root`: node 0, whose start flag and segment test are decided here.
-int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
+// `start`: the node holds the ray origin (the first cell of a start node's walk); a node entered
+// before `tS` (the end of the start region, -inf for the paper's) is in the start region too.
+int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Frame f) {
     LsNode n = lsNodes[index];
     float tIn, tOut;
     int ia, oa;
@@ -121,16 +231,30 @@ int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
         if (max(tIn, 0.0) > min(tOut, r.tEnd)) return ENTER_SKIP; // the segment misses the scene box
         start = tIn <= 0.0;
     }
+    start = start || tIn < tS;
     ++rayVisited; // a ray that misses the scene box visits nothing
+    vec3 cellSize = n.size / float(LS_N);
+    // Where the walk of a start-region node begins: the start region's end (geometry before it is
+    // ignored), or, when the start region is tested exactly, the node's entry.
+#if LS_START_MODE == LS_START_EXACT
+    float tFrom = max(tIn, 0.0);
+#else
+    float tFrom = max(max(tIn, tS), 0.0);
+#endif
     if (start && last) {
+#if LS_START_MODE != LS_START_NODE
+        float tTo = min(tOut, r.tEnd);
+        if (tFrom > tTo) return ENTER_SKIP; // the whole node lies in the start region
+        return leafWalk(index, n.lo, cellSize, r, tFrom, tTo, tS) ? ENTER_OCCLUDED : ENTER_SKIP;
+#else
         startNode = index; // the ray starts among this node's leaves: nothing can be said
         return ENTER_SKIP;
+#endif
     }
-    vec3 cellSize = n.size / float(LS_N);
     // The entry point's cell serves the DDA and the entry sub-face. A start node walks from the
-    // segment's start; any other node from where the line enters it (the same point unless
+    // end of the start region; any other node from where the line enters it (the same point unless
     // rounding puts tIn a hair below 0, where the walk then starts one cell early: a superset).
-    ivec3 cIn = cellOf(r.o + r.d * (start ? max(tIn, 0.0) : tIn), n.lo, cellSize);
+    ivec3 cIn = cellOf(r.o + r.d * (start ? tFrom : tIn), n.lo, cellSize);
     if (!start) {
         ++sumShafts;
         int fa = 2 * ia + (r.d[ia] >= 0.0 ? 0 : 1); // moving up an axis enters through its min face
@@ -148,12 +272,20 @@ int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
             nonEmpty = ((lineSpaceWord(index, bit >> 5u) >> (bit & 31u)) & 1u) != 0u;
         }
         if (!nonEmpty) return ENTER_SKIP;
-        if (last) return ENTER_OCCLUDED; // "deep enough": the shaft stands for its leaves
+        if (last) { // "deep enough"
+#if LS_LAST_LEAVES
+            // The shaft is non-empty; the leaves the ray itself crosses decide (occupancy, one leaf
+            // wide instead of the shaft's union of all lines between two sub-faces).
+            return leafWalk(index, n.lo, cellSize, r, max(tIn, 0.0), min(tOut, r.tEnd), -kInf) ? ENTER_OCCLUDED : ENTER_SKIP;
+#else
+            return ENTER_OCCLUDED; // the shaft stands for its leaves (Algorithm 1)
+#endif
+        }
     }
     f.children = n.children;
     f.lo = n.lo;
     f.cellSize = cellSize;
-    f.t = max(tIn, 0.0);
+    f.t = start ? tFrom : max(tIn, 0.0);
     f.tEnd = min(tOut, r.tEnd);
     f.start = start;
     f.cell = cIn;
@@ -185,12 +317,12 @@ int enter(uint index, bool root, bool last, bool start, Ray r, out Frame f) {
 #define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
 #endif
 
-shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 
 void main() {
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = 0u;
     barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(uVisibility);
@@ -213,6 +345,9 @@ void main() {
                 int count = directional ? 1 : uSampleCount;
                 uint unblocked = 0u, cells = 0u, occluded = 0u, maxVisited = 0u, overflow = 0u;
                 sumShafts = 0u;
+                leafCells = 0u;
+                trianglesTested = 0u;
+                vec3 nu = normalize(n);
 #if LS_CLASSIFY
                 startNode = LS_NONE;
 #endif
@@ -241,8 +376,16 @@ void main() {
                     ivec3 childStep = stepDir * ivec3(1, LS_N, LS_N * LS_N);
                     rayVisited = 0u;
                     bool blocked = false;
+#if LS_START_MODE != LS_START_NODE
+                    float tS = startRegionEnd(nu, r.d);
+#if LS_START_MODE == LS_START_EXACT
+                    exactRay = watertightRay(r.o, r.d, r.tEnd);
+#endif
+#else
+                    float tS = -kInf;
+#endif
                     Frame f;
-                    int e = uNodeCount == 0u ? ENTER_SKIP : enter(0u, true, LS_DEPTH == 1, false, r, f);
+                    int e = uNodeCount == 0u ? ENTER_SKIP : enter(0u, true, LS_DEPTH == 1, false, tS, r, f);
                     if (e == ENTER_OCCLUDED) blocked = true;
                     if (e == ENTER_DESCEND) {
                         cur = f;
@@ -282,7 +425,7 @@ void main() {
                                 if (child != LS_EMPTY) { node = child; break; } // Algorithm 1, line 8: empty children are skipped
                             }
                             if (node == LS_NONE) break; // walked past the root: the ray is free
-                            e = enter(node, false, level + 1 == LS_DEPTH - 1, nodeStart, r, f);
+                            e = enter(node, false, level + 1 == LS_DEPTH - 1, nodeStart, tS, r, f);
                             if (e == ENTER_OCCLUDED) { blocked = true; break; }
                             if (e == ENTER_DESCEND) {
                                 // One frame per level above the last suffices by construction. Checked
@@ -310,13 +453,26 @@ void main() {
                 // The start node depends only on the origin: every sample reports the same one.
                 if (startNode != LS_NONE) pixelStartNode = startNode;
 #endif
-                visibility = float(unblocked) / float(count);
+                // Every sample's iteration ends counted as unblocked or occluded. Fewer means the loop
+                // was cut short: llvmpipe's code generator (gallivm) stops the loops of an invocation
+                // after a fixed budget of iterations, silently, and a sample never traced would count
+                // as lit. Such a pixel is written shadowed and reported (overflowCount()), like an
+                // overflow, never as light.
+                bool truncated = unblocked + occluded != uint(count);
+                visibility = truncated ? 0.0 : float(unblocked) / float(count);
+#if LS_CLASSIFY
+                if (truncated)
+                    for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0xFFFFFFFFu; // every sample blocked
+#endif
+                if (truncated) atomicAdd(sTruncated, 1u);
                 atomicAdd(sPixels, 1u);
                 atomicAdd(sRays, uint(count));
                 atomicAdd(sVisited, visited);
                 atomicMax(sVisitedMax, maxVisited);
                 atomicAdd(sShafts, shafts);
                 atomicAdd(sCells, cells);
+                atomicAdd(sLeaves, leafCells);
+                atomicAdd(sTris, trianglesTested);
                 atomicAdd(sOccluded, occluded);
                 if (overflow != 0u) atomicAdd(sOverflow, overflow);
             }
@@ -335,7 +491,10 @@ void main() {
         atomicMax(lsCounters[LS_C_VISITED_MAX], sVisitedMax);
         addWide(LS_C_SHAFTS_LO, sShafts);
         addWide(LS_C_CELLS_LO, sCells);
+        addWide(LS_C_LEAVES_LO, sLeaves);
+        addWide(LS_C_TRIS_LO, sTris);
         addWide(LS_C_OCCLUDED_LO, sOccluded);
         if (sOverflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], sOverflow);
+        if (sTruncated != 0u) atomicAdd(lsCounters[LS_C_TRUNCATED], sTruncated);
     }
 }
