@@ -13,8 +13,11 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/sanitizers/lsan.supp:print_suppressions=0"
 
 # The CPU tier (the GL tier's algorithms run inside Mesa, which is not instrumented). The GUI is not
-# built here. Tests that run `shadowlab` run the sanitized binary.
-(cd build-asan && ctest --output-on-failure -j"$(nproc)" -E "GLTest|GuiTest" "$@")
+# built here. Tests that run `shadowlab` run the sanitized binary. Left out: the EGL runner's test,
+# because Mesa's EGL driver is built without frame pointers, so LeakSanitizer's fast unwinder cannot
+# see that its per-display allocations are Mesa's (with fast_unwind_on_malloc=0 they are, and are
+# suppressed, but that run takes minutes); the smoke run below covers the same runner code on OSMesa.
+(cd build-asan && ctest --output-on-failure -j"$(nproc)" -E "GLTest|GuiTest|gl_tests|EglRunner" "$@")
 
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
