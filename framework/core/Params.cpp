@@ -43,25 +43,25 @@ static Json valueToJson(const ParamValue& v) {
 }
 
 ParamSchema& ParamSchema::boolean(std::string key, bool def, std::string doc, ParamChange change) {
-    specs_.push_back({std::move(key), ParamType::Bool, def, 0, 1, "", std::move(doc), {}, change});
+    specs_.push_back({std::move(key), ParamType::Bool, def, 0, 1, "", std::move(doc), {}, change, {}});
     return *this;
 }
 
 ParamSchema& ParamSchema::integer(std::string key, int def, int min, int max, std::string unit, std::string doc,
                                   ParamChange change) {
-    specs_.push_back({std::move(key), ParamType::Int, def, double(min), double(max), std::move(unit), std::move(doc), {}, change});
+    specs_.push_back({std::move(key), ParamType::Int, def, double(min), double(max), std::move(unit), std::move(doc), {}, change, {}});
     return *this;
 }
 
 ParamSchema& ParamSchema::real(std::string key, double def, double min, double max, std::string unit, std::string doc,
                                ParamChange change) {
-    specs_.push_back({std::move(key), ParamType::Float, def, min, max, std::move(unit), std::move(doc), {}, change});
+    specs_.push_back({std::move(key), ParamType::Float, def, min, max, std::move(unit), std::move(doc), {}, change, {}});
     return *this;
 }
 
 ParamSchema& ParamSchema::choice(std::string key, std::string def, std::vector<std::string> choices, std::string doc,
                                  ParamChange change) {
-    specs_.push_back({std::move(key), ParamType::Enum, std::move(def), 0, 0, "", std::move(doc), std::move(choices), change});
+    specs_.push_back({std::move(key), ParamType::Enum, std::move(def), 0, 0, "", std::move(doc), std::move(choices), change, {}});
     return *this;
 }
 
