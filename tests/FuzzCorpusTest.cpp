@@ -223,6 +223,20 @@ void report(const char* what, size_t cases, const Tally& t) {
                 what, cases, t.loaded, t.rejected, t.maxRssKiB / 1024, t.worstRss.c_str(), t.maxSeconds);
 }
 
+/// Runs every case; the first that crashes or hangs stops the run, its input kept as PATH.failed.
+void runCorpus(const char* what, const std::vector<Case>& cases, bool isScene) {
+    Tally t;
+    for (const Case& c : cases) {
+        runCase(c, isScene, t);
+        if (::testing::Test::HasFatalFailure()) {
+            fs::copy_file(c.path, c.path + ".failed", fs::copy_options::overwrite_existing);
+            return;
+        }
+    }
+    report(what, cases.size(), t);
+    EXPECT_GT(t.loaded, 0u);  // the corpus reaches past the checks too, not only into them
+}
+
 TEST(FuzzCorpusTest, SceneLoaderSurvivesMutatedGltfAndGlb) {
     std::string dir = test::makeTempDir("fuzz-scenes");
     std::vector<Case> cases;
@@ -237,25 +251,16 @@ TEST(FuzzCorpusTest, SceneLoaderSurvivesMutatedGltfAndGlb) {
         auto more = mutationsOf(seedPath.empty() ? "generated" + ext : seedPath, bytes, copy + "/mutated" + ext, true, count, seed++);
         cases.insert(cases.end(), more.begin(), more.end());
     };
-    for (const auto& e : fs::recursive_directory_iterator(test::kAssimpGltf)) {
-        std::string ext = e.path().extension().string();
-        if (ext != ".gltf" && ext != ".glb") continue;
-        // The 1.8 MB engine costs ~0.1 s a load: fewer of its mutations.
-        addSeed(e.path().string(), readFile(e.path().string()), ext, e.file_size() > (1u << 20) ? 24 : 12);
-    }
+    std::vector<fs::path> models;
+    for (const auto& e : fs::recursive_directory_iterator(test::kAssimpGltf))
+        if (e.path().extension() == ".gltf" || e.path().extension() == ".glb") models.push_back(e.path());
+    std::sort(models.begin(), models.end());  // directory order is not deterministic; the seeds must be
+    for (const fs::path& m : models)  // the 1.8 MB engine, the one big real model, gets twice the mutations
+        addSeed(m.string(), readFile(m.string()), m.extension().string(), fs::file_size(m) > (1u << 20) ? 24 : 12);
     addSeed("", test::triangleGltf(), ".gltf", 60);
     addSeed("", test::glbOf(test::triangleGltf()), ".glb", 60);
     ASSERT_GE(cases.size(), 600u);
-    Tally t;
-    for (const Case& c : cases) {
-        runCase(c, true, t);
-        if (HasFatalFailure()) {
-            fs::copy_file(c.path, c.path + ".failed", fs::copy_options::overwrite_existing);
-            return;
-        }
-    }
-    report("scene loader", cases.size(), t);
-    EXPECT_GT(t.loaded, 0u);  // the corpus reaches past the checks too, not only into them
+    runCorpus("scene loader", cases, true);
 }
 
 TEST(FuzzCorpusTest, ConfigLoaderSurvivesMutatedConfigs) {
@@ -277,16 +282,7 @@ TEST(FuzzCorpusTest, ConfigLoaderSurvivesMutatedConfigs) {
     for (const auto& s : seeds) addSeed(s, readFile(s), 15);
     addSeed("", test::configWith({}), 200);
     ASSERT_GE(cases.size(), 500u);
-    Tally t;
-    for (const Case& c : cases) {
-        runCase(c, false, t);
-        if (HasFatalFailure()) {
-            fs::copy_file(c.path, c.path + ".failed", fs::copy_options::overwrite_existing);
-            return;
-        }
-    }
-    report("config loader", cases.size(), t);
-    EXPECT_GT(t.loaded, 0u);
+    runCorpus("config loader", cases, false);
 }
 
 } // namespace
