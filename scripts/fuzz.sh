@@ -16,7 +16,7 @@ run() {
   mkdir -p "build-fuzz/corpus-$target"
   echo "fuzz: $target for $seconds s (seeds: $seeds)"
   # -rss_limit_mb: a case that allocates past this is a finding (the loaders check sizes first).
-  build-fuzz/fuzz_$target -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=30 -max_len=2000000 \
+  build-fuzz/tests/fuzz/fuzz_$target -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=30 -max_len=2000000 \
     -artifact_prefix=build-fuzz/ "build-fuzz/corpus-$target" "$seeds"
 }
 if [ "$which" = config ] || [ "$which" = both ]; then
