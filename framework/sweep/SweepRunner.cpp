@@ -1,6 +1,7 @@
 #include "framework/sweep/SweepRunner.h"
 
 #include "framework/core/Error.h"
+#include "framework/core/Interrupt.h"
 #include "framework/experiment/Results.h"
 
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <map>
 #include <sstream>
 #include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 
 namespace shadowlab {
@@ -21,27 +23,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-volatile std::sig_atomic_t gStopSignal = 0;
-void onStopSignal(int sig) { gStopSignal = sig; }
-
-/// SIGINT/SIGTERM set a flag instead of killing this process, so it can stop its runs first
-/// (a Slurm job's cancel and Ctrl-C both arrive as one of these). No SA_RESTART: waitpid wakes up.
-struct StopSignals {
-    struct sigaction oldInt {}, oldTerm {};
-    StopSignals() {
-        gStopSignal = 0;
-        struct sigaction sa {};
-        sa.sa_handler = onStopSignal;
-        sigemptyset(&sa.sa_mask);
-        sigaction(SIGINT, &sa, &oldInt);
-        sigaction(SIGTERM, &sa, &oldTerm);
-    }
-    ~StopSignals() {
-        sigaction(SIGINT, &oldInt, nullptr);
-        sigaction(SIGTERM, &oldTerm, nullptr);
-    }
-};
 
 std::string readFile(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
@@ -110,7 +91,8 @@ void writeSweepSnapshot(const Sweep& sweep, const std::string& outputDir) {
 
 int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
     writeSweepSnapshot(sweep, opt.outputDir);
-    StopSignals signals;
+    // SIGINT/SIGTERM (a Slurm cancel, Ctrl-C) only set the flag: the runs in flight are stopped first.
+    installInterruptHandlers();
     const size_t n = opt.indices.size();
     const int width = int(std::to_string(n).size());
     size_t reported = 0, failed = 0, next = 0;
@@ -127,9 +109,9 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
         std::fflush(stderr);
     };
 
-    while (!gStopSignal && (next < n || !running.empty())) {
+    while (!pendingInterrupt() && (next < n || !running.empty())) {
         // Fill the free slots; complete runs are skipped without taking one.
-        while (!gStopSignal && next < n && running.size() < std::max<size_t>(1, opt.jobs)) {
+        while (!pendingInterrupt() && next < n && running.size() < std::max<size_t>(1, opt.jobs)) {
             const SweepRun& run = sweep.runs.at(opt.indices[next++]);
             RunPaths p(opt.outputDir, run.id);
             if (p.complete()) {
@@ -141,11 +123,13 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
         }
         if (running.empty()) continue;
         int status = 0;
-        pid_t pid = waitpid(-1, &status, 0);
-        if (pid < 0) {
-            if (errno == EINTR) continue; // a stop signal: the loop condition sees it
-            throw RuntimeError(std::string("waitpid failed: ") + std::strerror(errno));
+        // Polled, so a stop signal is acted on at once rather than when a run ends.
+        pid_t pid = waitpid(-1, &status, WNOHANG);
+        if (pid == 0 || (pid < 0 && errno == EINTR)) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            continue;
         }
+        if (pid < 0) throw RuntimeError(std::string("waitpid failed: ") + std::strerror(errno));
         auto it = running.find(pid);
         if (it == running.end()) continue;
         const SweepRun& run = sweep.runs[it->second.index];
@@ -171,7 +155,7 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
         report(run, "FAILED", std::string(took) + ": " + describeStatus(status) + "; see " + p.log);
     }
 
-    if (gStopSignal) {
+    if (pendingInterrupt()) {
         // Stop the runs in flight and wait for them: nothing is left writing once this returns.
         for (const auto& [pid, r] : running) kill(pid, SIGTERM);
         for (const auto& [pid, r] : running) {
@@ -181,8 +165,8 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
             fs::remove_all(RunPaths(opt.outputDir, sweep.runs[r.index].id).dir + ".partial-" + std::to_string(pid), ec);
         }
         std::fprintf(stderr, "sweep: stopped by signal %d; %zu of %zu runs reported; run the same command again to finish\n",
-                     int(gStopSignal), reported, n);
-        return 128 + int(gStopSignal);
+                     int(pendingInterrupt()), reported, n);
+        return 128 + int(pendingInterrupt());
     }
     std::fprintf(stderr, "sweep: %zu runs: %zu complete, %zu failed (%s)\n", n, n - failed, failed, opt.outputDir.c_str());
     return failed ? 1 : 0;
