@@ -33,4 +33,21 @@ const AlgorithmInfo* findAlgorithm(const std::string& name) {
 
 bool AlgorithmInfo::supports(LightType t) const { return std::find(lights.begin(), lights.end(), t) != lights.end(); }
 
+std::string AlgorithmInfo::motionRefusal(const ParamValues& params) const {
+    if (motion != MotionHandling::StaticOnly) return "";
+    if (!rebuildParam.empty() && std::get<bool>(params.get(rebuildParam))) return "";
+    return name + " precomputes its structure for static geometry and the scene moves" +
+           (rebuildParam.empty() ? std::string() : "; set params." + rebuildParam + " = true to rebuild it every frame (timed)");
+}
+
+const char* toString(MotionHandling m) {
+    switch (m) {
+    case MotionHandling::PerFrame: return "per_frame";
+    case MotionHandling::Rigid: return "rigid";
+    case MotionHandling::Refit: return "refit";
+    case MotionHandling::StaticOnly: return "static_only";
+    }
+    return "?";
+}
+
 } // namespace shadowlab

@@ -185,4 +185,33 @@ private:
 
 Bvh buildBvh(const Scene& scene, const BuildOptions& options) { return Builder(scene, options).run(scene); }
 
+void refitBvh(Bvh& tree, const std::vector<glm::vec3>& positions) {
+    for (size_t i = 0; i < tree.triIndices.size(); ++i)
+        for (size_t k = 0; k < 3; ++k) tree.triangles[3 * i + k] = glm::vec4(positions[3 * size_t(tree.triIndices[i]) + k], 0.0f);
+    // Children are always stored after their parent (build() appends them), so one pass from the
+    // last node to the root sees every child's boxes final before its parent reads them.
+    for (size_t n = tree.nodes.size(); n-- > 0;) {
+        NodeGpu& node = tree.nodes[n];
+        for (int k = 0; k < 2; ++k) {
+            const uint32_t child = k == 0 ? node.child0 : node.child1;
+            const uint32_t count = k == 0 ? node.count0 : node.count1;
+            if (child == BVH_ABSENT) continue;
+            glm::vec3 lo(kInf), hi(-kInf);
+            if (count > 0) {
+                for (size_t i = 3 * size_t(child); i < 3 * size_t(child + count); ++i) {
+                    lo = glm::min(lo, glm::vec3(tree.triangles[i]));
+                    hi = glm::max(hi, glm::vec3(tree.triangles[i]));
+                }
+            } else {
+                const NodeGpu& c = tree.nodes[child];
+                lo = glm::min(glm::min(glm::vec3(c.lo0[0], c.lo0[1], c.lo0[2]), glm::vec3(c.lo1[0], c.lo1[1], c.lo1[2])), lo);
+                hi = glm::max(glm::max(glm::vec3(c.hi0[0], c.hi0[1], c.hi0[2]), glm::vec3(c.hi1[0], c.hi1[1], c.hi1[2])), hi);
+            }
+            float* l = k == 0 ? node.lo0 : node.lo1;
+            float* h = k == 0 ? node.hi0 : node.hi1;
+            for (int a = 0; a < 3; ++a) l[a] = lo[a], h[a] = hi[a];
+        }
+    }
+}
+
 } // namespace shadowlab::bvh

@@ -32,4 +32,9 @@ struct Bvh {
 /// Builds the BVH of every triangle of `scene`. Deterministic for a given scene and options.
 Bvh buildBvh(const Scene& scene, const BuildOptions& options = {});
 
+/// Refits `tree` to new positions of the same triangles (3 per scene triangle): rewrites the
+/// leaf-ordered triangles and recomputes every box bottom-up. The tree keeps its shape, so its
+/// quality (not its correctness) degrades as moving parts travel away from where it was built.
+void refitBvh(Bvh& tree, const std::vector<glm::vec3>& positions);
+
 } // namespace shadowlab::bvh

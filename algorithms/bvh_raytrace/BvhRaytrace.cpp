@@ -81,13 +81,36 @@ public:
         // The shader packs a leaf's first triangle in 27 bits of a stack entry (layout.glsl).
         if (tree.triIndices.size() >= (size_t(1) << 27))
             throw RuntimeError("bvh_raytrace: more than 2^27 triangles cannot be addressed by the traversal stack");
-        nodes_ = GlBuffer::fromVector(tree.nodes, 0);
-        triangles_ = GlBuffer::fromVector(tree.triangles, 0);
+        const GLbitfield flags = scene.dynamic() ? GL_DYNAMIC_STORAGE_BIT : 0;  // refitted trees are re-uploaded
+        nodes_ = GlBuffer::fromVector(tree.nodes, flags);
+        triangles_ = GlBuffer::fromVector(tree.triangles, flags);
         counters_.allocate();
         nodeCount_ = tree.nodes.size();
         depth_ = tree.depth;
         leaves_ = tree.leaves;
         sahCost_ = tree.sahCost;
+        if (scene.dynamic()) {
+            tree_ = std::move(tree);
+            posed_ = scene.cpu().positions;
+        }
+    }
+
+    // Moving parts: their posed triangles are read back (the floats the G-buffer used), the tree
+    // refitted on the CPU and uploaded whole; a GPU refit would beat this on big moving sets.
+    void sceneMoved(const FrameInputs& f) override {
+        f.timer.begin("read_scene");
+        for (const MovingPart& part : scene_->cpu().moving) {
+            std::vector<glm::vec3> v = scene_->readPositions(part.firstTriangle, part.triangleCount);
+            std::copy(v.begin(), v.end(), posed_.begin() + ptrdiff_t(3 * part.firstTriangle));
+        }
+        f.timer.end();
+        f.timer.begin("refit", false);
+        bvh::refitBvh(tree_, posed_);
+        f.timer.end();
+        f.timer.begin("upload");
+        nodes_.upload(tree_.nodes.data(), tree_.nodes.size() * sizeof(bvh::NodeGpu));
+        triangles_.upload(tree_.triangles.data(), tree_.triangles.size() * sizeof(glm::vec4));
+        f.timer.end();
     }
 
     void resize(glm::ivec2 resolution) override {
@@ -167,6 +190,8 @@ private:
     const SceneGpu* scene_ = nullptr;
     ShaderProgram trace_;
     GlBuffer nodes_, triangles_, samples_;
+    bvh::Bvh tree_;                  ///< kept for refits (moving scenes only)
+    std::vector<glm::vec3> posed_;   ///< the posed scene positions the last refit used
     GpuCounters<BVH_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
     size_t nodeCount_ = 0, leaves_ = 0;
@@ -177,9 +202,11 @@ private:
 } // namespace
 
 AlgorithmInfo bvhRaytraceInfo() {
-    return makeAlgorithmInfo<BvhRaytrace>("bvh_raytrace",
-                                    "GLSL ray tracing of the reference's shadow rays through a binned-SAH BVH built on the CPU",
-                                    {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true, &bvhSchema);
+    AlgorithmInfo info = makeAlgorithmInfo<BvhRaytrace>(
+        "bvh_raytrace", "GLSL ray tracing of the reference's shadow rays through a binned-SAH BVH built on the CPU",
+        {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true, &bvhSchema);
+    info.motion = MotionHandling::Refit;
+    return info;
 }
 
 } // namespace shadowlab

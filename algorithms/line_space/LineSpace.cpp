@@ -27,6 +27,7 @@ struct LineSpaceParams {
     float rayOffset;   ///< × scene radius
     std::string startRegion, lastLevel;  ///< "exact" | "distance" | "node"; "leaves" | "shaft"
     float startCells, startMaxCells;     ///< leaf widths
+    bool rebuildEveryFrame;              ///< allows moving scenes: the whole precomputation each frame
 };
 
 const ParamStruct<LineSpaceParams>& lineSpaceParams() {
@@ -74,7 +75,12 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
               ParamChange::Update)
         .real("start_max_cells", &P::startMaxCells, 64.0, 0.0, 1024.0, "leaf widths",
               "start_region exact/distance: most leaf widths along the ray a start region spans (grazing rays)",
-              ParamChange::Update);
+              ParamChange::Update)
+        // The method precomputes for static scenes; rebuilding shows what moving geometry costs it.
+        .boolean("rebuild_every_frame", &P::rebuildEveryFrame, false,
+                 "allow a scene with moving parts: rebuild the N-tree and its line spaces from the posed triangles "
+                 "every frame they move (the `rebuild` stage; the disk cache is bypassed)",
+                 ParamChange::Update);
     return s;
 }
 
@@ -86,13 +92,31 @@ public:
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
+        build(scene.cpu(), p_.cache);
+    }
+
+    // Only with rebuild_every_frame (the host refuses a moving scene otherwise): the posed triangles
+    // are read back and everything setScene() does is done again on them.
+    void sceneMoved(const FrameInputs& f) override {
+        f.timer.begin("rebuild", false);
+        posed_ = scene_->cpu();
+        for (const MovingPart& part : posed_.moving) {
+            std::vector<glm::vec3> v = scene_->readPositions(part.firstTriangle, part.triangleCount);
+            std::copy(v.begin(), v.end(), posed_.positions.begin() + ptrdiff_t(3 * part.firstTriangle));
+        }
+        posed_.updateBounds();
+        build(posed_, false);
+        f.timer.end();
+    }
+
+    void build(const Scene& cpu, bool useCache) {
         tracer_.reset();
         nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(), occBuf_ = GlBuffer(); // free the old pools first
         for (GlBuffer& b : bitsBuf_) b = GlBuffer();
         const int n = p_.n, d = p_.d;
         const size_t cap = size_t(p_.maxBlockMib) << 20;
         const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
-        tree_ = obtainTree(scene.cpu(), n, d, limit);
+        tree_ = obtainTree(cpu, n, d, limit, useCache);
         // The occupancy pool is read (and counted) only by the distance and exact start regions; the
         // leaf lists and the scene's triangles only by the exact one.
         const ls::StartMode mode = startMode();
@@ -100,7 +124,7 @@ public:
         leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer();
         ls::LeafLists lists;
         if (exact) {
-            lists = ls::buildLeafLists(scene.cpu(), tree_);
+            lists = ls::buildLeafLists(cpu, tree_);
             // The shader numbers a leaf by the occupancy bits below it: one occupied leaf without a list
             // (or the reverse) would shift every later list, so the two must agree exactly.
             size_t occupied = 0;
@@ -114,7 +138,7 @@ public:
         }
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
                       tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0,
-                      exact ? lists.bytes() + scene.positions().size() : 0};
+                      exact ? lists.bytes() + scene_->positions().size() : 0};
         // Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
         // up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a
         // GPU with a larger limit is caught here.
@@ -136,7 +160,7 @@ public:
         if (occupancy) occBuf_ = GlBuffer::fromVector(tree_.occupancy, 0);
         if (exact) {
             for (auto [what, bytes] : {std::pair{"leaf triangle lists", lists.tris.size() * sizeof(uint32_t)},
-                                       std::pair{"scene positions", scene.positions().size()}})
+                                       std::pair{"scene positions", scene_->positions().size()}})
                 if (bytes > limit)
                     throw RuntimeError(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
                                        " MiB; one SSBO may hold " + mib(limit) + " MiB here");
@@ -323,8 +347,8 @@ private:
     }
 
     /// The tree from the disk cache when allowed and valid, else built (and cached).
-    ls::NTree obtainTree(const Scene& scene, int n, int d, size_t blockLimit) {
-        const std::string dir = p_.cache ? ls::cacheDirectory() : std::string();
+    ls::NTree obtainTree(const Scene& scene, int n, int d, size_t blockLimit, bool useCache) {
+        const std::string dir = useCache ? ls::cacheDirectory() : std::string();
         const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
         const std::string path = dir.empty() ? std::string() : ls::cacheFile(dir, hash, n, d);
         return diskcache::loadOrBuild(
@@ -335,7 +359,7 @@ private:
 
     const ls::SampleClasses& classify() const {
         if (!classes_) {
-            if (!tracer_) tracer_ = std::make_unique<EmbreeTracer>(scene_->cpu());
+            if (!tracer_) tracer_ = std::make_unique<EmbreeTracer>(posed_.triangleCount() ? posed_ : scene_->cpu());
             std::vector<uint32_t> perPixel = classifyBuf_.read<uint32_t>(
                 size_t(pendingG_.width) * size_t(pendingG_.height) * ls::classifyStride(pendingLight_.samplePoints().size()));
             classes_ = ls::classifySamples(*tracer_, pendingG_, pendingLight_, rayOffset(), tree_.nodes, perPixel, startRegion());
@@ -345,6 +369,7 @@ private:
 
     LineSpaceParams p_;
     const SceneGpu* scene_ = nullptr;
+    Scene posed_; ///< rebuild_every_frame: the scene as last posed (empty until a part moves)
     glm::ivec2 resolution_{0, 0};
     ShaderProgram trace_, classifyProgram_;
     ls::NTree tree_; ///< node pool and statistics (the tree and line-space pools live on the GPU only)
@@ -368,9 +393,12 @@ private:
 } // namespace
 
 AlgorithmInfo lineSpaceInfo() {
-    return makeAlgorithmInfo<LineSpace>("line_space",
-                                    "approximate shadows from precomputed line-space visibility in an N-tree (no triangle tests)",
-                                    {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, false, &lineSpaceSchema);
+    AlgorithmInfo info = makeAlgorithmInfo<LineSpace>(
+        "line_space", "approximate shadows from precomputed line-space visibility in an N-tree (no triangle tests)",
+        {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, false, &lineSpaceSchema);
+    info.motion = MotionHandling::StaticOnly;
+    info.rebuildParam = "rebuild_every_frame";
+    return info;
 }
 
 } // namespace shadowlab

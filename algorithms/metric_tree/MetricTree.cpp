@@ -18,6 +18,8 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
+#include <random>
 
 namespace shadowlab {
 namespace {
@@ -30,6 +32,7 @@ struct MetricTreeParams {
     std::string treeBuilder;                                   ///< "gpu" | "cpu"
     int stackSize;                                             ///< query stack, nodes
     float rayOffset;                                           ///< × scene radius
+    std::string motion;                                        ///< "rigid" | "recluster"
 };
 
 const ParamStruct<MetricTreeParams>& metricTreeParams() {
@@ -69,7 +72,14 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                 ParamChange::Update)
         .apply(stackSizeRow(&P::stackSize, 64))
         .apply(cacheRow(&P::cache, "metric_tree"))
-        .apply(rayOffsetRow(&P::rayOffset));
+        .apply(rayOffsetRow(&P::rayOffset))
+        // The paper's answer to rigid motion: clusters never span two moving parts, and each moves
+        // with its part; "recluster" is the alternative it avoids, timed for comparison.
+        .choice("motion", &P::motion, "rigid", {"rigid", "recluster"},
+                "moving parts: rigid = clusters are made per part (never spanning two) and their spheres, capsules, "
+                "cones and slabs move with it each frame; recluster = the whole clustering is redone on the posed "
+                "triangles every frame they move (the `recluster` stage)",
+                ParamChange::Rebuild);
     return s;
 }
 
@@ -93,7 +103,63 @@ public:
                                " the geometry blocks hold");
         clusters_ = GlBuffer(), nodes_ = GlBuffer();
         for (GlBuffer& g : geometry_) g = GlBuffer();
-        mt::Clustering c = cluster(scene.cpu());
+        // A moving scene: clusters per part in the part's own space, posed each frame (sceneMoved).
+        const bool rigid = scene.dynamic() && p_.motion == "rigid";
+        mt::Clustering c = rigid ? clusterByPart(scene.cpu()) : cluster(scene.cpu());
+        upload(c, scene.cpu());
+        if (rigid) {
+            restClusters_ = GlBuffer::fromVector(c.clusters, 0);
+            clusterPart_ = GlBuffer::fromVector(clusterPart_cpu_, 0);
+            order_ = GlBuffer::fromVector(c.order, 0);
+            movingFirst_ = staticTriangles_;
+        }
+    }
+
+    void sceneMoved(const FrameInputs& f) override {
+        if (p_.motion == "recluster") {
+            f.timer.begin("recluster", false);
+            posed_ = scene_->cpu();
+            for (const MovingPart& part : posed_.moving) {
+                std::vector<glm::vec3> v = scene_->readPositions(part.firstTriangle, part.triangleCount);
+                std::copy(v.begin(), v.end(), posed_.positions.begin() + ptrdiff_t(3 * part.firstTriangle));
+                for (size_t i = 0; i < part.triangleCount; ++i) {
+                    const glm::vec3* t = &posed_.positions[3 * (part.firstTriangle + i)];
+                    posed_.normals[part.firstTriangle + i] = glm::normalize(glm::cross(t[1] - t[0], t[2] - t[0]));
+                }
+            }
+            posed_.updateBounds();
+            const bool cache = p_.cache;
+            p_.cache = false; // a pose is never seen twice: caching would only write files
+            mt::Clustering c = cluster(posed_);
+            p_.cache = cache;
+            upload(c, posed_);
+            f.timer.end();
+            return;
+        }
+        // Rigid: the rest clusters of moving parts through their part's matrix, and the posed
+        // triangles (the scene's own floats) gathered into cluster order.
+        f.timer.begin("move_clusters");
+        restClusters_.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+        clusterPart_.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
+        clusters_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_CLUSTER_BINDING);
+        scene_->partTransforms().bindBase(GL_SHADER_STORAGE_BUFFER, 4);
+        poseClusters_.set("uFirst", unsigned(movingClusterFirst_));
+        poseClusters_.set("uCount", unsigned(clusterCount_ - movingClusterFirst_));
+        poseClusters_.dispatchLinear(clusterCount_ - movingClusterFirst_, kGroup);
+        scene_->positions().bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+        order_.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+        bindGeometry();
+        const size_t moving = scene_->triangleCount() - movingFirst_;
+        poseGeometry_.set("uFirst", unsigned(movingFirst_));
+        poseGeometry_.set("uCount", unsigned(moving));
+        poseGeometry_.dispatchLinear(moving, kGroup);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        f.timer.end();
+    }
+
+    /// Clusters (GPU) and the triangles in cluster order, split over the geometry blocks.
+    void upload(const mt::Clustering& c, const Scene& s) {
+        const size_t n = s.triangleCount();
         clusterCount_ = c.clusters.size();
         capsuleCount_ = c.capsules;
         clusters_ = GlBuffer::fromVector(c.clusters, 0);
@@ -101,7 +167,7 @@ public:
         counters_.allocate();
         // The triangles in cluster order, split over blocks of at most MT_TRIANGLES_PER_CHUNK.
         geometryBytes_ = 0;
-        const Scene& s = scene.cpu();
+        for (GlBuffer& g : geometry_) g = GlBuffer();
         for (size_t chunk = 0; chunk * MT_TRIANGLES_PER_CHUNK < n; ++chunk) {
             const size_t begin = chunk * MT_TRIANGLES_PER_CHUNK, end = std::min(n, begin + MT_TRIANGLES_PER_CHUNK);
             std::vector<float> v;
@@ -210,6 +276,8 @@ private:
                                        {"MT_NORMAL_CONE_CULLING", flag(p_.normalConeCulling)},
                                        {"MT_STACK_SIZE", std::to_string(p_.stackSize)}};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
+        poseClusters_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "1"}});
+        poseGeometry_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "0"}});
         insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
     }
@@ -237,12 +305,88 @@ private:
         return c;
     }
 
+    /// Clusters that never span two parts: the static triangles (world space) first, then each
+    /// moving part in its own space; `first` and `order` refer to the whole scene. Not cached: the
+    /// cache's validation checks clusters against world positions.
+    mt::Clustering clusterByPart(const Scene& scene) {
+        const auto start = std::chrono::steady_clock::now();
+        mt::ClusteringOptions o;
+        o.clusterSize = p_.clusterSize;
+        o.chunkTriangles = p_.chunkTriangles;
+        o.kmeansIterations = p_.kmeansIterations;
+        o.capsules = p_.capsules;
+        o.randomOrder = false; // shuffled once below, over all groups
+        o.seed = uint32_t(p_.seed);
+        mt::Clustering all;
+        std::vector<uint32_t> parts;
+        auto addGroup = [&](const std::vector<uint32_t>& triangles, const glm::vec3* local, uint32_t part) {
+            if (triangles.empty()) return;
+            Scene g;
+            g.materials = {Material{}};
+            for (size_t i = 0; i < triangles.size(); ++i) {
+                const glm::vec3* v = local ? local + 3 * i : &scene.positions[3 * size_t(triangles[i])];
+                g.positions.insert(g.positions.end(), {v[0], v[1], v[2]});
+                const glm::vec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+                g.normals.push_back(glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0, 1, 0));
+                g.materialIds.push_back(0);
+            }
+            g.updateBounds();
+            mt::Clustering c = mt::clusterScene(g, o);
+            const uint32_t base = uint32_t(all.order.size());
+            for (mt::ClusterGpu cl : c.clusters) {
+                cl.first += base;
+                all.clusters.push_back(cl);
+                parts.push_back(part);
+            }
+            for (uint32_t t : c.order) all.order.push_back(triangles[t]);
+            all.capsules += c.capsules;
+        };
+        std::vector<uint32_t> statics;
+        size_t next = 0;
+        for (const MovingPart& part : scene.moving) {
+            for (size_t t = next; t < part.firstTriangle; ++t) statics.push_back(uint32_t(t));
+            next = part.firstTriangle + part.triangleCount;
+        }
+        for (size_t t = next; t < scene.triangleCount(); ++t) statics.push_back(uint32_t(t));
+        addGroup(statics, nullptr, kStaticPart);
+        staticTriangles_ = statics.size();
+        movingClusterFirst_ = all.clusters.size();
+        for (uint32_t p = 0; p < scene.moving.size(); ++p) {
+            const MovingPart& part = scene.moving[p];
+            std::vector<uint32_t> triangles(part.triangleCount);
+            std::iota(triangles.begin(), triangles.end(), uint32_t(part.firstTriangle));
+            addGroup(triangles, part.local.data(), p);
+        }
+        // Insertion (pivot) order spread over the scene, as random_order does for a static one; the
+        // moving clusters stay last so one dispatch poses them (the shuffle is within each half).
+        if (p_.randomOrder) {
+            std::mt19937 rng(uint32_t(p_.seed));
+            auto shuffleRange = [&](size_t b, size_t e) {
+                for (size_t i = e; i > b + 1; --i) {
+                    const size_t j = b + size_t(rng() % (i - b));
+                    std::swap(all.clusters[i - 1], all.clusters[j]);
+                    std::swap(parts[i - 1], parts[j]);
+                }
+            };
+            shuffleRange(0, movingClusterFirst_);
+            shuffleRange(movingClusterFirst_, all.clusters.size());
+        }
+        clusterPart_cpu_ = std::move(parts);
+        cacheHit_ = false;
+        clusteringMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return all;
+    }
+
+    void bindGeometry() const {
+        for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i) // unused blocks alias chunk 0: never read, but bound
+            (geometry_[i] ? geometry_[i] : geometry_[0]).bindBase(GL_SHADER_STORAGE_BUFFER, MT_GEOMETRY_BINDING_0 + i);
+    }
+
     void bind() const {
         clusters_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_CLUSTER_BINDING);
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_NODE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_COUNTER_BINDING);
-        for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i) // unused blocks alias chunk 0: never read, but bound
-            (geometry_[i] ? geometry_[i] : geometry_[0]).bindBase(GL_SHADER_STORAGE_BUFFER, MT_GEOMETRY_BINDING_0 + i);
+        bindGeometry();
     }
 
     void setUniforms(const Light& light) {
@@ -303,8 +447,15 @@ private:
 
     MetricTreeParams p_;
     const SceneGpu* scene_ = nullptr;
-    ShaderProgram prepare_, insert_, query_;
+    ShaderProgram prepare_, insert_, query_, poseClusters_, poseGeometry_;
     GlBuffer clusters_, nodes_;
+    // Rigid motion: rest-pose clusters, each cluster's part, the cluster order of the triangles;
+    // the static clusters and triangles come first, moving ones from these indices on.
+    static constexpr uint32_t kStaticPart = 0xFFFFFFFFu;
+    GlBuffer restClusters_, clusterPart_, order_;
+    std::vector<uint32_t> clusterPart_cpu_;
+    size_t staticTriangles_ = 0, movingFirst_ = 0, movingClusterFirst_ = 0;
+    Scene posed_; ///< recluster: the scene as last posed
     GpuCounters<MT_COUNTER_WORDS> counters_;
     std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;
     GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;
@@ -317,9 +468,11 @@ private:
 } // namespace
 
 AlgorithmInfo metricTreeInfo() {
-    return makeAlgorithmInfo<MetricTree>("metric_tree",
+    AlgorithmInfo info = makeAlgorithmInfo<MetricTree>("metric_tree",
                                     "clusters bounded by spheres/capsules in a per-frame ternary metric tree (compute), per-pixel query",
                                     {LightType::Point, LightType::Directional}, true, &metricTreeSchema);
+    info.motion = MotionHandling::Rigid;
+    return info;
 }
 
 } // namespace shadowlab

@@ -13,6 +13,7 @@ namespace {
 struct ReferenceParams {
     int threads;     ///< 0 = all hardware threads
     float rayOffset; ///< × scene radius
+    std::string motionUpdate; ///< refit | rebuild: how the BVH follows moving parts
 };
 
 const ParamStruct<ReferenceParams>& referenceParams() {
@@ -20,7 +21,11 @@ const ParamStruct<ReferenceParams>& referenceParams() {
     static const ParamStruct<P> s = ParamStruct<P>()
         .integer("threads", &P::threads, 0, 0, 256, "", "CPU threads tracing rays (0 = all hardware threads)",
                  ParamChange::Update)
-        .apply(rayOffsetRow(&P::rayOffset));
+        .apply(rayOffsetRow(&P::rayOffset))
+        .choice("motion_update", &P::motionUpdate, "refit", {"refit", "rebuild"},
+                "how the Embree BVH follows moving parts each frame: refit its boxes (fast; the tree degrades as "
+                "parts travel) or rebuild it (the CPU alternative's full cost); either is exact",
+                ParamChange::Rebuild);
     return s;
 }
 
@@ -32,8 +37,25 @@ public:
 
     void setScene(const SceneGpu& scene) override {
         tracer_.reset(); // free the old BVH before building the new one
-        tracer_ = std::make_unique<EmbreeTracer>(scene.cpu());
-        sceneRadius_ = scene.bounds().empty() ? 1.0f : scene.bounds().radius();
+        scene_ = &scene;
+        tracer_ = std::make_unique<EmbreeTracer>(scene.cpu(), p_.motionUpdate == "rebuild"
+                                                                  ? EmbreeTracer::MotionUpdate::Rebuild
+                                                                  : EmbreeTracer::MotionUpdate::Refit);
+    }
+
+    // The moving triangles are read back from the GPU rather than posed again here, so the ground
+    // truth intersects the very floats the G-buffer rasterised.
+    void sceneMoved(const FrameInputs& frame) override {
+        const Scene& s = scene_->cpu();
+        frame.timer.begin("read_scene");
+        std::vector<std::vector<glm::vec3>> posed;
+        for (const MovingPart& part : s.moving) posed.push_back(scene_->readPositions(part.firstTriangle, part.triangleCount));
+        frame.timer.end();
+        frame.timer.begin(p_.motionUpdate == "rebuild" ? "rebuild" : "refit", false);
+        for (size_t p = 0; p < s.moving.size(); ++p)
+            tracer_->moveTriangles(s.moving[p].firstTriangle, posed[p].data(), s.moving[p].triangleCount);
+        tracer_->commitMoves();
+        frame.timer.end();
     }
 
     void paramsChanged(const ParamValues& params, ParamChange) override { p_ = referenceParams().read(params); }
@@ -42,7 +64,9 @@ public:
         const CpuGBuffer& g = frame.cpuGBuffer();
         frame.timer.begin("trace", false); // CPU stage: no GPU query
         auto t0 = std::chrono::steady_clock::now();
-        tracer_->traceVisibility(g, frame.light, p_.rayOffset * sceneRadius_, p_.threads, visibility_);
+        // The current bounds, as every GPU algorithm reads them each frame: the same offset everywhere.
+        const float sceneRadius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
+        tracer_->traceVisibility(g, frame.light, p_.rayOffset * sceneRadius, p_.threads, visibility_);
         double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         frame.timer.end();
         rays_ = double(tracer_->lastRayCount());
@@ -60,8 +84,8 @@ public:
     const std::vector<float>& lastVisibility() const { return visibility_; }
 
 private:
+    const SceneGpu* scene_ = nullptr;
     std::unique_ptr<EmbreeTracer> tracer_;
-    float sceneRadius_ = 1.0f;
     ReferenceParams p_;
     std::vector<float> visibility_;
     double rays_ = 0, mraysPerS_ = 0;
@@ -70,10 +94,11 @@ private:
 } // namespace
 
 AlgorithmInfo referenceInfo() {
-    return makeAlgorithmInfo<Reference>("reference",
-                                        "ground truth: exact shadows ray-traced on the CPU with Embree (multi-threaded)",
-                                        {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area},
-                                        true, &referenceSchema);
+    AlgorithmInfo info = makeAlgorithmInfo<Reference>(
+        "reference", "ground truth: exact shadows ray-traced on the CPU with Embree (multi-threaded)",
+        {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true, &referenceSchema);
+    info.motion = MotionHandling::Refit;
+    return info;
 }
 
 } // namespace shadowlab

@@ -22,6 +22,7 @@ void AlgorithmHost::setScene(const SceneGpu& scene) {
     auto start = std::chrono::steady_clock::now();
     scene_ = &scene;
     algorithm_->setScene(scene);
+    seenPose_ = 0;  // setScene() builds from Scene::positions, the rest pose
     if (resolution_.x > 0) algorithm_->resize(resolution_);
     glFinish();
     preprocessMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -50,8 +51,8 @@ ParamChange AlgorithmHost::setParams(const ParamValues& next) {
 }
 
 std::string AlgorithmHost::unsupportedReason(const Light& light) const {
-    if (info_->supports(light.type)) return "";
-    return info_->name + " does not support " + toString(light.type) + " lights";
+    if (!info_->supports(light.type)) return info_->name + " does not support " + toString(light.type) + " lights";
+    return scene_ && scene_->dynamic() ? info_->motionRefusal(params_) : "";
 }
 
 FrameMeasurement AlgorithmHost::computeFrame(const FrameView& view, StageTimer& timer) {
@@ -59,7 +60,12 @@ FrameMeasurement AlgorithmHost::computeFrame(const FrameView& view, StageTimer& 
     if (view.gbuffer.resolution() != resolution_) resize(view.gbuffer.resolution());
     if (std::string why = unsupportedReason(view.light); !why.empty()) throw RuntimeError(why);
     const FrameInputs inputs{view.gbuffer, view.cpuGBuffer, view.camera, view.light, view.frameIndex, visibility_.id(), timer};
-    TimedWork timed = timeWork(timer, [&] { algorithm_->computeVisibility(inputs); });
+    const bool moved = scene_->poseVersion() != seenPose_;
+    seenPose_ = scene_->poseVersion();
+    TimedWork timed = timeWork(timer, [&] {
+        if (moved) algorithm_->sceneMoved(inputs);
+        algorithm_->computeVisibility(inputs);
+    });
     FrameMeasurement m;
     m.stages = std::move(timed.stages);
     m.wallMs = timed.wallMs;

@@ -62,7 +62,7 @@ public:
     /// nothing changed (returns Update with no call when no value differs).
     ParamChange setParams(const ParamValues& next);
 
-    /// "" when the algorithm can run under `light`, else the reason.
+    /// "" when the algorithm can run under `light` (and, for a moving scene, with its parameters), else the reason.
     std::string unsupportedReason(const Light& light) const;
 
     /// Runs one frame into the visibility target, timed with `timer` as the runner times every
@@ -82,6 +82,7 @@ private:
     glm::ivec2 resolution_{0, 0};
     GlTexture visibility_;
     double preprocessMs_ = 0;
+    uint64_t seenPose_ = 0; ///< the scene's poseVersion() the algorithm last followed
 };
 
 } // namespace shadowlab

@@ -7,7 +7,9 @@
 //                          and whenever the resolution changes.
 //   4. paramsChanged(p, c) new values; c = Rebuild means setScene() and resize() follow, c = Update
 //                          means only uniforms change.
-//   5. per frame:          computeVisibility(frame) writes visibility in [0, 1] per pixel into
+//   5. per frame:          sceneMoved(frame) first when moving parts changed pose since the last
+//                          frame (or since setScene(), built at the rest pose); then
+//                          computeVisibility(frame) writes visibility in [0, 1] per pixel into
 //                          frame.visibility, timing its stages through frame.timer;
 //                          then counters(), debugViews() and memoryBytes() describe that frame.
 //
@@ -52,6 +54,18 @@ struct DebugView {
     std::string unit;
 };
 
+/// How an algorithm follows moving geometry. The scene's shared buffers are always posed for the
+/// frame (SceneGpu::setTime, the runner's `scene_update` stage); what else must move depends on
+/// what the algorithm precomputed.
+enum class MotionHandling {
+    PerFrame,   ///< builds or renders everything from the posed scene buffers each frame: nothing more to do
+    Rigid,      ///< moves its precomputed per-part structures with the parts' matrices (sceneMoved)
+    Refit,      ///< refits its acceleration structure to the posed triangles (sceneMoved)
+    StaticOnly, ///< precomputes over static geometry: a moving scene is bad input unless its
+                ///< AlgorithmInfo::rebuildParam is true, when sceneMoved() rebuilds (and times) it all
+};
+const char* toString(MotionHandling m);
+
 class ShadowAlgorithm {
 public:
     virtual ~ShadowAlgorithm() = default;
@@ -60,6 +74,10 @@ public:
     virtual void resize(glm::ivec2 resolution) { (void)resolution; }
     virtual void paramsChanged(const ParamValues& params, ParamChange change) = 0;
     virtual void computeVisibility(const FrameInputs& frame) = 0;
+    /// The scene's moving parts changed pose (SceneGpu::pose()) since the algorithm last saw it;
+    /// called just before computeVisibility() and timed with it, so stages go through frame.timer.
+    /// PerFrame algorithms need not override it.
+    virtual void sceneMoved(const FrameInputs& frame) { (void)frame; }
 
     virtual std::vector<Counter> counters() const { return {}; }
     virtual std::vector<DebugView> debugViews() const { return {}; }
@@ -75,10 +93,14 @@ struct AlgorithmInfo {
     std::string summary;          ///< one line for `shadowlab list`
     std::vector<LightType> lights; ///< light types it supports
     bool exact = false;           ///< exact hard shadows: held to the reference's tiny mismatch
+    MotionHandling motion = MotionHandling::PerFrame;
+    std::string rebuildParam;     ///< StaticOnly: the bool parameter that allows moving scenes (rebuilt each frame)
     const ParamSchema& (*schema)();
     std::unique_ptr<ShadowAlgorithm> (*create)(const ParamValues& params);
 
     bool supports(LightType t) const;
+    /// "" when the algorithm can run on a scene that moves with these parameter values, else why not.
+    std::string motionRefusal(const ParamValues& params) const;
 };
 
 /// Every registered algorithm, in registration order (algorithms/Registry.cpp).

@@ -113,6 +113,16 @@ Camera ExperimentConfig::cameraAt(int frame) const {
     return cam;
 }
 
+double ExperimentConfig::sceneTimeAt(int frame) const {
+    glm::dvec2 range(0.0);
+    if (scene && scene->hasTimeRange) range = scene->timeRange;
+    else if (cameraPath.keyframes().size() >= 2) range = {cameraPath.startTime(), cameraPath.endTime()};
+    else if (lightPath.keyframes().size() >= 2) range = {lightPath.startTime(), lightPath.endTime()};
+    else if (scene) range = scene->motionTimeRange();
+    if (frames <= 1) return range.x;
+    return range.x + (range.y - range.x) * double(frame) / double(frames - 1);
+}
+
 Light ExperimentConfig::lightAt(int frame) const {
     Light l = light;
     followPath(lightPath, frame, frames, l.position, l.target);
@@ -159,6 +169,9 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
         if (!e.info->supports(c.light.type))
             throw InputError(file, node.childPath("algorithm"),
                              e.info->name + " does not support " + toString(c.light.type) + " lights");
+        if (c.scene && c.scene->dynamic())
+            if (std::string why = e.info->motionRefusal(e.params); !why.empty())
+                throw InputError(file, node.childPath("algorithm"), why + " (objects with a \"path\" or an \"animation\")");
         c.algorithms.push_back(std::move(e));
     }
     if (c.algorithms.empty() && !c.reference) root.fail("algorithms", "nothing to run: no algorithms and no reference");

@@ -45,6 +45,9 @@ struct ExperimentConfig {
     Json resolved;
 
     Camera cameraAt(int frame) const;
+    /// The scene's clock at `frame`: uniformly over scene.time_range when given, else over the
+    /// camera path's times, else the light path's, else the span of the scene's own motion.
+    double sceneTimeAt(int frame) const;
     Light lightAt(int frame) const;
 };
 

@@ -104,13 +104,21 @@ FrameMeasurement Viewer::runOn(AlgorithmHost& host, StageTimer& timer) {
 
 void Viewer::renderFrame() {
     if (resolution_.x <= 0) return;
+    // Moving parts follow the playback frame (and so the scrubber) on the runner's clock.
+    TimedWork sceneUpdate;
+    if (sceneGpu_->dynamic()) sceneUpdate = timeWork(timer_, [&] {
+        timer_.begin("scene_update");
+        sceneGpu_->setTime(config_.sceneTimeAt(playback.frame));
+        timer_.end();
+    });
     gbuffer_->render(*sceneGpu_, camera);
     cpuG_.reset();
     lastStages_.clear();
     if (unsupportedReason().empty()) {
         FrameMeasurement m = runOn(*host_, timer_);  // measured as the runner measures a frame
-        lastWallMs_ = m.wallMs;
-        lastStages_ = std::move(m.stages);
+        lastWallMs_ = m.wallMs + sceneUpdate.wallMs;
+        lastStages_ = std::move(sceneUpdate.stages);
+        lastStages_.insert(lastStages_.end(), m.stages.begin(), m.stages.end());
     } else {
         // Shown unshadowed rather than with stale visibility; the panel says why.
         const float one = 1.0f;

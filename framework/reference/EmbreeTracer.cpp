@@ -91,7 +91,9 @@ RTCRay makeRay(glm::vec3 o, glm::vec3 d, float tfar) {
 
 } // namespace
 
-EmbreeTracer::EmbreeTracer(const Scene& scene) : state_(std::make_unique<DeviceState>()) {
+EmbreeTracer::EmbreeTracer(const Scene& scene) : EmbreeTracer(scene, MotionUpdate::Refit) {}
+
+EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update) : state_(std::make_unique<DeviceState>()) {
     device_ = rtcNewDevice("verbose=0");
     if (!device_) throw RuntimeError("Embree: cannot create a device (" + std::string(errorName(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(
@@ -132,10 +134,12 @@ EmbreeTracer::EmbreeTracer(const Scene& scene) : state_(std::make_unique<DeviceS
     // context filter, so occluded() can still ask plain opaque questions of the same BVH.
     RTCSceneFlags flags = RTC_SCENE_FLAG_ROBUST;
     if (transparent_) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    const bool dynamic = scene.dynamic();
+    if (dynamic) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_DYNAMIC);
     scene_ = rtcNewScene(device_);
     if (!scene_) fail("rtcNewScene");
     rtcSetSceneFlags(scene_, flags);
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(scene_, dynamic ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
 
     if (triangleCount_ > 0) {
         if (triangleCount_ * 3 > std::numeric_limits<uint32_t>::max())
@@ -156,12 +160,28 @@ EmbreeTracer::EmbreeTracer(const Scene& scene) : state_(std::make_unique<DeviceS
         static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
         std::memcpy(verts, scene.positions.data(), nv * sizeof(glm::vec3));
         for (uint32_t i = 0; i < uint32_t(nv); ++i) index[i] = i; // triangle soup: triangle t = vertices 3t..3t+2
+        if (dynamic && update == MotionUpdate::Refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
         rtcCommitGeometry(geom);
         rtcAttachGeometry(scene_, geom);
+        geometry_ = geom;
         rtcReleaseGeometry(geom); // the scene keeps its own reference
     }
     rtcCommitScene(scene_);
     if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) fail("building the BVH");
+}
+
+void EmbreeTracer::moveTriangles(size_t firstTriangle, const glm::vec3* positions, size_t count) {
+    if (!geometry_ || firstTriangle + count > triangleCount_) throw RuntimeError("Embree: moved triangles out of range");
+    auto* verts = static_cast<glm::vec3*>(rtcGetGeometryBufferData(geometry_, RTC_BUFFER_TYPE_VERTEX, 0));
+    std::memcpy(verts + 3 * firstTriangle, positions, 3 * count * sizeof(glm::vec3));
+}
+
+void EmbreeTracer::commitMoves() {
+    if (!geometry_) return;
+    rtcUpdateGeometryBuffer(geometry_, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geometry_);
+    rtcCommitScene(scene_);
+    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw RuntimeError("Embree: updating the BVH failed");
 }
 
 EmbreeTracer::~EmbreeTracer() {

@@ -46,6 +46,12 @@ public:
     /// Builds the BVH (RTC_BUILD_QUALITY_HIGH) over a copy of the scene's triangles, so the tracer
     /// does not depend on the Scene's lifetime. Throws RuntimeError when Embree fails (e.g. out of memory).
     explicit EmbreeTracer(const Scene& scene);
+    /// How moveTriangles() updates the BVH of a scene whose parts move.
+    enum class MotionUpdate { Refit, Rebuild };
+    /// As above; for a scene with moving parts the BVH is built to be updated (RTC_SCENE_FLAG_DYNAMIC):
+    /// by refitting its boxes (RTC_BUILD_QUALITY_REFIT: fast, the tree's quality degrades as parts
+    /// travel) or by a full rebuild.
+    EmbreeTracer(const Scene& scene, MotionUpdate update);
     ~EmbreeTracer();
     EmbreeTracer(const EmbreeTracer&) = delete;
     EmbreeTracer& operator=(const EmbreeTracer&) = delete;
@@ -60,6 +66,11 @@ public:
     /// Fraction of light passing along the segment: product of (1 - opacity) of the distinct triangles
     /// crossed (0 or 1 in opaque scenes). `dir` need not be unit length; t is in units of |dir|.
     float transmission(glm::vec3 origin, glm::vec3 dir, float tfar) const;
+
+    /// Replaces the vertices of triangles [firstTriangle, firstTriangle + count) (3 per triangle);
+    /// commitMoves() then updates the BVH once for all moves.
+    void moveTriangles(size_t firstTriangle, const glm::vec3* positions, size_t count);
+    void commitMoves();
 
     /// Rays cast by the last traceVisibility() call.
     uint64_t lastRayCount() const { return lastRays_; }
@@ -86,6 +97,7 @@ private:
 
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
+    RTCGeometry geometry_ = nullptr; ///< the one triangle geometry (owned by scene_)
     size_t triangleCount_ = 0;
     bool transparent_ = false;
     std::vector<uint32_t> materialIds_;   ///< only when transparent_: primID → material

@@ -15,7 +15,7 @@ struct MaterialInfo { // std430, 16 bytes
 static_assert(sizeof(TriangleInfo) == 16 && sizeof(MaterialInfo) == 16);
 } // namespace
 
-SceneGpu::SceneGpu(const Scene& scene) : scene_(&scene) {
+SceneGpu::SceneGpu(const Scene& scene) : scene_(&scene), bounds_(scene.bounds) {
     positions_ = GlBuffer::fromVector(scene.positions, 0);
     std::vector<TriangleInfo> tris(scene.triangleCount());
     // Per-vertex attribute (normal.xyz, material): the rasteriser needs per-triangle data at each
@@ -46,6 +46,58 @@ SceneGpu::SceneGpu(const Scene& scene) : scene_(&scene) {
     glEnableVertexArrayAttrib(vao, 2);
     glVertexArrayAttribIFormat(vao, 2, 1, GL_UNSIGNED_INT, 12);
     glVertexArrayAttribBinding(vao, 2, 1);
+    if (scene.dynamic()) uploadMotion();
+}
+
+void SceneGpu::uploadMotion() {
+    std::vector<glm::vec4> local;       // xyz per vertex, w unused: std430 vec4 needs no repacking in the shader
+    std::vector<glm::uvec2> index;      // (scene triangle, part) per moving triangle
+    for (size_t p = 0; p < scene_->moving.size(); ++p) {
+        const MovingPart& part = scene_->moving[p];
+        for (size_t i = 0; i < part.triangleCount; ++i) {
+            for (int k = 0; k < 3; ++k) local.emplace_back(part.local[3 * i + size_t(k)], 1.0f);
+            index.emplace_back(uint32_t(part.firstTriangle + i), uint32_t(p));
+        }
+    }
+    movingTriangles_ = index.size();
+    local_ = GlBuffer::fromVector(local, 0);
+    movingIndex_ = GlBuffer::fromVector(index, 0);
+    transforms_ = GlBuffer(scene_->moving.size() * sizeof(glm::mat4), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    update_ = ShaderProgram::compute("common/scene_update.comp");
+    // The GPU pass poses even the rest pose: its floats may differ from the CPU's in the last bit
+    // (fused multiply-adds), and every consumer must see the very same triangles. So version 1 is
+    // the first GPU pose, and algorithms built from Scene::positions follow it via sceneMoved().
+    pose_.clear();
+    setTime(0.0);
+}
+
+std::vector<glm::vec3> SceneGpu::readPositions(size_t firstTriangle, size_t count) const {
+    std::vector<glm::vec3> out(3 * count);
+    if (count)
+        glGetNamedBufferSubData(positions_.id(), GLintptr(firstTriangle * 3 * sizeof(glm::vec3)),
+                                GLsizeiptr(out.size() * sizeof(glm::vec3)), out.data());
+    return out;
+}
+
+void SceneGpu::setTime(double time) {
+    if (!scene_->dynamic()) return;
+    std::vector<glm::mat4> pose = scene_->poseAt(time);
+    if (pose == pose_ && poseVersion_ > 0) return;
+    pose_ = std::move(pose);
+    ++poseVersion_;
+    bounds_ = scene_->boundsAt(pose_);
+    transforms_.upload(pose_.data(), pose_.size() * sizeof(glm::mat4));
+    local_.bindBase(GL_SHADER_STORAGE_BUFFER, 3);
+    movingIndex_.bindBase(GL_SHADER_STORAGE_BUFFER, 4);
+    transforms_.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
+    positions_.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+    triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+    vertexNormals_.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
+    update_.set("uCount", unsigned(movingTriangles_));
+    update_.use();
+    update_.dispatchLinear(movingTriangles_, 64);
+    // Everything after reads the posed scene: algorithms as SSBOs, the G-buffer as vertex attributes.
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
 void SceneGpu::bindStorage() const {

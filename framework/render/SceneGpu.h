@@ -1,7 +1,10 @@
 #pragma once
 // The scene uploaded once to the GPU. The same buffers feed the G-buffer rasterisation (as vertex
 // buffers) and the algorithms (as SSBOs), so the geometry exists once in GPU memory.
+// Moving parts are posed on the GPU: setTime() re-transforms only their triangles from object-space
+// copies (shaders/common/scene_update.comp), the static rest is never touched.
 #include "framework/gl/GlObjects.h"
+#include "framework/gl/Shader.h"
 #include "framework/scene/Scene.h"
 
 namespace shadowlab {
@@ -17,13 +20,32 @@ class SceneGpu {
 public:
     explicit SceneGpu(const Scene& scene);
 
+    /// The scene on the CPU: static triangles as they are, moving parts at their rest pose (time 0).
     const Scene& cpu() const { return *scene_; }
     size_t triangleCount() const { return scene_->triangleCount(); }
-    const Bounds& bounds() const { return scene_->bounds; }
+    /// Bounds of the scene as currently posed.
+    const Bounds& bounds() const { return bounds_; }
+
+    bool dynamic() const { return scene_->dynamic(); }
+    /// Poses the moving parts at `time` (a no-op for a static scene or an unchanged pose): one
+    /// compute pass over their triangles rewriting positions and normals in place.
+    void setTime(double time);
+    /// The moving parts' current matrices (Scene::poseAt of the last setTime, else of time 0).
+    const std::vector<glm::mat4>& pose() const { return pose_; }
+    /// Changes whenever the pose does: 0 is Scene::positions as they are (a static scene's only
+    /// version); a moving scene is posed by the GPU from the start, so its versions begin at 1.
+    uint64_t poseVersion() const { return poseVersion_; }
+    /// The posed positions of triangles [firstTriangle, firstTriangle + count) read back from the GPU
+    /// (3 per triangle): the very floats the G-buffer and the GPU algorithms see, for CPU consumers.
+    std::vector<glm::vec3> readPositions(size_t firstTriangle, size_t count) const;
+    /// Bytes of the object-space copies and part tables (0 for a static scene).
+    size_t motionBytes() const { return local_.size() + movingIndex_.size() + transforms_.size(); }
 
     const GlBuffer& positions() const { return positions_; }
     const GlBuffer& triangles() const { return triangles_; }
     const GlBuffer& materials() const { return materials_; }
+    /// mat4 per moving part, the current pose (std430; a 4-byte dummy for a static scene).
+    const GlBuffer& partTransforms() const { return transforms_; }
     GLuint vertexArray() const { return vao_.id(); }
 
     /// Binds positions, triangles and materials to their SceneBinding points.
@@ -32,9 +54,17 @@ public:
     void draw() const;
 
 private:
+    void uploadMotion();
+
     const Scene* scene_;
     GlBuffer positions_, triangles_, materials_, vertexNormals_;
     GlVertexArray vao_;
+    Bounds bounds_;
+    std::vector<glm::mat4> pose_;
+    uint64_t poseVersion_ = 0;
+    GlBuffer local_, movingIndex_, transforms_;
+    size_t movingTriangles_ = 0;
+    ShaderProgram update_;
 };
 
 } // namespace shadowlab

@@ -12,6 +12,8 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <memory>
+#include <tuple>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -225,10 +227,83 @@ const char* const kHarmlessExtensions[] = {
     "KHR_materials_specular", "KHR_materials_ior",      "KHR_materials_variants", "KHR_materials_iridescence",
     "KHR_materials_anisotropy", "KHR_lights_punctual"};
 
+/// Quaternion (x, y, z, w) to matrix, written out to avoid any doubt about glm's quat argument order.
+glm::mat4 rotationMatrix(glm::vec4 q) {
+    float len = glm::length(q);
+    float x = q.x / len, y = q.y / len, z = q.z / len, w = q.w / len;
+    glm::mat4 r(1.0f);
+    r[0] = glm::vec4(1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y), 0);
+    r[1] = glm::vec4(2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x), 0);
+    r[2] = glm::vec4(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y), 0);
+    return r;
+}
+
+glm::mat4 trsMatrix(glm::vec3 t, glm::vec4 q, glm::vec3 s) {
+    glm::mat4 m = rotationMatrix(q);
+    for (int c = 0; c < 3; ++c) m[c] *= s[c];
+    m[3] = glm::vec4(t, 1.0f);
+    return m;
+}
+
+glm::vec4 slerp(glm::vec4 a, glm::vec4 b, float u) {
+    float d = glm::dot(a, b);
+    if (d < 0.0f) b = -b, d = -d;  // the shorter way round
+    if (d > 0.9995f) return glm::normalize(glm::mix(a, b, u));
+    float theta = std::acos(d);
+    return (std::sin((1.0f - u) * theta) * a + std::sin(u * theta) * b) / std::sin(theta);
+}
+
+/// One animation channel's keys (glTF 2.0 spec 3.11): values are vec3 (translation, scale) or
+/// quaternions; CUBICSPLINE stores (in-tangent, value, out-tangent) per key.
+struct Track {
+    enum Mode { Linear, Step, Cubic } mode = Linear;
+    std::vector<float> times;
+    std::vector<glm::vec4> values;
+    bool rotation = false;
+
+    glm::vec4 key(size_t k) const { return mode == Cubic ? values[3 * k + 1] : values[k]; }
+    glm::vec4 at(double time) const {
+        if (times.size() == 1 || time <= times.front()) return key(0);
+        if (time >= times.back()) return key(times.size() - 1);
+        size_t k = size_t(std::upper_bound(times.begin(), times.end(), float(time)) - times.begin()) - 1;
+        if (k + 1 >= times.size()) return key(times.size() - 1);
+        if (mode == Step) return key(k);
+        const float dt = times[k + 1] - times[k], u = float((time - times[k]) / dt);
+        if (mode == Linear) return rotation ? slerp(key(k), key(k + 1), u) : glm::mix(key(k), key(k + 1), u);
+        const float u2 = u * u, u3 = u2 * u;
+        glm::vec4 v = (2 * u3 - 3 * u2 + 1) * key(k) + (u3 - 2 * u2 + u) * dt * values[3 * k + 2] +
+                      (-2 * u3 + 3 * u2) * key(k + 1) + (u3 - u2) * dt * values[3 * (k + 1)];
+        return rotation ? glm::normalize(v) : v;
+    }
+};
+
+/// The node hierarchy with one animation's tracks: every node's world matrix at any time. Shared
+/// (immutable) by the motion functions of the file's moving parts.
+struct NodeAnimation {
+    std::vector<int> parent;
+    std::vector<glm::mat4> fixed;             ///< local matrix of nodes without tracks
+    std::vector<glm::vec3> t, s;              ///< rest TRS of animated nodes
+    std::vector<glm::vec4> r;
+    std::vector<int> track[3];                ///< translation, rotation, scale: index into tracks, -1 = none
+    std::vector<Track> tracks;
+
+    bool animated(size_t n) const { return track[0][n] >= 0 || track[1][n] >= 0 || track[2][n] >= 0; }
+    glm::mat4 local(size_t n, double time) const {
+        if (!animated(n)) return fixed[n];
+        auto value = [&](int slot, glm::vec4 rest) { return track[slot][n] >= 0 ? tracks[size_t(track[slot][n])].at(time) : rest; };
+        return trsMatrix(glm::vec3(value(0, glm::vec4(t[n], 0))), value(1, r[n]), glm::vec3(value(2, glm::vec4(s[n], 0))));
+    }
+    glm::mat4 world(size_t n, double time) const {
+        glm::mat4 m = local(n, time);
+        for (int p = parent[n]; p != -1; p = parent[size_t(p)]) m = local(size_t(p), time) * m;
+        return m;
+    }
+};
+
 class Loader {
 public:
-    Loader(const std::string& file, const tinygltf::Model& model, size_t maxTriangles)
-        : file_(file), m_(model), maxTriangles_(maxTriangles) {}
+    Loader(const std::string& file, const tinygltf::Model& model, size_t maxTriangles, std::string animation = {})
+        : file_(file), m_(model), maxTriangles_(maxTriangles), animation_(std::move(animation)) {}
 
     Scene run(GltfStats* stats);
 
@@ -258,6 +333,10 @@ private:
     Material material(int index) const;
     glm::mat4 localMatrix(const tinygltf::Node& n) const;
     size_t emitPrimitive(Scene& scene, size_t meshIndex, size_t primIndex, const glm::mat4& world);
+    /// The chosen animation's tracks (nullptr when none is chosen); fills the time range.
+    std::shared_ptr<const NodeAnimation> readAnimation();
+    Track readTrack(const tinygltf::AnimationSampler& sampler, const std::string& path, bool rotation);
+    std::vector<float> floats(int accessor, int type, const std::string& path);
 
     const std::string& file_;
     const tinygltf::Model& m_;
@@ -266,7 +345,106 @@ private:
     std::vector<int> parent_;
     std::map<int, std::vector<glm::vec3>> positionCache_;
     size_t skipped_ = 0;  // primitive instances without triangles (points, lines, no POSITION)
+    std::string animation_;  // "" = none; else a name or a decimal index
+    double animStart_ = 0, animEnd_ = 0;
 };
+
+std::vector<float> Loader::floats(int accessor, int type, const std::string& path) {
+    checkIndex(accessor, m_.accessors, path, "accessor");
+    const auto& a = m_.accessors[size_t(accessor)];
+    if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || a.type != type)
+        fail(path, "accessor " + std::to_string(accessor) + " must be FLOAT " +
+                       (type == TINYGLTF_TYPE_SCALAR ? "SCALAR" : type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "VEC4") +
+                       " (quantized animation data needs KHR_mesh_quantization, not supported)");
+    std::vector<unsigned char> bytes = gather(accessor);
+    std::vector<float> out(bytes.size() / sizeof(float));
+    std::memcpy(out.data(), bytes.data(), out.size() * sizeof(float));
+    for (float v : out)
+        if (!std::isfinite(v)) fail(path, "accessor " + std::to_string(accessor) + " holds a non-finite value");
+    return out;
+}
+
+Track Loader::readTrack(const tinygltf::AnimationSampler& sampler, const std::string& path, bool rotation) {
+    Track tr;
+    tr.rotation = rotation;
+    if (sampler.interpolation == "STEP") tr.mode = Track::Step;
+    else if (sampler.interpolation == "CUBICSPLINE") tr.mode = Track::Cubic;
+    else if (!sampler.interpolation.empty() && sampler.interpolation != "LINEAR")
+        fail(path + "/interpolation", "unknown interpolation \"" + sampler.interpolation.substr(0, 40) + "\"");
+    tr.times = floats(sampler.input, TINYGLTF_TYPE_SCALAR, path + "/input");
+    if (tr.times.empty()) fail(path + "/input", "an animation sampler needs at least one key");
+    for (size_t k = 1; k < tr.times.size(); ++k)
+        if (!(tr.times[k] > tr.times[k - 1])) fail(path + "/input", "key times must increase strictly (key " + std::to_string(k) + ")");
+    const int width = rotation ? 4 : 3;
+    std::vector<float> v = floats(sampler.output, rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, path + "/output");
+    const size_t perKey = tr.mode == Track::Cubic ? 3 : 1;
+    if (v.size() != tr.times.size() * perKey * size_t(width))
+        fail(path + "/output", "has " + std::to_string(v.size() / size_t(width)) + " values for " + std::to_string(tr.times.size()) +
+                                   " keys (" + std::to_string(perKey) + " per key expected)");
+    for (size_t i = 0; i < v.size(); i += size_t(width)) {
+        glm::vec4 x(v[i], v[i + 1], v[i + 2], width == 4 ? v[i + 3] : 0.0f);
+        if (rotation && (perKey == 1 || i / 4 % 3 == 1) && !(glm::length(x) > 0.0f))
+            fail(path + "/output", "a rotation key is the zero quaternion");
+        tr.values.push_back(x);
+    }
+    return tr;
+}
+
+std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
+    if (animation_.empty()) return nullptr;
+    size_t chosen = m_.animations.size();
+    for (size_t i = 0; i < m_.animations.size(); ++i)
+        if (m_.animations[i].name == animation_) chosen = i;
+    if (chosen == m_.animations.size() && !animation_.empty() &&
+        std::all_of(animation_.begin(), animation_.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }) &&
+        animation_.size() < 10 && std::stoul(animation_) < m_.animations.size())
+        chosen = std::stoul(animation_);
+    if (chosen == m_.animations.size()) {
+        std::string names;
+        for (size_t i = 0; i < m_.animations.size() && i < 8; ++i)
+            names += (i ? ", " : "") + std::to_string(i) + (m_.animations[i].name.empty() ? "" : " \"" + m_.animations[i].name.substr(0, 30) + "\"");
+        fail("/animations", "no animation \"" + animation_.substr(0, 40) + "\" (the file has " +
+                                (m_.animations.empty() ? std::string("none") : std::to_string(m_.animations.size()) + ": " + names) + ")");
+    }
+    for (size_t i = 0; i < m_.nodes.size(); ++i)
+        if (m_.nodes[i].skin != -1 && m_.nodes[i].mesh != -1)
+            fail(at("nodes", i) + "/skin", "skinned meshes are not supported: only node (rigid) animation is played");
+    auto anim = std::make_shared<NodeAnimation>();
+    const size_t n = m_.nodes.size();
+    anim->parent = parent_;
+    anim->fixed.resize(n);
+    anim->t.resize(n), anim->r.resize(n), anim->s.resize(n);
+    for (auto& slot : anim->track) slot.assign(n, -1);
+    for (size_t i = 0; i < n; ++i) {
+        const auto& node = m_.nodes[i];
+        anim->fixed[i] = localMatrix(node);
+        anim->t[i] = node.translation.size() == 3 ? glm::vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])) : glm::vec3(0.0f);
+        anim->r[i] = node.rotation.size() == 4 ? glm::vec4(float(node.rotation[0]), float(node.rotation[1]), float(node.rotation[2]), float(node.rotation[3])) : glm::vec4(0, 0, 0, 1);
+        anim->s[i] = node.scale.size() == 3 ? glm::vec3(float(node.scale[0]), float(node.scale[1]), float(node.scale[2])) : glm::vec3(1.0f);
+    }
+    const auto& a = m_.animations[chosen];
+    const std::string base = at("animations", chosen);
+    animStart_ = 1e300, animEnd_ = -1e300;
+    for (size_t c = 0; c < a.channels.size(); ++c) {
+        const auto& ch = a.channels[c];
+        const std::string path = base + "/channels/" + std::to_string(c);
+        checkIndex(ch.target_node, m_.nodes, path + "/target/node", "node");
+        checkIndex(ch.sampler, a.samplers, path + "/sampler", "sampler");
+        const std::string& what = ch.target_path;
+        if (what == "weights") fail(path + "/target/path", "morph target animation (weights) is not supported: only node (rigid) animation is played");
+        const int slot = what == "translation" ? 0 : what == "rotation" ? 1 : what == "scale" ? 2 : -1;
+        if (slot < 0) fail(path + "/target/path", "unknown animated property \"" + what.substr(0, 40) + "\"");
+        if (m_.nodes[size_t(ch.target_node)].matrix.size() == 16)
+            fail(path + "/target/node", "node " + std::to_string(ch.target_node) + " has a matrix; glTF animates only nodes given by TRS");
+        Track tr = readTrack(a.samplers[size_t(ch.sampler)], base + "/samplers/" + std::to_string(ch.sampler), slot == 1);
+        animStart_ = std::min(animStart_, double(tr.times.front()));
+        animEnd_ = std::max(animEnd_, double(tr.times.back()));
+        anim->track[slot][size_t(ch.target_node)] = int(anim->tracks.size());
+        anim->tracks.push_back(std::move(tr));
+    }
+    if (anim->tracks.empty()) animStart_ = animEnd_ = 0;
+    return anim;
+}
 
 void Loader::validateStructure() {
     // These extensions replace or add geometry; loading without them would silently give wrong shapes.
@@ -490,14 +668,10 @@ glm::mat4 Loader::localMatrix(const tinygltf::Node& n) const {
     if (n.translation.size() == 3)
         t[3] = glm::vec4(float(n.translation[0]), float(n.translation[1]), float(n.translation[2]), 1.0f);
     if (n.rotation.size() == 4) {
-        // Quaternion (x, y, z, w) to matrix, written out to avoid any doubt about glm's quat argument order.
         double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
                                n.rotation[3] * n.rotation[3]);
-        float x = float(n.rotation[0] / len), y = float(n.rotation[1] / len), z = float(n.rotation[2] / len),
-              w = float(n.rotation[3] / len);
-        r[0] = glm::vec4(1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y), 0);
-        r[1] = glm::vec4(2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x), 0);
-        r[2] = glm::vec4(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y), 0);
+        r = rotationMatrix(glm::vec4(float(n.rotation[0] / len), float(n.rotation[1] / len), float(n.rotation[2] / len),
+                                     float(n.rotation[3] / len)));
     }
     if (n.scale.size() == 3)
         s = glm::mat4(glm::vec4(float(n.scale[0]), 0, 0, 0), glm::vec4(0, float(n.scale[1]), 0, 0),
@@ -586,24 +760,40 @@ Scene Loader::run(GltfStats* stats) {
     Scene scene;
     GltfStats counts;
     std::vector<bool> meshCounted(m_.meshes.size(), false);
+    std::shared_ptr<const NodeAnimation> anim = readAnimation();
     for (int root : roots) {
-        std::vector<std::pair<int, glm::mat4>> stack{{root, glm::mat4(1.0f)}};
+        // (node, parent's world matrix, whether the node or an ancestor is animated)
+        std::vector<std::tuple<int, glm::mat4, bool>> stack{{root, glm::mat4(1.0f), false}};
         while (!stack.empty()) {
-            auto [node, parentMatrix] = stack.back();
+            auto [node, parentMatrix, moving] = stack.back();
             stack.pop_back();
             const auto& n = m_.nodes[size_t(node)];
             glm::mat4 world = parentMatrix * localMatrix(n);
+            moving = moving || (anim && anim->animated(size_t(node)));
             if (n.mesh != -1) {
+                // A moving node's triangles stay in mesh space; its part is posed by the animation.
+                const size_t first = scene.triangleCount();
                 size_t meshTris = 0;
                 for (size_t pi = 0; pi < m_.meshes[size_t(n.mesh)].primitives.size(); ++pi)
-                    meshTris += emitPrimitive(scene, size_t(n.mesh), pi, world);
+                    meshTris += emitPrimitive(scene, size_t(n.mesh), pi, moving ? glm::mat4(1.0f) : world);
+                if (moving && scene.triangleCount() > first) {
+                    MovingPart part;
+                    part.firstTriangle = first;
+                    part.triangleCount = scene.triangleCount() - first;
+                    part.local.assign(scene.positions.begin() + ptrdiff_t(3 * first), scene.positions.end());
+                    part.worldFromLocal = [anim, node = size_t(node)](double time) { return anim->world(node, time); };
+                    part.startTime = animStart_;
+                    part.endTime = animEnd_;
+                    scene.moving.push_back(std::move(part));
+                }
                 counts.instanceTriangles += meshTris;
                 if (!meshCounted[size_t(n.mesh)]) counts.meshTriangles += meshTris;
                 meshCounted[size_t(n.mesh)] = true;
             }
-            for (int c : n.children) stack.emplace_back(c, world);
+            for (int c : n.children) stack.emplace_back(c, world, moving);
         }
     }
+    if (scene.dynamic()) scene.applyPose(scene.poseAt(0.0));
     if (stats) *stats = counts;
     if (scene.triangleCount() == 0) {
         std::string why = counts.instanceTriangles ? " (all " + std::to_string(counts.instanceTriangles) + " are degenerate)"
@@ -619,6 +809,10 @@ Scene Loader::run(GltfStats* stats) {
 Scene loadGltf(const std::string& file) { return loadGltf(file, nullptr); }
 
 Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles) {
+    return loadGltf(file, stats, maxTriangles, "");
+}
+
+Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const std::string& animation) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, "", "cannot open file");
     std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -651,7 +845,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles) {
         std::string cause = oneLine(err + "\n" + warn);
         throw InputError(file, "", cause.empty() ? std::string("tinygltf could not load the file") : cause);
     }
-    return Loader(file, model, maxTriangles).run(stats);
+    return Loader(file, model, maxTriangles, animation).run(stats);
 }
 
 } // namespace shadowlab

@@ -26,5 +26,10 @@ struct GltfStats {
 /// is an InputError raised before they are allocated (a few nodes instancing a big mesh can ask
 /// for billions).
 Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles = 200'000'000);
+/// As above, playing the file's animation `animation` (its name, else its index; "" = none): the
+/// meshes of animated nodes (or of nodes below one) become moving parts posed by its translation,
+/// rotation and scale channels (LINEAR, STEP, CUBICSPLINE) on the file's own clock, in seconds.
+/// Skinned meshes and morph-target (weights) channels are an InputError, as is an unknown name.
+Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const std::string& animation);
 
 } // namespace shadowlab

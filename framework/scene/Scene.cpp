@@ -34,23 +34,128 @@ void Scene::append(const Scene& other, const glm::mat4& m) {
         normals.reserve(want / 3);
         materialIds.reserve(want / 3);
     }
+    // Moving triangles are always kept (their local copies are what they are) and their parts
+    // carried over with `m` composed onto their motion; they are posed at time 0 at the end.
+    std::vector<int> partOf(other.triangleCount(), -1);
+    for (size_t p = 0; p < other.moving.size(); ++p)
+        std::fill_n(partOf.begin() + ptrdiff_t(other.moving[p].firstTriangle), other.moving[p].triangleCount, int(p));
+    std::vector<size_t> partStart(other.moving.size(), 0);
     for (size_t t = 0; t < other.triangleCount(); ++t) {
         glm::vec3 v[3];
         for (int k = 0; k < 3; ++k) v[k] = glm::vec3(m * glm::vec4(other.positions[3 * t + k], 1.0f));
         if (mirrored) std::swap(v[1], v[2]);
         glm::vec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
         float len = glm::length(n);
-        if (!(len > 0.0f) || !std::isfinite(len)) continue;
+        const bool moves = partOf[t] >= 0;
+        if (!moves && (!(len > 0.0f) || !std::isfinite(len))) continue;
+        if (moves && other.moving[size_t(partOf[t])].firstTriangle == t) partStart[size_t(partOf[t])] = triangleCount();
         positions.insert(positions.end(), {v[0], v[1], v[2]});
-        normals.push_back(n / len);
+        normals.push_back(len > 0.0f ? n / len : glm::vec3(0, 1, 0));
         materialIds.push_back(matBase + other.materialIds[t]);
-        for (auto& p : v) bounds.extend(p);
+        for (auto& p : v) {
+            bounds.extend(p);
+            if (!moves) staticBounds.extend(p);
+        }
+    }
+    if (other.moving.empty()) return;
+    for (size_t p = 0; p < other.moving.size(); ++p) {
+        MovingPart part = other.moving[p];
+        part.firstTriangle = partStart[p];
+        MotionFn inner = part.worldFromLocal;
+        part.worldFromLocal = [inner, m](double time) { return m * inner(time); };
+        // Posed from its local copy with the composed matrix, exactly as every later frame is.
+        const glm::mat4 rest = part.worldFromLocal(0.0);
+        for (size_t i = 0; i < part.triangleCount; ++i) {
+            const size_t t = part.firstTriangle + i;
+            poseTriangle(rest, &part.local[3 * i], &positions[3 * t], normals[t]);
+            for (int k = 0; k < 3; ++k) bounds.extend(positions[3 * t + size_t(k)]);
+        }
+        moving.push_back(std::move(part));
     }
 }
 
 void Scene::updateBounds() {
     bounds = Bounds{};
     for (const auto& p : positions) bounds.extend(p);
+    staticBounds = Bounds{};
+    size_t next = 0; // triangles before moving[k] are static
+    auto addStatic = [&](size_t from, size_t to) {
+        for (size_t i = 3 * from; i < 3 * to; ++i) staticBounds.extend(positions[i]);
+    };
+    for (const MovingPart& part : moving) {
+        addStatic(next, part.firstTriangle);
+        next = part.firstTriangle + part.triangleCount;
+    }
+    addStatic(next, triangleCount());
+}
+
+std::vector<glm::mat4> Scene::poseAt(double time) const {
+    std::vector<glm::mat4> pose;
+    pose.reserve(moving.size());
+    for (const MovingPart& part : moving) pose.push_back(part.worldFromLocal(time));
+    return pose;
+}
+
+void Scene::applyPose(const std::vector<glm::mat4>& pose) {
+    for (size_t p = 0; p < moving.size(); ++p) {
+        const MovingPart& part = moving[p];
+        for (size_t i = 0; i < part.triangleCount; ++i) {
+            const size_t t = part.firstTriangle + i;
+            poseTriangle(pose[p], &part.local[3 * i], &positions[3 * t], normals[t]);
+        }
+    }
+    updateBounds();
+}
+
+Bounds Scene::boundsAt(const std::vector<glm::mat4>& pose) const {
+    Bounds b = staticBounds;
+    for (size_t p = 0; p < moving.size(); ++p) {
+        Bounds local;
+        for (const glm::vec3& v : moving[p].local) local.extend(v);  // cheap next to the GPU pass; parts are small
+        for (int c = 0; c < 8; ++c) {
+            glm::vec3 corner((c & 1) ? local.max.x : local.min.x, (c & 2) ? local.max.y : local.min.y,
+                             (c & 4) ? local.max.z : local.min.z);
+            b.extend(glm::vec3(pose[p] * glm::vec4(corner, 1.0f)));
+        }
+    }
+    return b;
+}
+
+glm::dvec2 Scene::motionTimeRange() const {
+    if (moving.empty()) return {0, 0};
+    glm::dvec2 r(moving.front().startTime, moving.front().endTime);
+    for (const MovingPart& part : moving) r = {std::min(r.x, part.startTime), std::max(r.y, part.endTime)};
+    return r;
+}
+
+void Scene::attachMotion(const MotionFn& motion, double startTime, double endTime) {
+    std::vector<MovingPart> parts;
+    auto addStaticRun = [&](size_t from, size_t to) {
+        if (from == to) return;
+        MovingPart part;
+        part.firstTriangle = from;
+        part.triangleCount = to - from;
+        part.local.assign(positions.begin() + ptrdiff_t(3 * from), positions.begin() + ptrdiff_t(3 * to));
+        part.worldFromLocal = motion;
+        part.startTime = startTime;
+        part.endTime = endTime;
+        parts.push_back(std::move(part));
+    };
+    size_t next = 0;
+    for (MovingPart& part : moving) {
+        addStaticRun(next, part.firstTriangle);
+        next = part.firstTriangle + part.triangleCount;
+        MotionFn inner = part.worldFromLocal;
+        part.worldFromLocal = [inner, motion](double time) { return motion(time) * inner(time); };
+        part.startTime = std::min(part.startTime, startTime);
+        part.endTime = std::max(part.endTime, endTime);
+        parts.push_back(std::move(part));
+    }
+    addStaticRun(next, triangleCount());
+    std::sort(parts.begin(), parts.end(),
+              [](const MovingPart& a, const MovingPart& b) { return a.firstTriangle < b.firstTriangle; });
+    moving = std::move(parts);
+    applyPose(poseAt(0.0));
 }
 
 uint64_t Scene::contentHash() const {
@@ -63,6 +168,11 @@ uint64_t Scene::contentHash() const {
     mix(positions.data(), positions.size() * sizeof(glm::vec3));
     mix(materialIds.data(), materialIds.size() * sizeof(uint32_t));
     mix(materials.data(), materials.size() * sizeof(Material));
+    // Which triangles move changes what may be precomputed over them (clusters never span parts).
+    for (const MovingPart& part : moving) {
+        mix(&part.firstTriangle, sizeof part.firstTriangle);
+        mix(&part.triangleCount, sizeof part.triangleCount);
+    }
     return h;
 }
 

@@ -1,6 +1,10 @@
 #pragma once
 // The scene as every algorithm sees it: one world-space triangle soup with per-triangle normals
 // and materials, plus bounds. Built once from the config (glTF files and procedural generators).
+// Some triangle ranges may move rigidly (MovingPart); their positions here are the rest pose, the
+// pose at time 0, and SceneGpu poses them per frame.
+#include "framework/scene/Motion.h"
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
@@ -30,16 +34,34 @@ struct Scene {
     std::vector<glm::vec3> normals;       ///< 1 per triangle, unit length (geometric, from the winding)
     std::vector<uint32_t> materialIds;    ///< 1 per triangle, index into materials
     std::vector<Material> materials;
-    Bounds bounds;
+    Bounds bounds;            ///< of every triangle as posed in `positions`
+    Bounds staticBounds;      ///< of the triangles outside moving parts
+    std::vector<MovingPart> moving; ///< disjoint, by increasing firstTriangle
+    bool hasTimeRange = false;       ///< the config's "time_range": the clock the frames sample
+    glm::dvec2 timeRange{0.0};
 
     size_t triangleCount() const { return normals.size(); }
+    bool dynamic() const { return !moving.empty(); }
+    /// Each moving part's world matrix at `time`.
+    std::vector<glm::mat4> poseAt(double time) const;
+    /// Rewrites the moving parts' positions and normals for `pose` (poseAt()), and the bounds.
+    void applyPose(const std::vector<glm::mat4>& pose);
+    /// The bounds with the parts at `pose`: the static bounds joined with each part's local box
+    /// under its matrix (a box around the posed triangles, cheap enough for every frame).
+    Bounds boundsAt(const std::vector<glm::mat4>& pose) const;
+    /// [start, end] of all motion (both 0 for a static scene).
+    glm::dvec2 motionTimeRange() const;
+    /// Turns every triangle outside a moving part into parts moving with `motion` (their current
+    /// positions are their local ones) and composes `motion` onto the existing parts; then poses
+    /// the scene at time 0.
+    void attachMotion(const MotionFn& motion, double startTime, double endTime);
 
     /// Appends triangles (already in world space) using `material`; degenerate triangles
     /// (zero area) are dropped since they cast no shadow and have no normal.
     void addTriangles(const std::vector<glm::vec3>& triPositions, const Material& material);
     /// Appends another scene, transformed by `m`.
     void append(const Scene& other, const glm::mat4& m);
-    /// Recomputes bounds from positions.
+    /// Recomputes bounds (and staticBounds) from positions.
     void updateBounds();
     /// A 64-bit content hash (positions and materials), for on-disk caches keyed by scene content.
     uint64_t contentHash() const;

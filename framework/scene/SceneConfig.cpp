@@ -1,11 +1,18 @@
 // The "scene" object of a config (full reference with examples: docs/scene.md).
 //
 //   {"objects": [OBJECT, ...],                                   at least one object
-//    "max_triangles": 20000000}                                  budget of the whole scene (1..200,000,000),
+//    "max_triangles": 20000000,                                  budget of the whole scene (1..200,000,000),
 //                                                                 checked before anything that size is built
-//   OBJECT = {"gltf": "file.glb", "transform": T, "material": M}  path relative to the config file;
-//                                                                 M replaces the file's materials only if given
+//    "time_range": [start, end]}                                 the clock the frames sample uniformly (default:
+//                                                                 the camera path's, else the light path's, else
+//                                                                 the span of the objects' motion)
+//   OBJECT = {"gltf": "file.glb", "transform": T, "material": M,  path relative to the config file;
+//             "animation": NAME or INDEX}                         M replaces the file's materials only if given;
+//                                                                 the animation's node channels move its nodes
 //          | {"procedural": KIND, ...generator keys..., "transform": T, "material": M}
+//     either may carry "path": P, which moves it rigidly: world(t) = P(t) · T · object
+//   P = {"keyframes": [{"time": s, "translate": [0, 0, 0], "rotate_deg": [0, 0, 0], "scale": 1 or [sx, sy, sz] (> 0)}, ...],
+//        "interpolation": "catmull_rom" (default) | "linear" | "step"}
 //   KIND and its keys (lengths in scene units, metres by convention):
 //     plane     size [w, d] = [10, 10] (> 0), subdivisions = 1 (1..4096)      2·subdivisions² triangles
 //     sphere    radius = 1, triangles = 2000                                  UV sphere at the origin
@@ -26,6 +33,7 @@
 // loaded, so a typo in the last object fails at once instead of after building a 10 M triangle sphere.
 #include "framework/scene/SceneConfig.h"
 
+#include "framework/core/JsonParse.h"
 #include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
 
@@ -35,6 +43,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <utility>
 
 namespace shadowlab {
@@ -72,7 +81,7 @@ struct Transform {
 
 Transform readTransform(JsonNode node) {
     glm::vec3 translate = node.getPoint("translate", glm::vec3(0.0f));
-    glm::vec3 rot = glm::radians(node.getVec3("rotate_deg", glm::vec3(0.0f)));
+    glm::vec3 rotDeg = node.getVec3("rotate_deg", glm::vec3(0.0f));
     glm::vec3 scale(1.0f);
     // "scale" is a number or three numbers; JsonNode has no getter for "either", so dispatch on the type.
     const Json* raw = node.has("scale") ? &node.raw().at("scale") : nullptr;
@@ -83,15 +92,19 @@ Transform readTransform(JsonNode node) {
     Transform t;
     t.fitSize = float(node.getFloat("fit_size", 0.0, 0.0));
     node.finish();
-    glm::mat4 r = glm::rotate(glm::mat4(1.0f), rot.z, {0, 0, 1}) * glm::rotate(glm::mat4(1.0f), rot.y, {0, 1, 0}) *
-                  glm::rotate(glm::mat4(1.0f), rot.x, {1, 0, 0});
-    t.matrix = glm::translate(glm::mat4(1.0f), translate) * r * glm::scale(glm::mat4(1.0f), scale);
+    t.matrix = composeTransform(translate, rotDeg, scale);
     return t;
 }
 
 /// Transforms a scene in place (no second copy of a big scene), with Scene::append's rules:
 /// mirroring flips the winding back, triangles that become degenerate are dropped.
 void transformInPlace(Scene& s, const glm::mat4& m) {
+    if (s.dynamic()) {  // moving triangles are never dropped and their motions take `m`: append's rules
+        Scene out;
+        out.append(s, m);
+        s = std::move(out);
+        return;
+    }
     bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;
     size_t kept = 0;
     for (size_t t = 0; t < s.triangleCount(); ++t) {
@@ -214,9 +227,17 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         std::error_code ec;
         if (!std::filesystem::is_regular_file(path, ec)) node.fail("gltf", "glTF file not found: " + path);
         std::string where = node.file() + " at " + node.childPath("gltf");
-        build = [path, where, budget] {
+        std::string animation;  // a name, or an index written as a decimal string
+        if (node.has("animation")) {
+            const Json& raw = node.raw().at("animation");
+            if (raw.is_number_integer() && raw.get<int64_t>() >= 0) animation = std::to_string(raw.get<int64_t>());
+            else if (raw.is_string() && !raw.get<std::string>().empty()) animation = raw.get<std::string>();
+            else node.fail("animation", "expected an animation's name or index, got " + shortDump(raw));
+            node.markRead("animation");
+        }
+        build = [path, where, budget, animation] {
             try {
-                return loadGltf(path, nullptr, size_t(budget));
+                return loadGltf(path, nullptr, size_t(budget), animation);
             } catch (const InputError& e) {
                 // Still an error about the glTF file; the suffix says which config entry asked for it.
                 throw InputError(e.file(), e.jsonPath(), e.cause() + " (loaded from " + where + ")");
@@ -227,6 +248,8 @@ Builder parseObject(JsonNode node, int depth, int budget) {
     }
     JsonNode transformNode = node.child("transform");
     Transform transform = readTransform(transformNode);
+    std::optional<RigidPath> path;
+    if (node.has("path")) path = RigidPath::parse(node.child("path"));
     node.finish();
 
     return [=]() mutable {
@@ -243,6 +266,8 @@ Builder parseObject(JsonNode node, int depth, int budget) {
             m = m * glm::scale(glm::mat4(1.0f), glm::vec3(k)) * glm::translate(glm::mat4(1.0f), -anchor);
         }
         if (m != glm::mat4(1.0f)) transformInPlace(s, m);
+        // The path moves the placed object: world(t) = path(t) · transform · object.
+        if (path) s.attachMotion([p = *path](double time) { return p.at(time); }, path->startTime(), path->endTime());
         checkBuilt(s, node);
         return s;
     };
@@ -254,6 +279,8 @@ Builder parseObject(JsonNode node, int depth, int budget) {
 /// or loaded yet.
 struct ParsedScene {
     int budget;
+    bool hasTimeRange = false;
+    glm::dvec2 timeRange{0.0};
     std::vector<JsonNode> objects;
     std::vector<Builder> builders;
 };
@@ -261,6 +288,12 @@ struct ParsedScene {
 static ParsedScene parseScene(JsonNode& sceneNode) {
     ParsedScene p;
     p.budget = sceneNode.getInt("max_triangles", kDefaultMaxTriangles, 1, kMaxTrianglesCeiling);
+    if (sceneNode.has("time_range")) {
+        glm::vec2 r = sceneNode.getVec2("time_range", glm::vec2(0.0f));
+        if (!(r.y >= r.x)) sceneNode.fail("time_range", "expected [start, end] with end >= start");
+        p.hasTimeRange = true;
+        p.timeRange = glm::dvec2(r);
+    }
     p.objects = sceneNode.objectArray("objects");
     for (JsonNode& object : p.objects) p.builders.push_back(parseObject(object, 0, p.budget));
     sceneNode.finish();
@@ -297,6 +330,8 @@ Scene buildScene(JsonNode sceneNode) {
         scene.append(s, glm::mat4(1.0f));
     }
     scene.updateBounds();
+    scene.hasTimeRange = parsed.hasTimeRange;
+    scene.timeRange = parsed.timeRange;
     return scene;
 }
 
