@@ -40,6 +40,30 @@ static std::string num(double v) {
     return os.str();
 }
 
+namespace {
+
+/// Every stage any frame ran, in the order they run ("total" last): stages that run only on some
+/// frames (a refit when parts moved) count as taking 0 ms on the others, so each stage's statistics
+/// are per frame, like the total they add up to.
+std::vector<std::string> stageOrder(const AlgorithmResults& a) {
+    std::vector<std::string> order;
+    for (const auto& f : a.frames)
+        for (size_t i = 0; i < f.stages.size(); ++i) {
+            const std::string& name = f.stages[i].name;
+            if (std::find(order.begin(), order.end(), name) != order.end()) continue;
+            // After the stage that ran before it in this frame, else first.
+            auto at = order.begin();
+            if (i > 0) {
+                auto prev = std::find(order.begin(), order.end(), f.stages[i - 1].name);
+                if (prev != order.end()) at = prev + 1;
+            }
+            order.insert(at, name);
+        }
+    return order;
+}
+
+} // namespace
+
 void ExperimentResults::writeFramesCsv(const std::string& path) const {
     std::set<std::string> counterNames;
     for (const auto& a : algorithms)
@@ -80,11 +104,17 @@ Json ExperimentResults::summary() const {
         std::map<std::string, std::vector<double>> counters;
         std::vector<double> mismatch, falseLit, falseShadowed, rmse;
         uint64_t overflow = 0;
+        order = stageOrder(a);
         for (const auto& f : a.frames) {
-            for (const auto& s : f.stages) {
-                if (!cpu.count(s.name)) order.push_back(s.name);
-                cpu[s.name].push_back(s.cpuMs);
-                if (s.gpuMs >= 0) gpu[s.name].push_back(s.gpuMs);
+            for (const auto& name : order) {
+                auto s = std::find_if(f.stages.begin(), f.stages.end(), [&](const StageTime& t) { return t.name == name; });
+                if (s == f.stages.end()) {  // did not run this frame: it cost nothing
+                    cpu[name].push_back(0.0);
+                    if (gpu.count(name)) gpu[name].push_back(0.0);
+                    continue;
+                }
+                cpu[name].push_back(s->cpuMs);
+                if (s->gpuMs >= 0) gpu[name].push_back(s->gpuMs);
             }
             for (const auto& [k, v] : f.counters) counters[k].push_back(v);
             if (f.hasAccuracy) {
@@ -157,10 +187,7 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
         os << "| " << a.id << " | " << a.algorithm << " | preprocess | " << std::setprecision(2) << j["preprocess_ms"].get<double>()
            << " | | | |\n";
         // Stages in the order the algorithm ran them (JSON objects sort their keys).
-        std::vector<std::string> stages;
-        if (!a.frames.empty())
-            for (const auto& st : a.frames.front().stages) stages.push_back(st.name);
-        for (const auto& stage : stages) {
+        for (const auto& stage : stageOrder(a)) {
             const Json& st = j["time_ms"][stage];
             os << "| " << a.id << " | " << a.algorithm << " | " << (stage == "total" ? "**total**" : stage) << " | "
                << std::setprecision(3) << st["mean"].get<double>() << " | " << st["min"].get<double>() << " | "

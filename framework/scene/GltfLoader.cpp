@@ -286,10 +286,15 @@ struct NodeAnimation {
     std::vector<glm::vec4> r;
     std::vector<int> track[3];                ///< translation, rotation, scale: index into tracks, -1 = none
     std::vector<Track> tracks;
+    std::vector<MotionFn> extra;              ///< a config's node path, in the node's own frame (empty = none)
 
-    bool animated(size_t n) const { return track[0][n] >= 0 || track[1][n] >= 0 || track[2][n] >= 0; }
+    bool animated(size_t n) const { return track[0][n] >= 0 || track[1][n] >= 0 || track[2][n] >= 0 || extra[n]; }
     glm::mat4 local(size_t n, double time) const {
-        if (!animated(n)) return fixed[n];
+        if (extra[n]) return channels(n, time) * extra[n](time);
+        return channels(n, time);
+    }
+    glm::mat4 channels(size_t n, double time) const {
+        if (track[0][n] < 0 && track[1][n] < 0 && track[2][n] < 0) return fixed[n];
         auto value = [&](int slot, glm::vec4 rest) { return track[slot][n] >= 0 ? tracks[size_t(track[slot][n])].at(time) : rest; };
         return trsMatrix(glm::vec3(value(0, glm::vec4(t[n], 0))), value(1, r[n]), glm::vec3(value(2, glm::vec4(s[n], 0))));
     }
@@ -302,8 +307,8 @@ struct NodeAnimation {
 
 class Loader {
 public:
-    Loader(const std::string& file, const tinygltf::Model& model, size_t maxTriangles, std::string animation = {})
-        : file_(file), m_(model), maxTriangles_(maxTriangles), animation_(std::move(animation)) {}
+    Loader(const std::string& file, const tinygltf::Model& model, size_t maxTriangles, const GltfMotion& motion = {})
+        : file_(file), m_(model), maxTriangles_(maxTriangles), animation_(motion.animation), nodeMotions_(motion.nodes) {}
 
     Scene run(GltfStats* stats);
 
@@ -346,6 +351,7 @@ private:
     std::map<int, std::vector<glm::vec3>> positionCache_;
     size_t skipped_ = 0;  // primitive instances without triangles (points, lines, no POSITION)
     std::string animation_;  // "" = none; else a name or a decimal index
+    std::vector<GltfNodeMotion> nodeMotions_;
     double animStart_ = 0, animEnd_ = 0;
 };
 
@@ -391,7 +397,7 @@ Track Loader::readTrack(const tinygltf::AnimationSampler& sampler, const std::st
 }
 
 std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
-    if (animation_.empty()) return nullptr;
+    if (animation_.empty() && nodeMotions_.empty()) return nullptr;
     size_t chosen = m_.animations.size();
     for (size_t i = 0; i < m_.animations.size(); ++i)
         if (m_.animations[i].name == animation_) chosen = i;
@@ -399,7 +405,7 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         std::all_of(animation_.begin(), animation_.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }) &&
         animation_.size() < 10 && std::stoul(animation_) < m_.animations.size())
         chosen = std::stoul(animation_);
-    if (chosen == m_.animations.size()) {
+    if (chosen == m_.animations.size() && !animation_.empty()) {
         std::string names;
         for (size_t i = 0; i < m_.animations.size() && i < 8; ++i)
             names += (i ? ", " : "") + std::to_string(i) + (m_.animations[i].name.empty() ? "" : " \"" + m_.animations[i].name.substr(0, 30) + "\"");
@@ -410,6 +416,16 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         if (m_.nodes[i].skin != -1 && m_.nodes[i].mesh != -1)
             fail(at("nodes", i) + "/skin", "skinned meshes are not supported: only node (rigid) animation is played");
     auto anim = std::make_shared<NodeAnimation>();
+    anim->extra.resize(m_.nodes.size());
+    animStart_ = 1e300, animEnd_ = -1e300;
+    for (const GltfNodeMotion& nm : nodeMotions_) {
+        if (nm.node >= m_.nodes.size())
+            fail("/nodes", "a node path names node " + std::to_string(nm.node) + ", but the file has " +
+                               std::to_string(m_.nodes.size()) + " nodes");
+        anim->extra[nm.node] = nm.motion;
+        animStart_ = std::min(animStart_, nm.startTime);
+        animEnd_ = std::max(animEnd_, nm.endTime);
+    }
     const size_t n = m_.nodes.size();
     anim->parent = parent_;
     anim->fixed.resize(n);
@@ -422,9 +438,9 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         anim->r[i] = node.rotation.size() == 4 ? glm::vec4(float(node.rotation[0]), float(node.rotation[1]), float(node.rotation[2]), float(node.rotation[3])) : glm::vec4(0, 0, 0, 1);
         anim->s[i] = node.scale.size() == 3 ? glm::vec3(float(node.scale[0]), float(node.scale[1]), float(node.scale[2])) : glm::vec3(1.0f);
     }
+    if (chosen == m_.animations.size()) return anim;  // node paths only
     const auto& a = m_.animations[chosen];
     const std::string base = at("animations", chosen);
-    animStart_ = 1e300, animEnd_ = -1e300;
     for (size_t c = 0; c < a.channels.size(); ++c) {
         const auto& ch = a.channels[c];
         const std::string path = base + "/channels/" + std::to_string(c);
@@ -442,7 +458,7 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         anim->track[slot][size_t(ch.target_node)] = int(anim->tracks.size());
         anim->tracks.push_back(std::move(tr));
     }
-    if (anim->tracks.empty()) animStart_ = animEnd_ = 0;
+    if (animStart_ > animEnd_) animStart_ = animEnd_ = 0;
     return anim;
 }
 
@@ -813,6 +829,12 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles) {
 }
 
 Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const std::string& animation) {
+    GltfMotion motion;
+    motion.animation = animation;
+    return loadGltf(file, stats, maxTriangles, motion);
+}
+
+Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const GltfMotion& motion) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, "", "cannot open file");
     std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -845,7 +867,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
         std::string cause = oneLine(err + "\n" + warn);
         throw InputError(file, "", cause.empty() ? std::string("tinygltf could not load the file") : cause);
     }
-    return Loader(file, model, maxTriangles, animation).run(stats);
+    return Loader(file, model, maxTriangles, motion).run(stats);
 }
 
 } // namespace shadowlab

@@ -2,6 +2,8 @@
 // glTF 2.0 (.gltf and .glb) through tinygltf.
 #include "framework/scene/Scene.h"
 
+#include <vector>
+
 #include <cstddef>
 #include <string>
 
@@ -31,5 +33,18 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles = 
 /// rotation and scale channels (LINEAR, STEP, CUBICSPLINE) on the file's own clock, in seconds.
 /// Skinned meshes and morph-target (weights) channels are an InputError, as is an unknown name.
 Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const std::string& animation);
+
+/// A motion a config gives one node, in the node's own frame (after its local transform): the
+/// meshes at and below the node move with it.
+struct GltfNodeMotion {
+    size_t node = 0;
+    MotionFn motion;
+    double startTime = 0, endTime = 0;
+};
+struct GltfMotion {
+    std::string animation;             ///< "" = none
+    std::vector<GltfNodeMotion> nodes; ///< composed after the animation's channels of each node
+};
+Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const GltfMotion& motion);
 
 } // namespace shadowlab

@@ -7,8 +7,9 @@
 //                                                                 the camera path's, else the light path's, else
 //                                                                 the span of the objects' motion)
 //   OBJECT = {"gltf": "file.glb", "transform": T, "material": M,  path relative to the config file;
-//             "animation": NAME or INDEX}                         M replaces the file's materials only if given;
-//                                                                 the animation's node channels move its nodes
+//             "animation": NAME or INDEX,                         M replaces the file's materials only if given;
+//             "node_paths": [{"node": INDEX, "path": P}, ...]}   the animation's node channels move its nodes; a
+//                                                                 node path moves a node in its own frame
 //          | {"procedural": KIND, ...generator keys..., "transform": T, "material": M}
 //     either may carry "path": P, which moves it rigidly: world(t) = P(t) · T · object
 //   P = {"keyframes": [{"time": s, "translate": [0, 0, 0], "rotate_deg": [0, 0, 0], "scale": 1 or [sx, sy, sz] (> 0)}, ...],
@@ -235,9 +236,23 @@ Builder parseObject(JsonNode node, int depth, int budget) {
             else node.fail("animation", "expected an animation's name or index, got " + shortDump(raw));
             node.markRead("animation");
         }
-        build = [path, where, budget, animation] {
+        GltfMotion motion;
+        motion.animation = animation;
+        for (JsonNode& np : node.objectArray("node_paths")) {
+            GltfNodeMotion nm;
+            if (!np.has("node")) np.fail("node", "required key is missing");
+            if (!np.has("path")) np.fail("path", "required key is missing");
+            nm.node = size_t(np.getInt("node", 0, 0));
+            RigidPath path = RigidPath::parse(np.child("path"));
+            nm.motion = [path](double time) { return path.at(time); };
+            nm.startTime = path.startTime();
+            nm.endTime = path.endTime();
+            np.finish();
+            motion.nodes.push_back(std::move(nm));
+        }
+        build = [path, where, budget, motion] {
             try {
-                return loadGltf(path, nullptr, size_t(budget), animation);
+                return loadGltf(path, nullptr, size_t(budget), motion);
             } catch (const InputError& e) {
                 // Still an error about the glTF file; the suffix says which config entry asked for it.
                 throw InputError(e.file(), e.jsonPath(), e.cause() + " (loaded from " + where + ")");
