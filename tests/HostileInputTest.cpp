@@ -23,6 +23,7 @@ struct BadCase {
     std::string file;                    ///< written to the temp dir as this name
     std::string text;                    ///< its content
     std::vector<std::string> fragments;  ///< each must appear in the error line
+    std::string objectKeys = {};         ///< a scene file: more keys of the config object loading it
 };
 
 std::vector<BadCase> badCases() {
@@ -63,6 +64,20 @@ std::vector<BadCase> badCases() {
          configWith({{"scene", R"({"max_triangles": 1000, "objects": [{"procedural": "grid", "count": [10, 1, 10],
                        "object": {"procedural": "sphere", "triangles": 500}}]})"}}),
          {"/scene/objects/0/count", "max_triangles"}},
+        {"PathScaleZero", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "sphere", "path": {"keyframes": [{"time": 0, "scale": 0}]}}]})"}}),
+         {"/scene/objects/0/path/keyframes/0/scale", "greater than 0"}},
+        {"PathTimesGoBack", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "sphere", "path": {"keyframes": [{"time": 2}, {"time": 1}]}}]})"}}),
+         {"/scene/objects/0/path/keyframes/1/time", "increase strictly"}},
+        {"StaticOnlyAlgorithmOnMovingScene", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "plane"}, {"procedural": "sphere", "path": {"keyframes": [{"time": 0},
+                       {"time": 1, "translate": [1, 0, 0]}]}}]})"},
+                     {"algorithms", R"([{"algorithm": "line_space"}])"}}),
+         {"/algorithms/0/algorithm", "rebuild_every_frame"}},
+        {"GltfAnimationUnknown", "m.gltf", test::triangleGltf({}), {"m.gltf", "/animations", "no animation"}, R"(, "animation": "walk")"},
+        {"GltfNodePathBeyondNodes", "m.gltf", test::triangleGltf({}), {"m.gltf", "node 7"},
+         R"(, "node_paths": [{"node": 7, "path": {"keyframes": [{"time": 0}]}}])"},
         {"GlbWithDeepExtras", "m.glb", test::glbOf(test::triangleGltf({{"extras", deep}})), {"m.glb", "nesting deeper"}},
         {"GltfRequiresUnknownExtension", "m.gltf", test::triangleGltf({{"extensionsRequired", R"(["EXT_imaginary"])"}}),
          {"/extensionsRequired/0", "EXT_imaginary"}},
@@ -85,7 +100,7 @@ TEST_P(HostileInputTest, ExitsTwoWithOneShortLine) {
     std::string config = dir + "/" + c.file;
     if (c.file != "c.json") {  // a scene file: a config that loads it
         config = dir + "/c.json";
-        std::ofstream(config) << test::configWith({{"scene", R"({"objects": [{"gltf": ")" + c.file + R"("}]})"}});
+        std::ofstream(config) << test::configWith({{"scene", R"({"objects": [{"gltf": ")" + c.file + "\"" + c.objectKeys + "}]}"}});
     }
     std::string out;
     // ulimit -v: a case that allocates before it checks fails here instead of passing slowly

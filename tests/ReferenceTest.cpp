@@ -369,7 +369,12 @@ TEST(ReferenceAlgorithm, RegistryEntry) {
         EXPECT_NE(std::find(info.lights.begin(), info.lights.end(), t), info.lights.end()) << toString(t);
     const ParamSchema& schema = info.schema();
     EXPECT_EQ(&schema, &info.schema()); // built once
-    ASSERT_EQ(schema.specs().size(), 2u);
+    ASSERT_EQ(schema.specs().size(), 3u);
+    EXPECT_EQ(info.motion, MotionHandling::Refit);
+    const ParamSpec* motion = schema.find("motion_update");
+    ASSERT_TRUE(motion);
+    EXPECT_EQ(std::get<std::string>(motion->def), "refit");
+    EXPECT_EQ(motion->change, ParamChange::Rebuild);
     const ParamSpec* threads = schema.find("threads");
     const ParamSpec* offset = schema.find("ray_offset");
     ASSERT_TRUE(threads && offset);
