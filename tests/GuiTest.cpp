@@ -197,6 +197,26 @@ TEST(GuiTest, RecordedPathRunsUnchangedAndReproducesTheCamera) {
     }
 }
 
+TEST(GuiTest, PlaysMovingGeometryOnTheRunnersClock) {
+    REQUIRE_GUI(gui);
+    // The windmill config: its rotor and torus move on the camera path's clock; the playback (and
+    // so the scrubber, which sets the same frame) poses them as `shadowlab run` does.
+    const std::string windmill = std::string(SHADOWLAB_SOURCE_DIR) + "/configs/dynamic/windmill.json";
+    std::string dir = test::makeTempDir("gui"), report = dir + "/report.json", out;
+    int rc = runGui(gui + " " + windmill + " --algorithm psv --frame 3 --play --frames 3 --report " + report, out);
+    ASSERT_EQ(rc, 0) << out;
+    ExperimentConfig cfg = loadConfig(windmill, false);
+    Json r = readJson(report);
+    ASSERT_EQ(r["frames"].size(), 3u);
+    for (const Json& f : r["frames"]) {
+        const int frame = f["path_frame"].get<int>();
+        EXPECT_DOUBLE_EQ(f["scene_time"].get<double>(), cfg.sceneTimeAt(frame)) << "frame " << frame;
+        EXPECT_TRUE(f["stages"].contains("scene_update")) << "frame " << frame;
+    }
+    EXPECT_EQ(r["frames"][0]["path_frame"], 3);
+    EXPECT_NE(r["frames"][0]["scene_time"], r["frames"][1]["scene_time"]);
+}
+
 TEST(GuiTest, BadInputIsOneLineAndExitCode2) {
     if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
     // Checked before any window opens, so no X server is needed.

@@ -81,6 +81,7 @@ void FrameReport::add(const Viewer& v) {
     for (const StageTime& st : v.lastStages()) stages[st.name] = {{"gpu_ms", st.gpuMs}, {"cpu_ms", st.cpuMs}};
     const double gpu = sumGpuMs(v.lastStages());
     frames_.push_back({{"path_frame", v.playback.frame},
+                       {"scene_time", v.sceneTime()},
                        {"camera", {{"position", vec(v.camera.position)}, {"target", vec(v.camera.target)}}},
                        {"light", {{"position", vec(v.light.position)}, {"target", vec(v.light.target)}}},
                        {"resolution", {v.resolution().x, v.resolution().y}},

@@ -108,7 +108,8 @@ void Viewer::renderFrame() {
     TimedWork sceneUpdate;
     if (sceneGpu_->dynamic()) sceneUpdate = timeWork(timer_, [&] {
         timer_.begin("scene_update");
-        sceneGpu_->setTime(config_.sceneTimeAt(playback.frame));
+        sceneTime_ = config_.sceneTimeAt(playback.frame);
+        sceneGpu_->setTime(sceneTime_);
         timer_.end();
     });
     gbuffer_->render(*sceneGpu_, camera);

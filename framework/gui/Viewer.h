@@ -68,6 +68,8 @@ public:
 
     /// Reallocates everything that depends on the image size (G-buffer, shading, visibility, algorithm).
     void setResolution(glm::ivec2 resolution);
+    /// The scene clock of the last rendered frame (moving parts are posed at it).
+    double sceneTime() const { return sceneTime_; }
     glm::ivec2 resolution() const { return resolution_; }
 
     /// Renders one frame: G-buffer, the active algorithm's visibility (timed), shading.
@@ -99,6 +101,7 @@ private:
     std::unique_ptr<AlgorithmHost> host_;
 
     glm::ivec2 resolution_{0, 0};
+    double sceneTime_ = 0;
     std::unique_ptr<GBuffer> gbuffer_;
     std::unique_ptr<ShadingPass> shading_;
     StageTimer timer_;
