@@ -44,7 +44,7 @@ void printList(bool json) {
             Json lights = Json::array();
             for (LightType t : a.lights) lights.push_back(toString(t));
             out.push_back({{"name", a.name}, {"summary", a.summary}, {"lights", lights}, {"exact", a.exact},
-                           {"params", a.schema().toJson()}});
+                           {"motion", toString(a.motion)}, {"params", a.schema().toJson()}});
         }
         std::cout << out.dump(2) << "\n";
         return;
@@ -52,7 +52,8 @@ void printList(bool json) {
     for (const auto& a : algorithmRegistry()) {
         std::cout << a.name << " — " << a.summary << "\n  lights:";
         for (LightType t : a.lights) std::cout << " " << toString(t);
-        std::cout << "\n";
+        std::cout << "\n  moving geometry: " << toString(a.motion)
+                  << (a.rebuildParam.empty() ? "" : " (allowed with " + a.rebuildParam + " = true)") << "\n";
         for (const auto& s : a.schema().specs()) {
             std::cout << "  " << s.key << " (" << toString(s.type) << ", default " << toString(s.def);
             if (s.type == ParamType::Int || s.type == ParamType::Float) std::cout << ", range [" << s.min << ", " << s.max << "]";
