@@ -99,10 +99,7 @@ public:
     // refitted on the CPU and uploaded whole; a GPU refit would beat this on big moving sets.
     void sceneMoved(const FrameInputs& f) override {
         f.timer.begin("read_scene");
-        for (const MovingPart& part : scene_->cpu().moving) {
-            std::vector<glm::vec3> v = scene_->readPositions(part.firstTriangle, part.triangleCount);
-            std::copy(v.begin(), v.end(), posed_.begin() + ptrdiff_t(3 * part.firstTriangle));
-        }
+        scene_->readMovingPositions(posed_);
         f.timer.end();
         f.timer.begin("refit", false);
         bvh::refitBvh(tree_, posed_);

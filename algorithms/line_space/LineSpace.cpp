@@ -99,12 +99,7 @@ public:
     // are read back and everything setScene() does is done again on them.
     void sceneMoved(const FrameInputs& f) override {
         f.timer.begin("rebuild", false);
-        posed_ = scene_->cpu();
-        for (const MovingPart& part : posed_.moving) {
-            std::vector<glm::vec3> v = scene_->readPositions(part.firstTriangle, part.triangleCount);
-            std::copy(v.begin(), v.end(), posed_.positions.begin() + ptrdiff_t(3 * part.firstTriangle));
-        }
-        posed_.updateBounds();
+        posed_ = scene_->posedScene();
         build(posed_, false);
         f.timer.end();
     }

@@ -118,16 +118,7 @@ public:
     void sceneMoved(const FrameInputs& f) override {
         if (p_.motion == "recluster") {
             f.timer.begin("recluster", false);
-            posed_ = scene_->cpu();
-            for (const MovingPart& part : posed_.moving) {
-                std::vector<glm::vec3> v = scene_->readPositions(part.firstTriangle, part.triangleCount);
-                std::copy(v.begin(), v.end(), posed_.positions.begin() + ptrdiff_t(3 * part.firstTriangle));
-                for (size_t i = 0; i < part.triangleCount; ++i) {
-                    const glm::vec3* t = &posed_.positions[3 * (part.firstTriangle + i)];
-                    posed_.normals[part.firstTriangle + i] = glm::normalize(glm::cross(t[1] - t[0], t[2] - t[0]));
-                }
-            }
-            posed_.updateBounds();
+            posed_ = scene_->posedScene();
             const bool cache = p_.cache;
             p_.cache = false; // a pose is never seen twice: caching would only write files
             mt::Clustering c = cluster(posed_);
@@ -282,9 +273,7 @@ private:
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
     }
 
-    /// The clustering from the disk cache when allowed and valid, else computed (and cached).
-    mt::Clustering cluster(const Scene& scene) {
-        const auto start = std::chrono::steady_clock::now();
+    mt::ClusteringOptions clusteringOptions() const {
         mt::ClusteringOptions o;
         o.clusterSize = p_.clusterSize;
         o.chunkTriangles = p_.chunkTriangles;
@@ -292,6 +281,13 @@ private:
         o.capsules = p_.capsules;
         o.randomOrder = p_.randomOrder;
         o.seed = uint32_t(p_.seed);
+        return o;
+    }
+
+    /// The clustering from the disk cache when allowed and valid, else computed (and cached).
+    mt::Clustering cluster(const Scene& scene) {
+        const auto start = std::chrono::steady_clock::now();
+        const mt::ClusteringOptions o = clusteringOptions();
         const std::string dir = p_.cache ? mt::cacheDirectory() : std::string();
         const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
         const std::string path = dir.empty() ? std::string() : mt::cacheFile(dir, hash, o);
@@ -310,13 +306,8 @@ private:
     /// cache's validation checks clusters against world positions.
     mt::Clustering clusterByPart(const Scene& scene) {
         const auto start = std::chrono::steady_clock::now();
-        mt::ClusteringOptions o;
-        o.clusterSize = p_.clusterSize;
-        o.chunkTriangles = p_.chunkTriangles;
-        o.kmeansIterations = p_.kmeansIterations;
-        o.capsules = p_.capsules;
+        mt::ClusteringOptions o = clusteringOptions();
         o.randomOrder = false; // shuffled once below, over all groups
-        o.seed = uint32_t(p_.seed);
         mt::Clustering all;
         std::vector<uint32_t> parts;
         auto addGroup = [&](const std::vector<uint32_t>& triangles, const glm::vec3* local, uint32_t part) {

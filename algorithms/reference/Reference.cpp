@@ -38,6 +38,7 @@ public:
     void setScene(const SceneGpu& scene) override {
         tracer_.reset(); // free the old BVH before building the new one
         scene_ = &scene;
+        posed_.clear();
         tracer_ = std::make_unique<EmbreeTracer>(scene.cpu(), p_.motionUpdate == "rebuild"
                                                                   ? EmbreeTracer::MotionUpdate::Rebuild
                                                                   : EmbreeTracer::MotionUpdate::Refit);
@@ -46,14 +47,13 @@ public:
     // The moving triangles are read back from the GPU rather than posed again here, so the ground
     // truth intersects the very floats the G-buffer rasterised.
     void sceneMoved(const FrameInputs& frame) override {
-        const Scene& s = scene_->cpu();
         frame.timer.begin("read_scene");
-        std::vector<std::vector<glm::vec3>> posed;
-        for (const MovingPart& part : s.moving) posed.push_back(scene_->readPositions(part.firstTriangle, part.triangleCount));
+        if (posed_.empty()) posed_ = scene_->cpu().positions;
+        scene_->readMovingPositions(posed_);
         frame.timer.end();
         frame.timer.begin(p_.motionUpdate == "rebuild" ? "rebuild" : "refit", false);
-        for (size_t p = 0; p < s.moving.size(); ++p)
-            tracer_->moveTriangles(s.moving[p].firstTriangle, posed[p].data(), s.moving[p].triangleCount);
+        for (const MovingPart& part : scene_->cpu().moving)
+            tracer_->moveTriangles(part.firstTriangle, &posed_[3 * part.firstTriangle], part.triangleCount);
         tracer_->commitMoves();
         frame.timer.end();
     }
@@ -86,6 +86,7 @@ public:
 private:
     const SceneGpu* scene_ = nullptr;
     std::unique_ptr<EmbreeTracer> tracer_;
+    std::vector<glm::vec3> posed_; ///< moving scenes: the positions as last read back
     ReferenceParams p_;
     std::vector<float> visibility_;
     double rays_ = 0, mraysPerS_ = 0;

@@ -1,5 +1,6 @@
 #include "framework/render/SceneGpu.h"
 
+#include <algorithm>
 #include <cstring>
 
 namespace shadowlab {
@@ -77,6 +78,26 @@ std::vector<glm::vec3> SceneGpu::readPositions(size_t firstTriangle, size_t coun
         glGetNamedBufferSubData(positions_.id(), GLintptr(firstTriangle * 3 * sizeof(glm::vec3)),
                                 GLsizeiptr(out.size() * sizeof(glm::vec3)), out.data());
     return out;
+}
+
+void SceneGpu::readMovingPositions(std::vector<glm::vec3>& positions) const {
+    for (const MovingPart& part : scene_->moving) {
+        std::vector<glm::vec3> v = readPositions(part.firstTriangle, part.triangleCount);
+        std::copy(v.begin(), v.end(), positions.begin() + ptrdiff_t(3 * part.firstTriangle));
+    }
+}
+
+Scene SceneGpu::posedScene() const {
+    Scene s = *scene_;
+    readMovingPositions(s.positions);
+    for (const MovingPart& part : s.moving)
+        for (size_t t = part.firstTriangle; t < part.firstTriangle + part.triangleCount; ++t) {
+            const glm::vec3* v = &s.positions[3 * t];
+            const glm::vec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+            s.normals[t] = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0, 1, 0);
+        }
+    s.updateBounds();
+    return s;
 }
 
 void SceneGpu::setTime(double time) {

@@ -38,6 +38,11 @@ public:
     /// The posed positions of triangles [firstTriangle, firstTriangle + count) read back from the GPU
     /// (3 per triangle): the very floats the G-buffer and the GPU algorithms see, for CPU consumers.
     std::vector<glm::vec3> readPositions(size_t firstTriangle, size_t count) const;
+    /// Overwrites the moving parts' ranges of `positions` (3 per scene triangle) with their posed values.
+    void readMovingPositions(std::vector<glm::vec3>& positions) const;
+    /// The whole scene as posed now, on the CPU (positions, normals and bounds), for algorithms that
+    /// rebuild from scratch at each pose.
+    Scene posedScene() const;
     /// Bytes of the object-space copies and part tables (0 for a static scene).
     size_t motionBytes() const { return local_.size() + movingIndex_.size() + transforms_.size(); }
 
