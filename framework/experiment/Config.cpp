@@ -107,6 +107,19 @@ static void followPath(const Path& path, int frame, int frames, glm::vec3& posit
     target = s.target;
 }
 
+/// Moving parts stay within the coordinates every other input is held to (±kMaxCoordinate) on every
+/// frame the experiment samples: paths and animations compose, so a part checked at rest can still
+/// leave float range (or reach infinity) at another time.
+static void checkPoses(const ExperimentConfig& c) {
+    for (int f = 0; f < c.frames; ++f) {
+        const Bounds b = c.scene->boundsAt(c.scene->poseAt(c.sceneTimeAt(f)));
+        for (int a = 0; a < 3; ++a)
+            if (!(std::abs(double(b.min[a])) <= kMaxCoordinate && std::abs(double(b.max[a])) <= kMaxCoordinate))
+                throw InputError(c.file, "/scene", "moving objects reach beyond ±1e15 scene units at frame " + std::to_string(f) +
+                                                       " (check the paths' translate and scale)");
+    }
+}
+
 Camera ExperimentConfig::cameraAt(int frame) const {
     Camera cam = camera;
     followPath(cameraPath, frame, frames, cam.position, cam.target);
@@ -148,6 +161,7 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     parseCamera(cameraNode, c);
     parseLight(lightNode, c);
     checkViews(c, cameraNode, lightNode);
+    if (c.scene && c.scene->dynamic()) checkPoses(c);
 
     // "reference": true | false | {"params": {...}}
     if (root.has("reference") && root.raw()["reference"].is_object()) {
