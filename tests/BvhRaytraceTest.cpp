@@ -95,6 +95,23 @@ TEST(BvhRaytraceTest, TrianglesAreInLeafOrder) {
             ASSERT_EQ(glm::vec3(t.triangles[3 * i + k]), s.positions[3 * size_t(t.triIndices[i]) + k]) << "triangle " << i;
 }
 
+// Moving parts: the tree keeps its shape, and after a refit every box again holds its triangles
+// (checkTree walks every path) and the leaf-ordered copy is the moved scene's.
+TEST(BvhRaytraceTest, RefitHoldsTheMovedTriangles) {
+    Scene s = objects();
+    bvh::Bvh t = bvh::buildBvh(s);
+    const size_t nodes = t.nodes.size();
+    Scene moved = s;
+    const glm::mat4 m = glm::rotate(glm::translate(glm::mat4(1.0f), {2.5f, 1.0f, -1.0f}), 1.2f, glm::vec3(0, 1, 0));
+    for (size_t i = 3 * 2 * 4 * 4; i < moved.positions.size(); ++i)  // everything but the ground (2·4² triangles) moves
+        moved.positions[i] = glm::vec3(m * glm::vec4(moved.positions[i], 1.0f));
+    bvh::refitBvh(t, moved.positions);
+    EXPECT_EQ(t.nodes.size(), nodes);
+    checkTree(moved, t, 4);
+    for (size_t i = 0; i < t.triIndices.size(); ++i)
+        ASSERT_EQ(glm::vec3(t.triangles[3 * i]), moved.positions[3 * size_t(t.triIndices[i])]) << "triangle " << i;
+}
+
 TEST(BvhRaytraceTest, DegenerateInputs) {
     // Nothing, one triangle, and 50 copies of one triangle (identical centroids: split by count).
     Scene empty;

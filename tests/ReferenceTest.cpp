@@ -1,10 +1,12 @@
 // The reference (EmbreeTracer) against shadows known in closed form: horizontal squares over a
 // ground plane, seen through a synthetic CPU G-buffer whose "pixels" are points on y = 0.
 // No GL: the tracer is GL-free, and the algorithm entry is only inspected, never run.
+#include "framework/core/Error.h"
 #include "framework/reference/EmbreeTracer.h"
 #include "algorithms/reference/Reference.h"
 #include "tests/ShadowTestScenes.h"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -316,6 +318,32 @@ TEST(ReferenceTracer, OccludedAndTransmission) {
     EXPECT_EQ(tracer.transmission({0.2f, 0.5f, -0.1f}, up, 10.0f), 0.5f); // inside one triangle
     EXPECT_EQ(tracer.transmission(o, up, 0.4f), 1.0f);
     EXPECT_EQ(tracer.transmission(o, -up, 10.0f), 0.0f); // the opaque ground
+}
+
+// A scene with a moving part: after moveTriangles + commitMoves the tracer answers for the moved
+// triangles, by refit and by rebuild alike.
+TEST(ReferenceTracer, MovedTrianglesAreTracedWhereTheyMoved) {
+    for (auto update : {EmbreeTracer::MotionUpdate::Refit, EmbreeTracer::MotionUpdate::Rebuild}) {
+        Scene s;
+        s.addTriangles({{-1, 1, -1}, {1, 1, -1}, {0, 1, 1}}, Material{});  // a roof above the origin
+        MovingPart part;
+        part.triangleCount = 1;
+        part.local = s.positions;
+        part.worldFromLocal = [](double t) { return glm::translate(glm::mat4(1.0f), {float(t) * 10.0f, 0, 0}); };
+        s.moving.push_back(part);
+        s.updateBounds();
+        EmbreeTracer tracer(s, update);
+        const glm::vec3 up(0, 1, 0);
+        EXPECT_TRUE(tracer.occluded({0, 0, 0}, up, 5.0f));
+        EXPECT_FALSE(tracer.occluded({10, 0, 0}, up, 5.0f));
+        std::vector<glm::vec3> moved = s.positions;
+        for (glm::vec3& v : moved) v.x += 10.0f;
+        tracer.moveTriangles(0, moved.data(), 1);
+        tracer.commitMoves();
+        EXPECT_FALSE(tracer.occluded({0, 0, 0}, up, 5.0f));
+        EXPECT_TRUE(tracer.occluded({10, 0, 0}, up, 5.0f));
+        EXPECT_THROW(tracer.moveTriangles(1, moved.data(), 1), RuntimeError);
+    }
 }
 
 TEST(ReferenceTracer, EmptySceneIsFullyLit) {
