@@ -170,6 +170,26 @@ TEST(GltfAnimationTest, PlaysNodeChannelsOnTheFilesClock) {
     expectNear(apply(cubic.moving[0].worldFromLocal(0.5), {1, 0, 0}), {1.1f * c, 2, -1.1f * sn});
 }
 
+TEST(GltfAnimationTest, ConfigNodePathsTurnAPartAboutItsCentreOrItsOrigin) {
+    const std::string file = test::makeTempDir("anim") + "/spin.gltf";
+    test::writeAnimatedGltf(file);
+    auto blade = [&](const char* pivot) {
+        Json objects = {{{"gltf", file},
+                         {"node_paths", {{{"node", 1}, {"pivot", pivot},
+                                          {"path", {{"keyframes", {{{"time", 0}}, {{"time", 1}, {"rotate_deg", {0, 90, 0}}}}},
+                                                    {"interpolation", "linear"}}}}}}}};
+        return sceneOf(objects);
+    };
+    // The file's animation is not played; only the blade (node 1, below the hub at y = 2) turns.
+    Scene centre = blade("centre"), origin = blade("origin");
+    ASSERT_EQ(centre.moving.size(), 1u);
+    const glm::vec3 corner(0.3f, 0, -0.25f);
+    // About the blade's centre (1.1, 0, 0): the corner, 0.8 short of it, swings round it.
+    expectNear(apply(centre.moving[0].worldFromLocal(1.0), corner), {1.1f - 0.25f, 2, 0.8f});
+    // About the node's origin (the hub): the whole blade swings round the hub.
+    expectNear(apply(origin.moving[0].worldFromLocal(1.0), corner), {-0.25f, 2, -0.3f});
+}
+
 std::string gltfError(const std::string& file, const std::string& animation) {
     try {
         loadGltf(file, nullptr, 1'000'000, animation);

@@ -5,6 +5,8 @@
 
 #include <tiny_gltf.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -342,6 +344,8 @@ private:
     std::shared_ptr<const NodeAnimation> readAnimation();
     Track readTrack(const tinygltf::AnimationSampler& sampler, const std::string& path, bool rotation);
     std::vector<float> floats(int accessor, int type, const std::string& path);
+    /// Centre of the bounding box of every mesh vertex at or below `node`, in the node's own frame.
+    glm::vec3 subtreeCentre(size_t node);
 
     const std::string& file_;
     const tinygltf::Model& m_;
@@ -354,6 +358,22 @@ private:
     std::vector<GltfNodeMotion> nodeMotions_;
     double animStart_ = 0, animEnd_ = 0;
 };
+
+glm::vec3 Loader::subtreeCentre(size_t node) {
+    Bounds b;
+    std::vector<std::pair<size_t, glm::mat4>> stack{{node, glm::mat4(1.0f)}};
+    while (!stack.empty()) {
+        auto [n, m] = stack.back();
+        stack.pop_back();
+        const auto& nd = m_.nodes[n];
+        if (nd.mesh != -1)
+            for (const auto& prim : m_.meshes[size_t(nd.mesh)].primitives)
+                if (auto it = prim.attributes.find("POSITION"); it != prim.attributes.end())
+                    for (const glm::vec3& p : positions(it->second)) b.extend(glm::vec3(m * glm::vec4(p, 1.0f)));
+        for (int c : nd.children) stack.emplace_back(size_t(c), m * localMatrix(m_.nodes[size_t(c)]));
+    }
+    return b.empty() ? glm::vec3(0.0f) : b.center();
+}
 
 std::vector<float> Loader::floats(int accessor, int type, const std::string& path) {
     checkIndex(accessor, m_.accessors, path, "accessor");
@@ -422,7 +442,17 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         if (nm.node >= m_.nodes.size())
             fail("/nodes", "a node path names node " + std::to_string(nm.node) + ", but the file has " +
                                std::to_string(m_.nodes.size()) + " nodes");
-        anim->extra[nm.node] = nm.motion;
+        if (nm.aboutCentre) {
+            // Spin about the middle of what the node carries, not its frame's origin (which in
+            // many files sits far from the part and would swing it round the scene).
+            const glm::vec3 c = subtreeCentre(nm.node);
+            MotionFn motion = nm.motion;
+            anim->extra[nm.node] = [c, motion](double time) {
+                return glm::translate(glm::mat4(1.0f), c) * motion(time) * glm::translate(glm::mat4(1.0f), -c);
+            };
+        } else {
+            anim->extra[nm.node] = nm.motion;
+        }
         animStart_ = std::min(animStart_, nm.startTime);
         animEnd_ = std::max(animEnd_, nm.endTime);
     }

@@ -40,6 +40,7 @@ struct GltfNodeMotion {
     size_t node = 0;
     MotionFn motion;
     double startTime = 0, endTime = 0;
+    bool aboutCentre = true; ///< about the centre of the node's meshes (else its frame's origin)
 };
 struct GltfMotion {
     std::string animation;             ///< "" = none

@@ -8,8 +8,9 @@
 //                                                                 the span of the objects' motion)
 //   OBJECT = {"gltf": "file.glb", "transform": T, "material": M,  path relative to the config file;
 //             "animation": NAME or INDEX,                         M replaces the file's materials only if given;
-//             "node_paths": [{"node": INDEX, "path": P}, ...]}   the animation's node channels move its nodes; a
-//                                                                 node path moves a node in its own frame
+//             "node_paths": [{"node": INDEX, "path": P,          the animation's node channels move its nodes; a
+//                             "pivot": "centre" | "origin"}]}   node path moves a node in its own frame, about
+//                                                                 the centre of its meshes (or its origin)
 //          | {"procedural": KIND, ...generator keys..., "transform": T, "material": M}
 //     either may carry "path": P, which moves it rigidly: world(t) = P(t) · T · object
 //   P = {"keyframes": [{"time": s, "translate": [0, 0, 0], "rotate_deg": [0, 0, 0], "scale": 1 or [sx, sy, sz] (> 0)}, ...],
@@ -243,6 +244,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
             if (!np.has("node")) np.fail("node", "required key is missing");
             if (!np.has("path")) np.fail("path", "required key is missing");
             nm.node = size_t(np.getInt("node", 0, 0));
+            nm.aboutCentre = np.getEnum("pivot", "centre", {"centre", "origin"}) == "centre";
             RigidPath path = RigidPath::parse(np.child("path"));
             nm.motion = [path](double time) { return path.at(time); };
             nm.startTime = path.startTime();
