@@ -328,7 +328,7 @@ TEST(ReferenceTracer, MovedTrianglesAreTracedWhereTheyMoved) {
         s.addTriangles({{-1, 1, -1}, {1, 1, -1}, {0, 1, 1}}, Material{});  // a roof above the origin
         MovingPart part;
         part.triangleCount = 1;
-        part.local = s.positions;
+        part.setLocal(s.positions);
         part.worldFromLocal = [](double t) { return glm::translate(glm::mat4(1.0f), {float(t) * 10.0f, 0, 0}); };
         s.moving.push_back(part);
         s.updateBounds();

@@ -51,6 +51,9 @@ struct ExperimentConfig {
     Light lightAt(int frame) const;
 };
 
+/// InputError unless the scene posed for `frame` (its bounds `b`) lies within ±1e15 scene units.
+void checkPoseBounds(const ExperimentConfig& config, int frame, const Bounds& b);
+
 /// Limits of camera and light values, shared by the parser and the GUI's widgets (so whatever the
 /// widgets allow can be saved as a config).
 namespace configlimits {

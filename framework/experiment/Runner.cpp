@@ -159,6 +159,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             sceneGpu.setTime(cfg.sceneTimeAt(frame));
             timer.end();
         });
+        if (sceneGpu.dynamic()) checkPoseBounds(cfg, frame, sceneGpu.bounds());
         renderFrame(cam);
         glFinish();
         const CpuGBuffer& g = getCpuG();

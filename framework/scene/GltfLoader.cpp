@@ -826,7 +826,7 @@ Scene Loader::run(GltfStats* stats) {
                     MovingPart part;
                     part.firstTriangle = first;
                     part.triangleCount = scene.triangleCount() - first;
-                    part.local.assign(scene.positions.begin() + ptrdiff_t(3 * first), scene.positions.end());
+                    part.setLocal({scene.positions.begin() + ptrdiff_t(3 * first), scene.positions.end()});
                     part.worldFromLocal = [anim, node = size_t(node)](double time) { return anim->world(node, time); };
                     part.startTime = animStart_;
                     part.endTime = animEnd_;

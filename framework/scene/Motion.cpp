@@ -85,6 +85,14 @@ RigidPath RigidPath::parse(JsonNode node) {
     return RigidPath(std::move(keys), interp);
 }
 
+void MovingPart::setLocal(std::vector<glm::vec3> vertices) {
+    local = std::move(vertices);
+    localMin = glm::vec3(0.0f), localMax = glm::vec3(0.0f);
+    if (local.empty()) return;
+    localMin = localMax = local.front();
+    for (const glm::vec3& v : local) localMin = glm::min(localMin, v), localMax = glm::max(localMax, v);
+}
+
 void poseTriangle(const glm::mat4& m, const glm::vec3* local, glm::vec3* out, glm::vec3& normal) {
     for (int k = 0; k < 3; ++k) out[k] = glm::vec3(m * glm::vec4(local[k], 1.0f));
     if (glm::determinant(glm::mat3(m)) < 0.0f) std::swap(out[1], out[2]);

@@ -60,6 +60,10 @@ struct MovingPart {
     std::vector<glm::vec3> local; ///< 3 per triangle, in the part's own space
     MotionFn worldFromLocal;
     double startTime = 0, endTime = 0; ///< when its motion starts and ends (the default clock)
+    glm::vec3 localMin{0.0f}, localMax{0.0f}; ///< box of `local` (setLocal() keeps it)
+
+    /// Sets the local copy and its box.
+    void setLocal(std::vector<glm::vec3> vertices);
 };
 
 /// Places one triangle of a moving part with matrix `m`: the three vertices, the winding flipped

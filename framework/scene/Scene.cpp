@@ -110,11 +110,9 @@ void Scene::applyPose(const std::vector<glm::mat4>& pose) {
 Bounds Scene::boundsAt(const std::vector<glm::mat4>& pose) const {
     Bounds b = staticBounds;
     for (size_t p = 0; p < moving.size(); ++p) {
-        Bounds local;
-        for (const glm::vec3& v : moving[p].local) local.extend(v);  // cheap next to the GPU pass; parts are small
+        const glm::vec3 lo = moving[p].localMin, hi = moving[p].localMax;
         for (int c = 0; c < 8; ++c) {
-            glm::vec3 corner((c & 1) ? local.max.x : local.min.x, (c & 2) ? local.max.y : local.min.y,
-                             (c & 4) ? local.max.z : local.min.z);
+            const glm::vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
             b.extend(glm::vec3(pose[p] * glm::vec4(corner, 1.0f)));
         }
     }
@@ -135,7 +133,7 @@ void Scene::attachMotion(const MotionFn& motion, double startTime, double endTim
         MovingPart part;
         part.firstTriangle = from;
         part.triangleCount = to - from;
-        part.local.assign(positions.begin() + ptrdiff_t(3 * from), positions.begin() + ptrdiff_t(3 * to));
+        part.setLocal({positions.begin() + ptrdiff_t(3 * from), positions.begin() + ptrdiff_t(3 * to)});
         part.worldFromLocal = motion;
         part.startTime = startTime;
         part.endTime = endTime;
