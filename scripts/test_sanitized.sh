@@ -23,3 +23,7 @@ out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 build-asan/shadowlab run configs/smoke.json --out "$out/smoke" --no-progress
 echo "sanitized smoke run: clean ($out/smoke)"
+# Moving geometry: the GPU pose, the reference's and bvh_raytrace's refits, metric_tree's rigid clusters.
+build-asan/shadowlab run configs/dynamic/cars_fence.json --set resolution=[48,48] --set frames=3 \
+  --set output.images_at_frames=[2] --out "$out/dynamic" --no-progress
+echo "sanitized moving-geometry run: clean ($out/dynamic)"
