@@ -41,6 +41,8 @@ struct RunOptions {
     bool withReference = true;
     /// The frame's side in pixels: kRes unless a test needs a smaller, cheaper frame.
     int resolution = kRes;
+    /// Off: the host's timing mode (AlgorithmOptions::instrumentation), statistics compiled out.
+    bool instrumentation = true;
     /// Debug views read back into AlgorithmRun::views where the algorithm offers them.
     std::vector<std::string> debugViews;
     /// Called after the frame, before the reference, while the algorithm still exists and its

@@ -11,6 +11,7 @@
 #include "tests/TestSupport.h"
 
 #include <cmath>
+#include <cstring>
 #include <ostream>
 
 namespace shadowlab {
@@ -74,6 +75,40 @@ TEST_P(ConformanceGLTest, DefaultsGiveValidVisibilityAndExactOnesMatchTheReferen
         EXPECT_EQ(run.overflow, 0u) << "a fixed-size structure overflowed with the defaults";
         EXPECT_GT(run.accuracy.litPixels, 0u) << "the scene must show lit pixels, or nothing is compared";
         if (c.info->exact) EXPECT_LE(run.accuracy.mismatchRatio, kExactMismatch);
+    }
+}
+
+// Timing mode compiles the statistics out of the shaders; what an algorithm computes must not
+// change: the same visibility bit for bit, the same overflow count, and no debug image left to
+// write in the timed stages.
+TEST_P(ConformanceGLTest, TimingModeGivesBitIdenticalVisibility) {
+    const Case& c = GetParam();
+    for (test::Shot (*scene)() : {&test::intersectingTriangles, &test::thousandsOfTriangles}) {
+        const test::Shot shot = withLight(scene(), c.light);
+        test::RunOptions options;
+        options.resolution = kRes;
+        options.withReference = false;
+        const test::AlgorithmRun instrumented = test::runAlgorithm(*c.info, shot, {}, options);
+        options.instrumentation = false;
+        const test::AlgorithmRun timed = test::runAlgorithm(*c.info, shot, {}, options);
+        ASSERT_EQ(instrumented.visibility.size(), timed.visibility.size());
+        size_t differing = 0;
+        for (size_t i = 0; i < timed.visibility.size(); ++i)
+            differing += std::memcmp(&timed.visibility[i], &instrumented.visibility[i], sizeof(float)) != 0;
+        EXPECT_EQ(differing, 0u) << "pixels whose visibility differs between the two modes";
+        EXPECT_EQ(timed.overflow, instrumented.overflow);
+        EXPECT_TRUE(timed.overflowMask.empty()) << "timing mode still writes the stack_overflow image";
+    }
+}
+
+class ConformanceTimingModeGLTest : public test::GLTest {};
+
+TEST_F(ConformanceTimingModeGLTest, NoDebugViews) {
+    // Every plugin that has statistics drops them, and its debug images, in timing mode.
+    for (const AlgorithmInfo* info : conformingAlgorithms()) {
+        AlgorithmHost host(*info, ParamValues(info->schema()), AlgorithmOptions{false});
+        EXPECT_TRUE(host.algorithm().debugViews().empty()) << info->name;
+        EXPECT_FALSE(host.options().instrumentation);
     }
 }
 

@@ -412,7 +412,7 @@ TEST(ReferenceAlgorithm, RegistryEntry) {
     EXPECT_EQ(offset->max, 1e-2);
     EXPECT_EQ(offset->change, ParamChange::Update);
     // Creating it touches no GL (the tracer is built in setScene()).
-    auto algo = info.create(ParamValues(schema));
+    auto algo = info.create(ParamValues(schema), AlgorithmOptions{});
     ASSERT_TRUE(algo);
     EXPECT_EQ(algo->memoryBytes(), 0u);
 }

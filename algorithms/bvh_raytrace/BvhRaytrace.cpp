@@ -63,7 +63,7 @@ using Clock = std::chrono::steady_clock;
 
 class BvhRaytrace final : public ShadowAlgorithm {
 public:
-    explicit BvhRaytrace(const ParamValues& p) : p_(bvhParams().read(p)) { compile(); }
+    BvhRaytrace(const ParamValues& p, const AlgorithmOptions& o) : p_(bvhParams().read(p)), options_(o) { compile(); }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
@@ -111,6 +111,7 @@ public:
     }
 
     void resize(glm::ivec2 resolution) override {
+        if (!options_.instrumentation) return; // timing mode: no debug images
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
@@ -133,7 +134,8 @@ public:
         triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_TRI_BINDING);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
-        runPixelPass(f, trace_, {&nodesVisited_, &overflow_});
+        if (options_.instrumentation) runPixelPass(f, trace_, {&nodesVisited_, &overflow_});
+        else runPixelPass(f, trace_, {});
         f.timer.end();
         counters_.markStale();
     }
@@ -143,6 +145,17 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(BVH_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
+        if (!options_.instrumentation) // timing mode: the structure and what is still measured
+            return {{"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
+                    {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
+                    {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
+                    {"bvh_nodes", double(nodeCount_)},
+                    {"bvh_leaves", double(leaves_)},
+                    {"bvh_depth", double(depth_)},
+                    {"bvh_sah_cost", sahCost_},
+                    {"bvh_build_ms", buildMs_},
+                    {"node_bytes", double(nodes_.size())},
+                    {"triangle_bytes", double(triangles_.size())}};
         return {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
                 {"nodes_visited_max", double(c[BVH_C_VISITED_MAX])},
                 {"triangles_tested_mean", perRay(wide(BVH_C_TRIS_LO))},
@@ -161,6 +174,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
+        if (!options_.instrumentation) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
     }
 
@@ -179,11 +193,13 @@ public:
 private:
     void compile() {
         const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(p_.stackSize)},
-                                       {"BVH_SHORT_STACK", p_.shortStack ? "1" : "0"}};
+                                       {"BVH_SHORT_STACK", p_.shortStack ? "1" : "0"},
+                                       instrumentationDefine(options_)};
         trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp", defines);
     }
 
     BvhParams p_;
+    AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram trace_;
     GlBuffer nodes_, triangles_, samples_;

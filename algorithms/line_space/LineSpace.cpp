@@ -88,7 +88,10 @@ const ParamSchema& lineSpaceSchema() { return lineSpaceParams().schema(); }
 
 class LineSpace final : public ShadowAlgorithm {
 public:
-    explicit LineSpace(const ParamValues& p) : p_(lineSpaceParams().read(p)) { compile(); }
+    LineSpace(const ParamValues& p, const AlgorithmOptions& o) : p_(lineSpaceParams().read(p)), options_(o) {
+        instrumentParams();
+        compile();
+    }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
@@ -186,11 +189,13 @@ public:
 
     void resize(glm::ivec2 resolution) override {
         resolution_ = resolution;
+        if (!options_.instrumentation) return; // timing mode: no debug image
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         p_ = lineSpaceParams().read(p);
+        instrumentParams();
         // setScene() follows a Rebuild (ShadowAlgorithm.h) and compiles for the new tree's block count.
         // (start_region, a Rebuild, changes a define too.)
         if (change == ParamChange::Rebuild) bitChunks_ = 0;
@@ -230,7 +235,8 @@ public:
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_COUNTER_BINDING);
         if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
-        runPixelPass(f, p, {&nodesVisited_});
+        if (options_.instrumentation) runPixelPass(f, p, {&nodesVisited_});
+        else runPixelPass(f, p, {});
         f.timer.end();
         counters_.markStale();
         classes_.reset();
@@ -245,6 +251,16 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(LS_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
+        if (!options_.instrumentation) // timing mode: the structure and what is still measured
+            return {{"truncated_pixels", double(c[LS_C_TRUNCATED])},
+                    {"subdivided_nodes", double(tree_.nodes.size())},
+                    {"build_ms", tree_.buildMs},
+                    {"cache_hit", cacheHit_ ? 1.0 : 0.0},
+                    {"node_pool_bytes", double(poolBytes_[0])},
+                    {"tree_pool_bytes", double(poolBytes_[1])},
+                    {"line_space_pool_bytes", double(poolBytes_[2])},
+                    {"occupancy_pool_bytes", double(poolBytes_[3])},
+                    {"exact_start_bytes", double(poolBytes_[4])}};
         std::vector<Counter> out = {{"nodes_visited_mean", perRay(wide(LS_C_VISITED_LO))},
                                     {"nodes_visited_max", double(c[LS_C_VISITED_MAX])},
                                     {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
@@ -279,6 +295,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
+        if (!options_.instrumentation) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}};
     }
 
@@ -307,7 +324,8 @@ private:
                 {"LS_CLASSIFY", classify ? "1" : "0"},
                 {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)},
                 {"LS_START_MODE", std::to_string(int(startMode()))},
-                {"LS_LAST_LEAVES", lastLeaves() ? "1" : "0"}};
+                {"LS_LAST_LEAVES", lastLeaves() ? "1" : "0"},
+                instrumentationDefine(options_)};
     }
 
     bool lastLeaves() const { return p_.lastLevel == "leaves"; }
@@ -362,7 +380,13 @@ private:
         return *classes_;
     }
 
+    /// Timing mode compiles the statistics out: the sample classification (a debug aid) too.
+    void instrumentParams() {
+        if (!options_.instrumentation) p_.classify = false;
+    }
+
     LineSpaceParams p_;
+    AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     Scene posed_; ///< rebuild_every_frame: the scene as last posed (empty until a part moves)
     glm::ivec2 resolution_{0, 0};

@@ -92,7 +92,7 @@ constexpr float kAngularEps = 1e-4f;
 
 class MetricTree final : public ShadowAlgorithm {
 public:
-    explicit MetricTree(const ParamValues& p) : p_(metricTreeParams().read(p)) { compile(); }
+    MetricTree(const ParamValues& p, const AlgorithmOptions& o) : p_(metricTreeParams().read(p)), options_(o) { compile(); }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
@@ -175,6 +175,7 @@ public:
     }
 
     void resize(glm::ivec2 resolution) override {
+        if (!options_.instrumentation) return; // timing mode: no debug images
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         triangleTests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         fruitless_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
@@ -205,7 +206,8 @@ public:
         f.timer.end();
 
         f.timer.begin("traverse");
-        runPixelPass(f, query_, {&nodesVisited_, &triangleTests_, &fruitless_, &overflow_});
+        if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &triangleTests_, &fruitless_, &overflow_});
+        else runPixelPass(f, query_, {});
         f.timer.end();
         counters_.markStale();
     }
@@ -216,6 +218,12 @@ public:
         const double px = c[MT_C_TRAVERSED];
         auto perPixel = [&](int lo) { return px > 0 ? wide(lo) / px : 0.0; };
         const double n = double(clusterCount_);
+        if (!options_.instrumentation) // timing mode: the structure's size and what is still measured
+            return {{"clusters", n},
+                    {"build_errors", double(c[MT_C_BUILD_ERRORS])},
+                    {"stack_overflow_pixels", double(c[MT_C_STACK_OVERFLOW])},
+                    {"cache_hit", cacheHit_ ? 1.0 : 0.0},
+                    {"clustering_ms", clusteringMs_}};
         return {{"clusters", n},
                 {"capsule_percent", n > 0 ? 100.0 * double(capsuleCount_) / n : 0.0},
                 {"triangles_per_cluster", n > 0 ? double(scene_->triangleCount()) / n : 0.0},
@@ -241,6 +249,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
+        if (!options_.instrumentation) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"},
                 {"triangle_tests", triangleTests_.id(), 0.0f, "triangles"},
                 {"fruitless_clusters", fruitless_.id(), 0.0f, "clusters"},
@@ -265,7 +274,8 @@ private:
                                        {"MT_OVERLAP_INTERVAL", flag(p_.overlapInterval)},
                                        {"MT_DEPTH_SKIP", flag(p_.depthSkip)},
                                        {"MT_NORMAL_CONE_CULLING", flag(p_.normalConeCulling)},
-                                       {"MT_STACK_SIZE", std::to_string(p_.stackSize)}};
+                                       {"MT_STACK_SIZE", std::to_string(p_.stackSize)},
+                                       instrumentationDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
         poseClusters_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "1"}});
         poseGeometry_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "0"}});
@@ -437,6 +447,7 @@ private:
     }
 
     MetricTreeParams p_;
+    AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram prepare_, insert_, query_, poseClusters_, poseGeometry_;
     GlBuffer clusters_, nodes_;

@@ -54,7 +54,7 @@ constexpr GLuint kBuildGroup = 64;  ///< local_size_x of frusta.comp and build.c
 
 class Psv final : public ShadowAlgorithm {
 public:
-    explicit Psv(const ParamValues& p) : p_(psvParams().read(p)) { compile(); }
+    Psv(const ParamValues& p, const AlgorithmOptions& o) : p_(psvParams().read(p)), options_(o) { compile(); }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
@@ -68,6 +68,7 @@ public:
     }
 
     void resize(glm::ivec2 resolution) override {
+        if (!options_.instrumentation) return; // timing mode: no debug images
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
@@ -103,7 +104,8 @@ public:
         // scene, so a light-view frustum culls nothing for the lights psv supports (a spot light
         // would cull the triangles outside its cone).
         f.timer.begin("traverse");
-        runPixelPass(f, query_, {&nodesVisited_, &overflow_});
+        if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
+        else runPixelPass(f, query_, {});
         f.timer.end();
         counters_.markStale();
     }
@@ -113,6 +115,8 @@ public:
         static_assert(PSV_C_VISITED_HI == PSV_C_VISITED_LO + 1);
         const double visited = double(counters_.wide(PSV_C_VISITED_LO));
         const double traversed = c[PSV_C_TRAVERSED];
+        if (!options_.instrumentation) // timing mode: what is still measured
+            return {{"stack_overflow_pixels", double(c[PSV_C_STACK_OVERFLOW])}, {"build_errors", double(c[PSV_C_BUILD_ERRORS])}};
         return {{"nodes_visited_mean", traversed > 0 ? visited / traversed : 0.0},
                 {"nodes_visited_max", double(c[PSV_C_VISITED_MAX])},
                 {"stack_overflow_pixels", double(c[PSV_C_STACK_OVERFLOW])},
@@ -126,6 +130,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
+        if (!options_.instrumentation) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
     }
 
@@ -148,7 +153,8 @@ private:
                                        {"PSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
                                        {"PSV_DEPTH_SKIP", flag(p_.depthSkip)},
                                        {"PSV_TRANSPARENCY", flag(p_.transparency)},
-                                       {"PSV_STACK_SIZE", std::to_string(p_.stackSize)}};
+                                       {"PSV_STACK_SIZE", std::to_string(p_.stackSize)},
+                                       instrumentationDefine(options_)};
         frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
         build_ = ShaderProgram::compute("psv/build.comp", defines);
         query_ = ShaderProgram::compute("psv/query.comp", defines);
@@ -183,6 +189,7 @@ private:
     void dispatchPerTriangle(const ShaderProgram& p) const { p.dispatchLinear(scene_->triangleCount(), kBuildGroup); }
 
     PsvParams p_;
+    AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram frusta_, build_, query_;
     GlBuffer nodes_;

@@ -91,7 +91,8 @@ enum Vote { kVoteShared = 0, kVoteBallot = 1 };
 
 class Ptsv final : public ShadowAlgorithm {
 public:
-    explicit Ptsv(const ParamValues& p) : p_(ptsvParams().read(p)) {
+    Ptsv(const ParamValues& p, const AlgorithmOptions& o) : p_(ptsvParams().read(p)), options_(o) {
+        instrumentParams();
         subgroupSize_ = querySubgroupSize();
         compile();
     }
@@ -114,6 +115,7 @@ public:
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
         p_ = ptsvParams().read(p);
+        instrumentParams();
         if (change == ParamChange::Recompile) compile();
         if (change != ParamChange::Update) layoutKey_ = {};  // buffers follow at the next frame
     }
@@ -189,6 +191,17 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double jobs1 = c[PTSV_C_JOBS_1];
         const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(p_.jobCapacity));
+        if (!options_.instrumentation) // timing mode: the structure's shape and what is still measured
+            return {{"jobs", p_.twoPass ? pushed : 0.0},
+                    {"job_overflow", double(c[PTSV_C_JOB_OVERFLOW])},
+                    {"truncated_jobs", double(c[PTSV_C_TRUNCATED])},
+                    {"tree_levels", double(layout_.levels)},
+                    {"key_bits", double(layout_.keyBits)},
+                    {"slices_merged", double(layout_.merged)},
+                    {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
+                    {"vote_path", double(vote_)},
+                    {"traversal_lanes", double(lanes_)},
+                    {"subgroup_size", double(subgroupSize_)}};
         std::vector<Counter> out = {{"test_and_set", wide(PTSV_C_TESTS_LO)},
                 {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
                 {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
@@ -255,6 +268,13 @@ public:
     }
 
 private:
+    /// Timing mode compiles the statistics out: the heat map and the per-job iteration record too.
+    void instrumentParams() {
+        if (options_.instrumentation) return;
+        p_.heatMap = false;
+        p_.jobIterations = false;
+    }
+
     int splitDepth() const {
         const int l = p_.splitLevel;
         return l == 0 ? std::max(1, layout_.levels - 1) : std::min(l, layout_.levels);
@@ -271,7 +291,8 @@ private:
         vote_ = vote != "shared" && ballotUsable ? kVoteBallot : kVoteShared;
         lanes_ = vote_ == kVoteBallot ? std::min(subgroupSize_, 32) : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
-        ShaderDefines defines = {{"PTSV_TILE", std::to_string(p_.tileSize)},
+        ShaderDefines defines = {instrumentationDefine(options_),
+                                 {"PTSV_TILE", std::to_string(p_.tileSize)},
                                  {"PTSV_EXPLICIT_BOUNDS", flag(p_.bounds == "explicit")},
                                  {"PTSV_CULLING_PLANES", flag(p_.cullingPlanes)},
                                  {"PTSV_TWO_PASS", flag(p_.twoPass)},
@@ -395,6 +416,7 @@ private:
     static void dispatchLinear(const ShaderProgram& p, size_t count) { p.dispatchLinear(count, kSetupGroup); }
 
     PtsvParams p_;
+    AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};
     int subgroupSize_ = 0;

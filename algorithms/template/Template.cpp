@@ -1,6 +1,6 @@
 // The smallest complete plugin: a typed parameter struct whose schema rows show the three change
 // kinds, per-scene work in setScene(), image-size work in resize(), one timed stage, a counter and
-// a debug view. What the framework does around it (light check, call order, timing, read-back) is
+// a debug view, both compiled out in the host's timing mode (AlgorithmOptions). What the framework does around it (light check, call order, timing, read-back) is
 // in framework/algorithm/AlgorithmHost: a plugin only computes.
 #include "algorithms/template/Template.h"
 
@@ -40,7 +40,8 @@ const ParamSchema& templateSchema() { return templateParams().schema(); }
 
 class Template final : public ShadowAlgorithm {
 public:
-    explicit Template(const ParamValues& p) : p_(templateParams().read(p)) { compile(); }
+    /// The host's options: with instrumentation off (timing mode) statistics are compiled out.
+    Template(const ParamValues& p, const AlgorithmOptions& o) : p_(templateParams().read(p)), options_(o) { compile(); }
 
     /// 3. Per-scene work (timed as `preprocess`): here, the order in which triangles are tested.
     void setScene(const SceneGpu& scene) override {
@@ -61,7 +62,9 @@ public:
     }
 
     /// 4. Image-size work: the debug view.
-    void resize(glm::ivec2 resolution) override { tests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y); }
+    void resize(glm::ivec2 resolution) override {
+        if (options_.instrumentation) tests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+    }
 
     /// 5. New values: uniforms are read each frame; a Recompile rebuilds the programs; a Rebuild is
     /// followed by setScene() (the host calls it).
@@ -85,7 +88,7 @@ public:
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, TEMPLATE_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, TEMPLATE_COUNTER_BINDING);
         bindPixelPassInputs(f);
-        bindDebugImage(1, tests_);
+        if (options_.instrumentation) bindDebugImage(1, tests_);
         const glm::ivec2 r = f.gbuffer.resolution();
         trace_.dispatch2D(r.x, r.y, p_.groupSide, p_.groupSide);
         finishPixelPass();
@@ -95,21 +98,27 @@ public:
 
     /// 7. What the frame cost, for results and the GUI.
     std::vector<Counter> counters() const override {
+        if (!options_.instrumentation) return {};
         const auto& c = counters_.read();
         const double pixels = c[TEMPLATE_C_PIXELS];
         return {{"triangle_tests_mean", pixels > 0 ? double(counters_.wide(TEMPLATE_C_TESTS_LO)) / pixels : 0.0},
                 {"traced_pixels", pixels}};
     }
-    std::vector<DebugView> debugViews() const override { return {{"triangle_tests", tests_.id(), 0.0f, "tests"}}; }
+    std::vector<DebugView> debugViews() const override {
+        if (!options_.instrumentation) return {};
+        return {{"triangle_tests", tests_.id(), 0.0f, "tests"}};
+    }
     size_t memoryBytes() const override { return order_.size() + counters_.size(); }
     // No fixed-size structure (no stack, no pool), so nothing can overflow: overflowCount() stays 0.
 
 private:
     void compile() {
-        trace_ = ShaderProgram::compute("template/trace.comp", {{"TEMPLATE_GROUP_SIDE", std::to_string(p_.groupSide)}});
+        trace_ = ShaderProgram::compute("template/trace.comp", {{"TEMPLATE_GROUP_SIDE", std::to_string(p_.groupSide)},
+                                                                instrumentationDefine(options_)});
     }
 
     TemplateParams p_;
+    AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram trace_;
     GlBuffer order_, samples_;

@@ -13,8 +13,8 @@ std::vector<StageTime> FrameMeasurement::stagesWithTotal() const {
     return out;
 }
 
-AlgorithmHost::AlgorithmHost(const AlgorithmInfo& info, ParamValues params)
-    : info_(&info), params_(std::move(params)), algorithm_(info.create(params_)) {}
+AlgorithmHost::AlgorithmHost(const AlgorithmInfo& info, ParamValues params, AlgorithmOptions options)
+    : info_(&info), params_(std::move(params)), options_(options), algorithm_(info.create(params_, options_)) {}
 
 AlgorithmHost::~AlgorithmHost() = default;
 

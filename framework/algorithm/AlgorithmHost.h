@@ -41,12 +41,14 @@ struct FrameMeasurement {
 
 class AlgorithmHost {
 public:
-    /// Creates the algorithm from validated values of info's schema.
-    AlgorithmHost(const AlgorithmInfo& info, ParamValues params);
+    /// Creates the algorithm from validated values of info's schema; `options` hold for its life
+    /// (instrumentation off = timing mode, see AlgorithmOptions).
+    AlgorithmHost(const AlgorithmInfo& info, ParamValues params, AlgorithmOptions options = {});
     ~AlgorithmHost();
 
     const AlgorithmInfo& info() const { return *info_; }
     const ParamValues& params() const { return params_; }
+    const AlgorithmOptions& options() const { return options_; }
     const ShadowAlgorithm& algorithm() const { return *algorithm_; }
 
     /// Preprocessing for `scene` (kept by reference: it must outlive the host); then resize() again
@@ -77,6 +79,7 @@ public:
 private:
     const AlgorithmInfo* info_;
     ParamValues params_;
+    AlgorithmOptions options_;
     std::unique_ptr<ShadowAlgorithm> algorithm_;
     const SceneGpu* scene_ = nullptr;
     glm::ivec2 resolution_{0, 0};

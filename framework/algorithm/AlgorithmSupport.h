@@ -5,6 +5,7 @@
 #include "framework/gl/Shader.h"
 
 #include <initializer_list>
+#include <type_traits>
 
 #include <memory>
 #include <string>
@@ -13,7 +14,8 @@
 
 namespace shadowlab {
 
-/// The registry entry of algorithm class T, built from its validated ParamValues.
+/// The registry entry of algorithm class T, built from its validated ParamValues (and the host's
+/// AlgorithmOptions when T takes them: a plugin without statistics of its own need not).
 template <class T>
 AlgorithmInfo makeAlgorithmInfo(std::string name, std::string summary, std::vector<LightType> lights, bool exact,
                                 const ParamSchema& (*schema)()) {
@@ -23,8 +25,20 @@ AlgorithmInfo makeAlgorithmInfo(std::string name, std::string summary, std::vect
     info.lights = std::move(lights);
     info.exact = exact;
     info.schema = schema;
-    info.create = [](const ParamValues& p) -> std::unique_ptr<ShadowAlgorithm> { return std::make_unique<T>(p); };
+    info.create = [](const ParamValues& p, const AlgorithmOptions& o) -> std::unique_ptr<ShadowAlgorithm> {
+        if constexpr (std::is_constructible_v<T, const ParamValues&, const AlgorithmOptions&>)
+            return std::make_unique<T>(p, o);
+        else
+            return (void)o, std::make_unique<T>(p);
+    };
     return info;
+}
+
+/// The define every instrumented shader tests (`#if SHADOWLAB_INSTRUMENTATION`): 1 gathers the
+/// statistics and debug images, 0 (timing mode) compiles them out. Overflow detection is never
+/// behind it.
+inline std::pair<std::string, std::string> instrumentationDefine(const AlgorithmOptions& o) {
+    return {"SHADOWLAB_INSTRUMENTATION", o.instrumentation ? "1" : "0"};
 }
 
 /// Per-pixel passes read the G-buffer's world position (texture unit 0) and camera-facing normal

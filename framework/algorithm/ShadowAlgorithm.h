@@ -66,6 +66,15 @@ enum class MotionHandling {
 };
 const char* toString(MotionHandling m);
 
+/// How the host runs every algorithm, fixed at creation (one mechanism for all plugins).
+struct AlgorithmOptions {
+    /// Statistics: counters, per-pixel debug images (heat maps) and the atomics that gather them.
+    /// Off (a config's `timing_mode`), they are compiled out of the timed shaders and counters()
+    /// and debugViews() report only what is still measured; overflow and error detection stay
+    /// (overflowCount() is exact in both modes) and the visibility is bit-identical.
+    bool instrumentation = true;
+};
+
 class ShadowAlgorithm {
 public:
     virtual ~ShadowAlgorithm() = default;
@@ -96,7 +105,7 @@ struct AlgorithmInfo {
     MotionHandling motion = MotionHandling::PerFrame;
     std::string rebuildParam;     ///< StaticOnly: the bool parameter that allows moving scenes (rebuilt each frame)
     const ParamSchema& (*schema)();
-    std::unique_ptr<ShadowAlgorithm> (*create)(const ParamValues& params);
+    std::unique_ptr<ShadowAlgorithm> (*create)(const ParamValues& params, const AlgorithmOptions& options);
 
     bool supports(LightType t) const;
     /// "" when the algorithm can run on a scene that moves with these parameter values, else why not.

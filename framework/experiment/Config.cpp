@@ -159,6 +159,7 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     c.resolution = root.getIVec2("resolution", {256, 256}, 8, 8192);
     c.frames = root.getInt("frames", 30, 1, 1000000);
     c.warmupFrames = root.getInt("warmup_frames", 3, 0, 1000);
+    c.timingMode = root.getBool("timing_mode", false);
 
     if (!root.has("scene")) root.fail("scene", "required key is missing");
     JsonNode sceneNode = root.child("scene");

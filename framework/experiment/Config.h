@@ -27,6 +27,8 @@ struct ExperimentConfig {
     glm::ivec2 resolution{256, 256};
     int frames = 30;
     int warmupFrames = 3;
+    /// Statistics compiled out of the timed shaders (AlgorithmOptions::instrumentation off).
+    bool timingMode = false;
 
     std::shared_ptr<Scene> scene;
     Camera camera;               ///< fov/near/far, and the static pose when there is no path

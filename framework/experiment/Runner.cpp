@@ -96,7 +96,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     sceneGpu.setTime(cfg.sceneTimeAt(0));
     std::vector<Instance> instances;
     for (const AlgorithmEntry* e : entries) {
-        Instance inst{e, std::make_unique<AlgorithmHost>(*e->info, e->params), {}};
+        Instance inst{e, std::make_unique<AlgorithmHost>(*e->info, e->params, AlgorithmOptions{!cfg.timingMode}), {}};
         inst.results.id = e->id;
         inst.results.algorithm = e->info->name;
         inst.results.params = e->params.toJson();
@@ -119,6 +119,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"resolution", {res.x, res.y}},
                     {"frames", cfg.frames},
                     {"warmup_frames", cfg.warmupFrames},
+                    // true: the statistics were compiled out of the timed shaders (counters hold
+                    // only what stays measured: overflow, errors, structure sizes).
+                    {"timing_mode", cfg.timingMode},
                     {"triangles", cfg.scene->triangleCount()},
                     {"moving_parts", cfg.scene->moving.size()},
                     {"moving_triangles", movingTriangles(*cfg.scene)},

@@ -4,6 +4,7 @@
 // on the CPU: Aila & Laine's while-while traversal (inner nodes until a leaf is found, then the
 // leaves), near child first, a fixed stack whose overflow is reported, any-hit early exit.
 // Triangles are read in leaf order (no index indirection). Visibility = fraction of unblocked samples.
+#include "common/instrumentation.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "common/watertight.glsl"
@@ -24,8 +25,10 @@ layout(std430, binding = BVH_COUNTER_BINDING) buffer BvhCounters { uint bvhCount
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
+#if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map: nodes per pixel
 layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where a ray's stack overflowed
+#endif
 uniform float uRayOffset; // world units, the reference's
 uniform int uSampleCount; // entries of lightSamples (1 for point and spot lights)
 
@@ -151,13 +154,17 @@ Trace trace(Ray r) {
     return res;
 }
 
+#if SHADOWLAB_INSTRUMENTATION
 shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels, sTruncated;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(bvhCounters, lo, value)
+#endif
 
 void main() {
+#if SHADOWLAB_INSTRUMENTATION
     if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = sTruncated = 0u;
     barrier();
+#endif
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
@@ -197,6 +204,7 @@ void main() {
                 // An overflowed ray counts as blocked, and its pixel is written fully shadowed, so a
                 // stack too small shows as dark pixels and in overflowCount(), never as light.
                 visibility = overflowRays > 0u ? 0.0 : unblocked / float(count);
+#if SHADOWLAB_INSTRUMENTATION
                 atomicAdd(sPixels, 1u);
                 atomicAdd(sRays, uint(count));
                 atomicAdd(sVisited, visited);
@@ -204,12 +212,23 @@ void main() {
                 atomicAdd(sTested, tested);
                 if (truncated) atomicAdd(sTruncated, 1u);
                 else if (overflowRays > 0u) { atomicAdd(sOverflowRays, overflowRays); atomicAdd(sOverflowPixels, 1u); }
+#else
+                // Timing mode still counts every overflowed or truncated pixel.
+                if (truncated) atomicAdd(bvhCounters[BVH_C_TRUNCATED_PIXELS], 1u);
+                else if (overflowRays > 0u) {
+                    atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], overflowRays);
+                    atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], 1u);
+                }
+#endif
             }
         }
         imageStore(uVisibility, px, vec4(visibility));
+#if SHADOWLAB_INSTRUMENTATION
         imageStore(uNodesVisited, px, vec4(float(visited)));
         imageStore(uOverflow, px, vec4(overflowRays > 0u ? 1.0 : 0.0));
+#endif
     }
+#if SHADOWLAB_INSTRUMENTATION
     barrier();
     if (gl_LocalInvocationIndex == 0u && sPixels != 0u) {
         atomicAdd(bvhCounters[BVH_C_PIXELS], sPixels);
@@ -223,4 +242,5 @@ void main() {
             atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], sOverflowPixels);
         }
     }
+#endif
 }

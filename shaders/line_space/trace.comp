@@ -19,6 +19,7 @@
 //     LS_LAST_LEAVES the leaves the ray crosses in that node decide, by the node's occupancy mask.
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
 // LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE, LS_LAST_LEAVES.
+#include "common/instrumentation.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "line_space/layout.glsl"
@@ -61,7 +62,9 @@ layout(std430, binding = LS_CLASSIFY_BINDING) buffer LsClassify { uint lsClassif
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
+#if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map: nodes per pixel
+#endif
 uniform float uRayOffset; // world units, the reference's
 uniform int uSampleCount; // entries of lightSamples (1 for point and spot lights)
 uniform uint uNodeCount;  // 0: no geometry, nothing occludes
@@ -317,13 +320,17 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
 #endif
 
+#if SHADOWLAB_INSTRUMENTATION
 shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
+#endif
 
 void main() {
+#if SHADOWLAB_INSTRUMENTATION
     if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = 0u;
     barrier();
+#endif
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(uVisibility);
     if (all(lessThan(px, size))) {
@@ -464,6 +471,7 @@ void main() {
                 if (truncated)
                     for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0xFFFFFFFFu; // every sample blocked
 #endif
+#if SHADOWLAB_INSTRUMENTATION
                 if (truncated) atomicAdd(sTruncated, 1u);
                 atomicAdd(sPixels, 1u);
                 atomicAdd(sRays, uint(count));
@@ -475,14 +483,22 @@ void main() {
                 atomicAdd(sTris, trianglesTested);
                 atomicAdd(sOccluded, occluded);
                 if (overflow != 0u) atomicAdd(sOverflow, overflow);
+#else
+                // Timing mode still counts every overflowed or truncated pixel.
+                if (truncated) atomicAdd(lsCounters[LS_C_TRUNCATED], 1u);
+                if (overflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], overflow);
+#endif
             }
         }
 #if LS_CLASSIFY
         lsClassify[base] = pixelStartNode;
 #endif
         imageStore(uVisibility, px, vec4(visibility));
+#if SHADOWLAB_INSTRUMENTATION
         imageStore(uNodesVisited, px, vec4(float(visited)));
+#endif
     }
+#if SHADOWLAB_INSTRUMENTATION
     barrier();
     if (gl_LocalInvocationIndex == 0u && sPixels != 0u) {
         atomicAdd(lsCounters[LS_C_PIXELS], sPixels);
@@ -497,4 +513,5 @@ void main() {
         if (sOverflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], sOverflow);
         if (sTruncated != 0u) atomicAdd(lsCounters[LS_C_TRUNCATED], sTruncated);
     }
+#endif
 }

@@ -73,22 +73,33 @@ uint insertCluster(uint i, out uint crossed) {
     return MT_C_BUILD_ERRORS; // not reached
 }
 
+#if SHADOWLAB_INSTRUMENTATION
 shared uint sOutcomes[4]; // MT_C_INSERTED, MT_C_CULLED, MT_C_BUILD_ERRORS at words 1..3
 shared uint sCrossedMax;
+#endif
 
 void main() {
+#if SHADOWLAB_INSTRUMENTATION
     if (gl_LocalInvocationIndex < 4u) sOutcomes[gl_LocalInvocationIndex] = 0u;
     if (gl_LocalInvocationIndex == 0u) sCrossedMax = 0u;
     barrier();
+#endif
     uint i = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x;
     if (i < uClusterCount) {
         uint crossed;
         uint outcome = insertCluster(i, crossed);
+#if SHADOWLAB_INSTRUMENTATION
         atomicAdd(sOutcomes[outcome], 1u);
         atomicMax(sCrossedMax, crossed);
+#else
+        // Timing mode: only errors are counted (they must stay 0 and are reported in both modes).
+        if (outcome == MT_C_BUILD_ERRORS) atomicAdd(mtCounters[MT_C_BUILD_ERRORS], 1u);
+#endif
     }
+#if SHADOWLAB_INSTRUMENTATION
     barrier();
     if (gl_LocalInvocationIndex >= 1u && gl_LocalInvocationIndex < 4u && sOutcomes[gl_LocalInvocationIndex] != 0u)
         atomicAdd(mtCounters[gl_LocalInvocationIndex], sOutcomes[gl_LocalInvocationIndex]);
     if (gl_LocalInvocationIndex == 0u) atomicMax(mtCounters[MT_C_INSERT_DEPTH_MAX], sCrossedMax);
+#endif
 }

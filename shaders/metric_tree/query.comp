@@ -24,10 +24,12 @@ layout(std430, binding = MT_GEOMETRY_BINDING_0 + 5) readonly buffer MtGeometry5 
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
+#if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat maps
 layout(r32f, binding = 2) writeonly uniform image2D uTriangleTests;
 layout(r32f, binding = 3) writeonly uniform image2D uFruitless;    // paper Figure 9
 layout(r32f, binding = 4) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
+#endif
 uniform float uRayOffset;     // world units: the reference's shadow-ray origin offset along the normal
 uniform float uSlabTolerance; // world units added on both sides of a cluster's slabs
 
@@ -141,6 +143,7 @@ Result query(vec3 q) {
     return r;
 }
 
+#if SHADOWLAB_INSTRUMENTATION
 shared uint sTraversed, sOverflow, sVisitedMax, sTrianglesMax, sFruitlessMax;
 shared uint sVisited, sTriangles, sFruitless, sConeHits, sSlabRejects, sDepthSkips;
 
@@ -148,13 +151,16 @@ void addWide(uint lo, uint value) {
     if (value == 0u) return;
     COUNTER_ADD_WIDE(mtCounters, lo, value)
 }
+#endif
 
 void main() {
+#if SHADOWLAB_INSTRUMENTATION
     if (gl_LocalInvocationIndex == 0u) {
         sTraversed = sOverflow = sVisitedMax = sTrianglesMax = sFruitlessMax = 0u;
         sVisited = sTriangles = sFruitless = sConeHits = sSlabRejects = sDepthSkips = 0u;
     }
     barrier();
+#endif
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
@@ -167,6 +173,7 @@ void main() {
                 // The reference's ray origin: the same offset along the same (unnormalised) normal.
                 r = query(x + nrm * uRayOffset);
                 visibility = r.visibility;
+#if SHADOWLAB_INSTRUMENTATION
                 atomicAdd(sTraversed, 1u);
                 atomicAdd(sVisited, r.visited);
                 atomicAdd(sTriangles, r.triangles);
@@ -178,14 +185,21 @@ void main() {
                 atomicMax(sTrianglesMax, r.triangles);
                 atomicMax(sFruitlessMax, r.fruitless);
                 if (r.overflow) atomicAdd(sOverflow, 1u);
+#else
+                // Timing mode still counts every overflowed pixel (never a silent wrong image).
+                if (r.overflow) atomicAdd(mtCounters[MT_C_STACK_OVERFLOW], 1u);
+#endif
             }
         }
         imageStore(uVisibility, px, vec4(visibility));
+#if SHADOWLAB_INSTRUMENTATION
         imageStore(uNodesVisited, px, vec4(float(r.visited)));
         imageStore(uTriangleTests, px, vec4(float(r.triangles)));
         imageStore(uFruitless, px, vec4(float(r.fruitless)));
         imageStore(uOverflow, px, vec4(r.overflow ? 1.0 : 0.0));
+#endif
     }
+#if SHADOWLAB_INSTRUMENTATION
     barrier();
     if (gl_LocalInvocationIndex == 0u && sTraversed != 0u) {
         atomicAdd(mtCounters[MT_C_TRAVERSED], sTraversed);
@@ -200,4 +214,5 @@ void main() {
         atomicMax(mtCounters[MT_C_FRUITLESS_MAX], sFruitlessMax);
         if (sOverflow != 0u) atomicAdd(mtCounters[MT_C_STACK_OVERFLOW], sOverflow);
     }
+#endif
 }

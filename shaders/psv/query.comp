@@ -12,8 +12,6 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map
-layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
 uniform float uRayOffset; // world units: the reference's shadow-ray origin offset along the normal
 
 struct Result {
@@ -85,11 +83,17 @@ Result query(vec3 q) {
     return r;
 }
 
+#if SHADOWLAB_INSTRUMENTATION
+layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map
+layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
 shared uint sTraversed, sVisited, sVisitedMax, sOverflow;
+#endif
 
 void main() {
+#if SHADOWLAB_INSTRUMENTATION
     if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = 0u;
     barrier();
+#endif
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
@@ -102,16 +106,24 @@ void main() {
                 // The reference's ray origin: the same offset along the same (unnormalised) normal.
                 r = query(p + n * uRayOffset);
                 visibility = r.visibility;
+#if SHADOWLAB_INSTRUMENTATION
                 atomicAdd(sTraversed, 1u);
                 atomicAdd(sVisited, r.visited);
                 atomicMax(sVisitedMax, r.visited);
                 if (r.overflow) atomicAdd(sOverflow, 1u);
+#else
+                // Timing mode still counts every overflowed pixel (never a silent wrong image).
+                if (r.overflow) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], 1u);
+#endif
             }
         }
         imageStore(uVisibility, px, vec4(visibility));
+#if SHADOWLAB_INSTRUMENTATION
         imageStore(uNodesVisited, px, vec4(float(r.visited)));
         imageStore(uOverflow, px, vec4(r.overflow ? 1.0 : 0.0));
+#endif
     }
+#if SHADOWLAB_INSTRUMENTATION
     barrier();
     if (gl_LocalInvocationIndex == 0u && sTraversed != 0u) {
         atomicAdd(psvCounters[PSV_C_TRAVERSED], sTraversed);
@@ -119,4 +131,5 @@ void main() {
         atomicMax(psvCounters[PSV_C_VISITED_MAX], sVisitedMax);
         if (sOverflow != 0u) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], sOverflow);
     }
+#endif
 }

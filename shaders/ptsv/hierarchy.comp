@@ -50,12 +50,16 @@ void main() {
     sQ[local] = q;
     barrier();
     if (key < PTSV_KEY_AWAY) {
+#if SHADOWLAB_INSTRUMENTATION
         atomicAdd(sReceivers, 1u);
+#endif
         // The first sample of each cluster in the tile speaks for it.
         bool leader = true;
         for (uint j = 0u; j < local && leader; ++j) leader = sKey[j] != key;
         if (leader) {
+#if SHADOWLAB_INSTRUMENTATION
             atomicAdd(sClusters, 1u);
+#endif
             int leafDepth = uLevels;
             atomicOr(ptsvMasks[uMaskOffset[leafDepth - 1] + (key >> 5u)], 1u << (key & 31u));
 #if PTSV_EXPLICIT_BOUNDS
@@ -71,9 +75,11 @@ void main() {
 #endif
         }
     }
+#if SHADOWLAB_INSTRUMENTATION
     barrier();
     if (local == 0u) {
         if (sClusters != 0u) atomicAdd(ptsvCounters[PTSV_C_CLUSTERS], sClusters);
         if (sReceivers != 0u) atomicAdd(ptsvCounters[PTSV_C_RECEIVERS], sReceivers);
     }
+#endif
 }

@@ -30,13 +30,17 @@ void main() {
                 shadowed = ((word >> ((key >> uint(5 * (uLevels - 1 - d))) & 31u)) & 1u) == 0u;
             }
             visibility = shadowed ? 0.0 : 1.0;
+#if SHADOWLAB_INSTRUMENTATION
             if (shadowed) atomicAdd(sShadowed, 1u);
+#endif
         }
         imageStore(uVisibility, px, vec4(visibility));
 #if PTSV_HEAT_MAP
         imageStore(uHeat, px, vec4(float(ptsvHeat[slot])));
 #endif
     }
+#if SHADOWLAB_INSTRUMENTATION
     barrier();
     if (gl_LocalInvocationIndex == 0u && sShadowed != 0u) atomicAdd(ptsvCounters[PTSV_C_SHADOWED], sShadowed);
+#endif
 }

@@ -70,8 +70,11 @@ void main() {
         ptsvPlanes[base + 4u] = ptsvCullingPlane(e2, e0, v0); // planes meeting at v0: edges v2v0, v0v1
         ptsvPlanes[base + 5u] = ptsvCullingPlane(e0, e1, v1);
         ptsvPlanes[base + 6u] = ptsvCullingPlane(e1, e2, v2);
-    } else {
+    }
+#if SHADOWLAB_INSTRUMENTATION
+    else {
         atomicAdd(ptsvCounters[status == PTSV_CASTER_FACING ? PTSV_C_CULLED_FACING : PTSV_C_CULLED_EDGE_ON], 1u);
     }
+#endif
     ptsvPlanes[base + 7u] = vec4(uintBitsToFloat(status), 0.0, 0.0, 0.0);
 }

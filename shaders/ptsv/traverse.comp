@@ -212,6 +212,7 @@ void loadTriangle(uint t) {
 
 // Per job: the Figure 7 statistics (invocation 0 speaks for the workgroup).
 void finishJob(uint job) {
+#if SHADOWLAB_INSTRUMENTATION
     if (lane != 0u) return;
 #if PTSV_JOB_ITERATIONS
     ptsvJobIterations[PTSV_PASS == 1 ? job : uTriangleCount + job] = gIterations;
@@ -224,6 +225,7 @@ void finishJob(uint job) {
     atomicMax(ptsvCounters[PTSV_C_ITER_MAX_2], gIterations);
     atomicAdd(ptsvCounters[PTSV_C_ITER_SUM_2], gIterations);
 #endif
+#endif // SHADOWLAB_INSTRUMENTATION
 }
 
 void main() {
@@ -254,12 +256,15 @@ void main() {
 #endif
         finishJob(job);
     }
-    // Totals (no barrier: one atomic per invocation that has something to add).
+    // Totals (no barrier: one atomic per invocation that has something to add). Truncation is
+    // an error, counted in both modes.
+    if (gTruncated) atomicAdd(ptsvCounters[PTSV_C_TRUNCATED], 1u);
+#if SHADOWLAB_INSTRUMENTATION
     if (gTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_TESTS_LO, gTests)
     if (gNodeTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_NODE_TESTS_LO, gNodeTests)
-    if (gTruncated) atomicAdd(ptsvCounters[PTSV_C_TRUNCATED], 1u);
     if (lane == 0u) {
         if (gAccepted != 0u) atomicAdd(ptsvCounters[PTSV_C_ACCEPTED], gAccepted);
         if (gLeafVisits != 0u) atomicAdd(ptsvCounters[PTSV_C_LEAF_VISITS], gLeafVisits);
     }
+#endif
 }

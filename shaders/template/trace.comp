@@ -2,6 +2,7 @@
 // template: one invocation per pixel casts the reference's shadow rays (origin p + n * offset, one
 // per light sample) against every triangle, in the order setScene() uploaded, and stops at the first
 // hit. O(pixels × triangles): a correct baseline for small scenes and a starting point to copy.
+#include "common/instrumentation.glsl"
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "common/watertight.glsl"
@@ -16,7 +17,9 @@ layout(std430, binding = TEMPLATE_COUNTER_BINDING) buffer Counters { uint counte
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
+#if SHADOWLAB_INSTRUMENTATION // statistics: compiled out in timing mode
 layout(r32f, binding = 1) writeonly uniform image2D uTests; // debug view: triangle tests per pixel
+#endif
 uniform float uRayOffset;    // world units, the reference's
 uniform int uSampleCount;    // light samples (1 for point and spot lights)
 uniform uint uTriangleCount;
@@ -61,10 +64,14 @@ void main() {
                 if (!occluded(r, tests)) unblocked += 1.0;
             }
             visibility = unblocked / float(count);
+#if SHADOWLAB_INSTRUMENTATION
             atomicAdd(counters[TEMPLATE_C_PIXELS], 1u);
             addWide(TEMPLATE_C_TESTS_LO, tests);
+#endif
         }
     }
     imageStore(uVisibility, px, vec4(visibility));
+#if SHADOWLAB_INSTRUMENTATION
     imageStore(uTests, px, vec4(float(tests)));
+#endif
 }

@@ -1,0 +1,8 @@
+// Timing mode (AlgorithmOptions::instrumentation, a config's `timing_mode`): with
+// SHADOWLAB_INSTRUMENTATION 0 a shader gathers no statistics (counters, per-pixel debug images,
+// the atomics and barriers that sum them); overflow and error detection never depend on it, and
+// the visibility written is the same bit for bit. Every plugin passes the define
+// (instrumentationDefine() in framework/algorithm/AlgorithmSupport.h); 1 when it is missing.
+#ifndef SHADOWLAB_INSTRUMENTATION
+#define SHADOWLAB_INSTRUMENTATION 1
+#endif
