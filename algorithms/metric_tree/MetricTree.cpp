@@ -172,6 +172,12 @@ public:
             geometryBytes_ += geometry_[chunk].size();
         }
         if (!geometry_[0]) geometry_[0] = GlBuffer(36, nullptr, 0); // an empty scene still binds its blocks
+        // The query reads the blocks that hold triangles only (a #define): recompiled when that changes.
+        const int used = int(std::max<size_t>(1, (n + MT_TRIANGLES_PER_CHUNK - 1) / MT_TRIANGLES_PER_CHUNK));
+        if (used != geometryUsed_) {
+            geometryUsed_ = used;
+            compile();
+        }
     }
 
     void resize(glm::ivec2 resolution) override {
@@ -275,6 +281,7 @@ private:
                                        {"MT_DEPTH_SKIP", flag(p_.depthSkip)},
                                        {"MT_NORMAL_CONE_CULLING", flag(p_.normalConeCulling)},
                                        {"MT_STACK_SIZE", std::to_string(p_.stackSize)},
+                                       {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
                                        instrumentationDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
         poseClusters_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "1"}});
@@ -462,6 +469,7 @@ private:
     std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;
     GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;
     size_t clusterCount_ = 0, capsuleCount_ = 0, geometryBytes_ = 0;
+    int geometryUsed_ = 1; ///< geometry blocks holding triangles (MT_GEOMETRY_USED)
     float lsEps_ = kAngularEps;
     bool cacheHit_ = false;
     double clusteringMs_ = 0;

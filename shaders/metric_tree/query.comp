@@ -37,15 +37,44 @@ uniform float uSlabTolerance; // world units added on both sides of a cluster's 
 // would live in scratch memory on llvmpipe.
 #define MT_LOAD(buf, base, v0, v1, v2) { v0 = vec3(buf[base], buf[base + 1u], buf[base + 2u]); \
     v1 = vec3(buf[base + 3u], buf[base + 4u], buf[base + 5u]); v2 = vec3(buf[base + 6u], buf[base + 7u], buf[base + 8u]); }
+// MT_GEOMETRY_USED (1..MT_GEOMETRY_CHUNKS, set from the scene at compile time) is how many blocks
+// hold triangles: one below 3.5 M triangles, where the load is a single unconditional read. A
+// CPU SIMD back end (llvmpipe) runs every arm of a divergent if/else chain, so only the blocks
+// that exist get an arm.
+#ifndef MT_GEOMETRY_USED
+#define MT_GEOMETRY_USED MT_GEOMETRY_CHUNKS
+#endif
 void mtTriangle(uint t, out vec3 v0, out vec3 v1, out vec3 v2) {
+#if MT_GEOMETRY_USED == 1
+    MT_LOAD(mtGeometry0, 9u * t, v0, v1, v2)
+#else
     uint chunk = t / uint(MT_TRIANGLES_PER_CHUNK);
     uint base = 9u * (t - chunk * uint(MT_TRIANGLES_PER_CHUNK));
     if (chunk == 0u) MT_LOAD(mtGeometry0, base, v0, v1, v2)
+#if MT_GEOMETRY_USED > 2
     else if (chunk == 1u) MT_LOAD(mtGeometry1, base, v0, v1, v2)
+#endif
+#if MT_GEOMETRY_USED > 3
     else if (chunk == 2u) MT_LOAD(mtGeometry2, base, v0, v1, v2)
+#endif
+#if MT_GEOMETRY_USED > 4
     else if (chunk == 3u) MT_LOAD(mtGeometry3, base, v0, v1, v2)
+#endif
+#if MT_GEOMETRY_USED > 5
     else if (chunk == 4u) MT_LOAD(mtGeometry4, base, v0, v1, v2)
+#endif
+#if MT_GEOMETRY_USED == 2
+    else MT_LOAD(mtGeometry1, base, v0, v1, v2)
+#elif MT_GEOMETRY_USED == 3
+    else MT_LOAD(mtGeometry2, base, v0, v1, v2)
+#elif MT_GEOMETRY_USED == 4
+    else MT_LOAD(mtGeometry3, base, v0, v1, v2)
+#elif MT_GEOMETRY_USED == 5
+    else MT_LOAD(mtGeometry4, base, v0, v1, v2)
+#else
     else MT_LOAD(mtGeometry5, base, v0, v1, v2)
+#endif
+#endif
 }
 
 // Segment o + t d, t in (0, tMax), against a triangle; both faces, like the reference. Barycentric
