@@ -5,8 +5,15 @@
 // first and the descent goes on from it, so concurrent insertions neither wait nor lose a cluster.
 // The pivot order is the cluster order (shuffled at preprocessing with random_order) as the
 // scheduler interleaves it. The partitioning distance starts at the scene's angular radius
-// (uDelta0) and is halved at every near step; a node's delta is written before the CAS that
-// publishes it, and nobody reads an unpublished node.
+// (uDelta0) and is halved at every near step.
+//
+// A node's delta is the one field written while others read it, so it has exactly two states:
+// MT_DELTA_PENDING (prepare.comp, a previous dispatch) and its final value, written once, after
+// the CAS that links the node. A reader that finds the node linked but its delta still pending
+// (not yet written, or not yet visible to it) files the element under the overlap child, which
+// is correct for any delta: the query visits an overlap child wherever the point's distance lies
+// inside [overlapMin, overlapMax], and the element's [dMin, dMax] widens that interval. So no
+// reader ever compares against a delta that is not the node's final one, on any memory model.
 #include "common/light.glsl"
 #include "metric_tree/tree.glsl"
 layout(local_size_x = 64) in;
@@ -37,10 +44,11 @@ uint insertCluster(uint i, out uint crossed) {
     while (true) {
         uint child = mtChild(node, slot); // a stale 0 only makes the CAS below fail
         if (child == MT_NO_CHILD) {
-            mtNodes[i].b.w = delta;
-            memoryBarrierBuffer(); // delta is visible before the node is
             child = mtLink(node, slot, i + 1u);
-            if (child == MT_NO_CHILD) return MT_C_INSERTED;
+            if (child == MT_NO_CHILD) {
+                mtNodes[i].b.w = delta; // linked: the one write of its final delta
+                return MT_C_INSERTED;
+            }
         }
         if (child > uClusterCount || ++crossed > uClusterCount) return MT_C_BUILD_ERRORS;
         node = child - 1u;
@@ -55,10 +63,11 @@ uint insertCluster(uint i, out uint crossed) {
         // uLsEps so that they hold once rounded.
         float dMin = mtMinDist(n.a.xyz, n.b.xyz, a, b) - alpha - uLsEps;
         float dMax = alpha >= kMtPi ? kMtInf : mtMaxDist(n.a.xyz, n.b.xyz, a, b) + alpha + uLsEps;
-        if (dMax <= n.b.w) {
+        bool pending = floatBitsToUint(n.b.w) == MT_DELTA_PENDING;
+        if (!pending && dMax <= n.b.w) {
             slot = MT_CHILD_NEAR;
             delta *= 0.5;
-        } else if (dMin > n.b.w) {
+        } else if (!pending && dMin > n.b.w) {
             slot = MT_CHILD_FAR;
         } else {
             slot = MT_CHILD_OVERLAP;

@@ -23,6 +23,11 @@
 #define MT_CHILD_FAR 1
 #define MT_CHILD_OVERLAP 2
 
+// MtNode.b.w (the partitioning distance) before its node is linked: a NaN's bits, which no
+// distance has. insert.comp writes the real value once, after the CAS that links the node, so a
+// concurrent reader sees either this or the final value (see insert.comp).
+#define MT_DELTA_PENDING 0xFFFFFFFFu
+
 // Cluster flags (MtCluster.flags).
 #define MT_FLAG_CAPSULE 1u
 

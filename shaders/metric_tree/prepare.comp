@@ -51,7 +51,7 @@ void main() {
 #endif
     if (lightIsDirectional()) {
         n.a = vec4(mtToLightSpace(A), r);
-        n.b = vec4(mtToLightSpace(B), 0.0);
+        n.b = vec4(mtToLightSpace(B), uintBitsToFloat(MT_DELTA_PENDING));
         if (A == B) n.b.xyz = n.a.xyz; // exactly equal: the distances take the sphere path
         float depth = min(dot(A - uDepthOrigin, uLightDirection), dot(B - uDepthOrigin, uLightDirection)) - r;
         n.minDist = floatBitsToUint(max(depth - uDepthTolerance, 0.0)); // >= 0: uint order = float order
@@ -81,7 +81,7 @@ void main() {
         // A cone of every direction needs no centre; the light at the centre would make it NaN.
         if (alpha >= kMtPi) a = b = vec3(0.0, 0.0, 1.0);
         n.a = vec4(a, alpha);
-        n.b = vec4(b, 0.0);
+        n.b = vec4(b, uintBitsToFloat(MT_DELTA_PENDING));
         n.minDist = floatBitsToUint(max(dist - r - uDepthTolerance, 0.0)); // >= 0: uint order = float order
     }
     mtNodes[i] = n;
