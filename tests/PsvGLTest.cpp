@@ -87,7 +87,11 @@ const AccuracyCase kAccuracy[] = {
     {"camera_inside_shadow", cameraInsideShadow, {}, 1e-4, 1e-2},
     {"no_wedge", thousandsOfTriangles, {{"wedge", false}}, 1e-4, 1e-2},
     {"scene_order", thousandsOfTriangles, {{"random_order", false}}, 1e-4, 1e-2},
-    {"no_depth_skip", thousandsOfTriangles, {{"depth_skip", false}}, 1e-4, 1e-2},
+    {"depth_skip", thousandsOfTriangles, {{"depth_skip", true}}, 1e-4, 1e-2},
+    {"exact_wedge", thousandsOfTriangles, {{"wedge_bound", std::string("exact")}}, 1e-4, 1e-2},
+    {"exact_wedge_shell", omniInsideShell, {{"wedge_bound", std::string("exact")}}, 1e-4, 1e-2},
+    // The paper's vertex wedge can be too narrow (see tree.glsl); on these scenes it is not.
+    {"vertex_wedge", thousandsOfTriangles, {{"wedge_bound", std::string("vertices")}}, 1e-4, 1e-2},
     {"seed_7", thousandsOfTriangles, {{"seed", 7}}, 1e-4, 1e-2},
     // x-ray (opacities 0.5 and 0.3, and an opaque cylinder): RMSE is the real check here.
     {"transparency", transparentCasters, {{"transparency", true}, {"stack_size", 64}}, 1e-4, 1e-2},
@@ -252,11 +256,13 @@ TEST_F(PsvGLTest, ConcurrentBuildYieldsAValidTopTree) {
     for (bool directional : {false, true}) {
         Shot s = thousandsOfTriangles();
         if (directional) s.light = directionalObjects().light;
-        expectValidTopTree(s, run(s, {}, false));
+        // Depth skip on, so its bounds are checked too; both conservative wedges.
+        for (const char* wedge : {"distance", "exact"})
+            expectValidTopTree(s, run(s, {{"depth_skip", true}, {"wedge_bound", std::string(wedge)}}, false));
     }
     // Transparency keeps the triangles behind capping planes (negative children): checked too.
     Shot x = transparentCasters();
-    expectValidTopTree(x, run(x, {{"transparency", true}}, false));
+    expectValidTopTree(x, run(x, {{"transparency", true}, {"depth_skip", true}}, false));
 }
 
 // ---- CPU-only pieces --------------------------------------------------------------------------------

@@ -27,6 +27,9 @@ Result query(vec3 q) {
 #if PSV_DEPTH_SKIP
     float depth = psvDepth(q);
 #endif
+#if PSV_WEDGE
+    float wedgeScale = psvWedgeScale(q);
+#endif
     // Pushing onto a full stack would drop a subtree that may hold the occluder: stop and report.
 #define PSV_PUSH(node) { if (sp == PSV_STACK_SIZE) { r.overflow = true; break; } stack[sp++] = (node); }
     uint node = psvNodes[0].pos;
@@ -44,7 +47,7 @@ Result query(vec3 q) {
             // opposites, so q is inside at least one of them).
             uint next = s <= 0.0 ? node + 1u : n.pos;
 #if PSV_WEDGE
-            bool visitInter = n.inter != 0u && psvInWedge(s, q, uintBitsToFloat(n.wedgeOrNeg));
+            bool visitInter = n.inter != 0u && psvInWedge(s, wedgeScale, uintBitsToFloat(n.wedgeOrNeg));
 #else
             bool visitInter = n.inter != 0u;
 #endif

@@ -186,6 +186,7 @@ struct PsvWedgeTriangle {
     vec3 v0, v1, v2; // world positions (directional light)
     vec3 a, b, c;    // unit directions from the light to the vertices (point light)
     float arc;       // bound on the arc from a to any point of the triangle; 2 = unbounded
+    float minDist;   // PSV_WEDGE_BOUND 1: distance from the light to the triangle, rounded down
 };
 
 PsvWedgeTriangle psvWedgeTriangle(vec3 v0, vec3 v1, vec3 v2) {
@@ -199,6 +200,11 @@ PsvWedgeTriangle psvWedgeTriangle(vec3 v0, vec3 v1, vec3 v2) {
     // Arcs below 0.5 rad are at most 1.011 times their chords; larger triangles get no bound.
     float chord = max(length(t.b - t.a), length(t.c - t.a));
     t.arc = chord < 0.5 ? 1.02 * chord : 2.0;
+#if PSV_WEDGE_BOUND == 1
+    t.minDist = length(psvClosestPoint(uLightPosition, v0, v1, v2) - uLightPosition) * (1.0 - 1e-5) - uTolerance;
+#else
+    t.minDist = 0.0;
+#endif
     return t;
 }
 
@@ -211,6 +217,16 @@ float psvWedge(vec4 plane, PsvWedgeTriangle t) {
         return max(abs(psvSigned(plane, t.v0)), max(abs(psvSigned(plane, t.v1)), abs(psvSigned(plane, t.v2)))) + uTolerance;
     vec3 n = plane.xyz;
     float m = max(abs(dot(n, t.a)), max(abs(dot(n, t.b)), abs(dot(n, t.c))));
+#if PSV_WEDGE_BOUND == 2
+    // The paper's wedge: the vertices' angles only (too narrow where an edge bulges further out).
+    return min(1.0, m * (1.0 + 1e-5) + 1e-6);
+#elif PSV_WEDGE_BOUND == 1
+    // |sin| at a point p of the triangle is |s(p)| / |p - light|: s is linear, so |s(p)| is at most
+    // its largest value at a vertex, and |p - light| at least the triangle's distance. Wider than
+    // the exact value by about the triangle's depth extent over its distance, never narrower.
+    float s = max(abs(psvSigned(plane, t.v0)), max(abs(psvSigned(plane, t.v1)), abs(psvSigned(plane, t.v2))));
+    return t.minDist > 0.0 ? min(1.0, (s + uTolerance) * (1.0 + 1e-5) / t.minDist + 1e-6) : 1.0;
+#endif
     m = max(m, max(psvArcMax(n, t.a, t.b), max(psvArcMax(n, t.b, t.c), psvArcMax(n, t.c, t.a))));
     if (psvInsideCone(n, t.a, t.b, t.c) || psvInsideCone(-n, t.a, t.b, t.c)) m = 1.0;
     return min(1.0, m * (1.0 + 1e-5) + 1e-6);
@@ -220,13 +236,18 @@ float psvWedge(vec4 plane, PsvWedgeTriangle t) {
 // node's value: |sin| of the angle to the plane is 1-Lipschitz on the sphere, so
 // |n·u| <= |n·a| + arc(a, u) for every point u of the triangle.
 float psvWedgeBound(vec4 plane, PsvWedgeTriangle t) {
+#if PSV_WEDGE_BOUND != 0
+    return psvWedge(plane, t); // cheap already
+#endif
     if (lightIsDirectional()) return psvWedge(plane, t); // exact and cheap already
     float m = max(abs(dot(plane.xyz, t.a)), max(abs(dot(plane.xyz, t.b)), abs(dot(plane.xyz, t.c))));
     return min(1.0, (m + t.arc) * (1.0 + 1e-5) + 2e-6);
 }
 
-// Whether a query point is inside a node's intersection wedge (same units as psvWedge).
-bool psvInWedge(float s, vec3 q, float wedge) {
-    float scale = lightIsDirectional() ? 1.0 : length(q - uLightPosition);
-    return abs(s) <= wedge * scale + uTolerance;
-}
+// The scale psvInWedge compares a query point's plane distance with: its distance to a point
+// light (1 for a directional one), computed once per query point.
+float psvWedgeScale(vec3 q) { return lightIsDirectional() ? 1.0 : length(q - uLightPosition); }
+
+// Whether a query point (plane value s, psvWedgeScale `scale`) is inside a node's intersection
+// wedge (same units as psvWedge).
+bool psvInWedge(float s, float scale, float wedge) { return abs(s) <= wedge * scale + uTolerance; }
