@@ -202,7 +202,7 @@ TEST_F(PtsvGLTest, HeatMapSumsToTheTestAndSetCount) {
 // and shared-memory votes (32 lanes, a barrier per node) give the same image; the path is reported.
 TEST_F(PtsvGLTest, VotePathsAgree) {
     const int width = querySubgroupSize();
-    const bool ballotUsable = width >= 32 || (width > 0 && 32 % width == 0);
+    const bool ballotUsable = width == 4 || width == 8 || width == 16 || width == 32 || width == 64;
     Shot s = fenceDiscontinuity();
     Outcome shared = run(s, {{"vote", std::string("shared")}}, false);
     EXPECT_EQ(shared.counters["vote_path"], 0.0);
@@ -210,15 +210,55 @@ TEST_F(PtsvGLTest, VotePathsAgree) {
     Outcome autoVote = run(s, {}, false);
     EXPECT_EQ(autoVote.counters["vote_path"], ballotUsable ? 1.0 : 0.0);
     EXPECT_EQ(autoVote.counters["subgroup_size"], double(width));
-    // Only a driver without ARB_shader_ballot (or with a width that does not divide 32) has no
-    // ballot path to compare; llvmpipe, NVIDIA and AMD all have one.
+    // Only a driver without ARB_shader_ballot (or with an unusual width) has no ballot path to
+    // compare; llvmpipe, NVIDIA and AMD all have one.
     if (!ballotUsable) GTEST_SKIP() << "no usable ARB_shader_ballot (subgroup " << width << ")";
     Outcome ballot = run(s, {{"vote", std::string("ballot")}}, false);
     EXPECT_EQ(ballot.counters["vote_path"], 1.0);
-    EXPECT_EQ(ballot.counters["traversal_lanes"], double(std::min(width, 32)));
+    EXPECT_EQ(ballot.counters["traversal_lanes"], double(width));
+    EXPECT_EQ(ballot.counters["subgroup_mismatch_groups"], 0.0);
     EXPECT_EQ(ballot.visibility, shared.visibility);
     EXPECT_EQ(ballot.counters["receivers"], shared.counters["receivers"]);
     EXPECT_GT(ballot.counters["test_and_set"], 0.0);
+}
+
+// A ballot traversal compiled for another width than the subgroups it runs on (a driver free to
+// choose SIMD8/16/32, wave32 or wave64) is detected in the shader: its workgroups run nothing and
+// are reported as overflow (never a silent wrong image), and ptsv switches to shared-memory votes
+// from the next frame on, which is then exact. Forcing the width makes the mismatch here. 64 lanes
+// (AMD's waves, two invocations per child) also run through the shared path, so their
+// classification is checked on any device.
+TEST_F(PtsvGLTest, SubgroupWidthMismatchIsReportedThenFallsBack) {
+    const int width = querySubgroupSize();
+    const bool ballot = width == 4 || width == 8 || width == 16 || width == 32 || width == 64;
+    Shot s = thousandsOfTriangles();
+    Outcome base = run(s, {{"vote", std::string("shared")}});
+    EXPECT_LE(base.accuracy.mismatchRatio, 1e-4);
+    for (int lanes : {8, 16, 32, 64})
+        for (const char* vote : {"auto", "shared"}) {
+            SCOPED_TRACE(std::string("lanes ") + std::to_string(lanes) + ", vote " + vote);
+            const bool mismatch = ballot && std::string(vote) == "auto" && lanes != width;
+            RunOptions first;
+            first.withReference = false;
+            AlgorithmRun once = runAlgorithm(ptsvInfo(), s, {{"lanes", lanes}, {"vote", std::string(vote)}}, first);
+            if (mismatch) {
+                EXPECT_GT(once.counters["subgroup_mismatch_groups"], 0.0);
+                EXPECT_GE(once.overflow, uint64_t(once.counters["subgroup_mismatch_groups"])) << "reported as overflow";
+            } else {
+                EXPECT_EQ(once.counters["subgroup_mismatch_groups"], 0.0);
+                EXPECT_EQ(once.overflow, 0u);
+                EXPECT_EQ(once.visibility, base.visibility);
+            }
+            RunOptions second;
+            second.warmUp = true; // the frame after the one that met the mismatch
+            AlgorithmRun o = runAlgorithm(ptsvInfo(), s, {{"lanes", lanes}, {"vote", std::string(vote)}}, second);
+            EXPECT_EQ(o.counters["subgroup_fallback"], mismatch ? 1.0 : 0.0);
+            EXPECT_EQ(o.counters["vote_path"], mismatch || std::string(vote) == "shared" || !ballot ? 0.0 : 1.0);
+            EXPECT_EQ(o.counters["traversal_lanes"], double(lanes));
+            EXPECT_EQ(o.overflow, 0u);
+            EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+            EXPECT_EQ(o.visibility, base.visibility) << "every width and vote path gives the same image";
+        }
 }
 
 // The hierarchy built on the GPU, read back and checked against its definition: the GPU's cluster

@@ -18,7 +18,7 @@ namespace {
 struct PtsvParams {
     std::string bounds;      ///< "explicit" | "implicit"
     bool cullingPlanes, twoPass, frontFaceCulling, jobIterations, heatMap;
-    int splitLevel, tileSize, maxKeyBits, jobCapacity, jobsPerWorkgroup;
+    int splitLevel, tileSize, maxKeyBits, jobCapacity, jobsPerWorkgroup, lanes;
     float planeBias, rayOffset; ///< × scene radius
     std::string vote;        ///< "auto" | "ballot" | "shared"
     std::string leafSamples; ///< "tile" | "cluster"
@@ -61,7 +61,9 @@ const ParamStruct<PtsvParams>& ptsvParams() {
         .integer("job_capacity", &P::jobCapacity, 1 << 20, 1, 1 << 24, "jobs",
                  "two-pass job list; jobs that find it full are finished by pass one (counted in overflow)",
                  ParamChange::Rebuild)
-        .integer("jobs_per_workgroup", &P::jobsPerWorkgroup, 1, 1, 64, "jobs",
+        // 16 by default: on the peer engine scene (512², timing mode) 1240 / 1432 ms per frame
+        // against 1658 / 1592 with 1 and 1363 / 1683 with 64 (docs/algorithms/ptsv.md).
+        .integer("jobs_per_workgroup", &P::jobsPerWorkgroup, 16, 1, 64, "jobs",
                  "consecutive jobs one traversal workgroup runs in turn (the paper's persistent threads run "
                  "until the queue is empty; bounded here by llvmpipe's per-invocation loop cap)",
                  ParamChange::Recompile)
@@ -70,6 +72,11 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                 "invocation testing 32 / width children, no barrier), shared (32 invocations, shared memory and a "
                 "barrier per node), auto (ballot where the driver has it)",
                 ParamChange::Recompile)
+        .integer("lanes", &P::lanes, 0, 0, 64, "invocations",
+                 "traversal workgroup width: 0 = the device's subgroup width with ballots (32 with shared votes); "
+                 "4, 8, 16, 32 or 64 compiles for that width (ballot workgroups whose subgroups differ at run "
+                 "time are reported as overflow, and ptsv switches to shared votes from the next frame)",
+                 ParamChange::Recompile)
         .choice("leaf_samples", &P::leafSamples, "tile", {"tile", "cluster"},
                 "samples tested at a leaf: the whole tile (paper) or only the cluster's (its key compared first)",
                 ParamChange::Recompile)
@@ -121,6 +128,14 @@ public:
     }
 
     void computeVisibility(const FrameInputs& f) override {
+        // The last frame's ballot workgroups found subgroups of another width than compiled (it
+        // was reported as overflow): shared-memory votes from now on.
+        if (vote_ == kVoteBallot && counters_ && counters_.read()[PTSV_C_SUBGROUP_MISMATCH] != 0) {
+            std::fprintf(stderr, "ptsv: subgroups of another width than %d at run time: switching to shared-memory votes\n",
+                         lanes_);
+            fellBack_ = true;
+            compile();
+        }
         ensureLayout(f.camera);
         setUniforms(f.camera, f.light);
         bindAll();
@@ -201,7 +216,9 @@ public:
                     {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
                     {"vote_path", double(vote_)},
                     {"traversal_lanes", double(lanes_)},
-                    {"subgroup_size", double(subgroupSize_)}};
+                    {"subgroup_size", double(subgroupSize_)},
+                    {"subgroup_mismatch_groups", double(c[PTSV_C_SUBGROUP_MISMATCH])},
+                {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
         std::vector<Counter> out = {{"test_and_set", wide(PTSV_C_TESTS_LO)},
                 {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
                 {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
@@ -225,7 +242,9 @@ public:
                 {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
                 {"vote_path", double(vote_)},
                 {"traversal_lanes", double(lanes_)},
-                {"subgroup_size", double(subgroupSize_)}};
+                {"subgroup_size", double(subgroupSize_)},
+                {"subgroup_mismatch_groups", double(c[PTSV_C_SUBGROUP_MISMATCH])},
+                {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
         if (p_.jobIterations) {
             // Figure 7: the jobs that keep a multiprocessor busy longest, against the average.
             const size_t n = scene_ ? scene_->triangleCount() : 0;
@@ -264,7 +283,7 @@ public:
     /// cut short (their shadows may be missing: must stay 0).
     uint64_t overflowCount() const override {
         const auto& c = counters_.read();
-        return uint64_t(c[PTSV_C_JOB_OVERFLOW]) + c[PTSV_C_TRUNCATED];
+        return uint64_t(c[PTSV_C_JOB_OVERFLOW]) + c[PTSV_C_TRUNCATED] + c[PTSV_C_SUBGROUP_MISMATCH];
     }
 
 private:
@@ -281,15 +300,19 @@ private:
     }
 
     void compile() {
-        // The ballot path needs the workgroup to be one subgroup: widths dividing 32 give
-        // 32 / width children per invocation; wider subgroups run 32 invocations in one.
-        const bool ballotUsable = subgroupSize_ >= 32 || (subgroupSize_ > 0 && 32 % subgroupSize_ == 0);
+        // The ballot path needs the workgroup to be one subgroup: widths 4 to 32 test 32 / width
+        // children per invocation, 64 (AMD waves) two invocations per child. Whether the
+        // subgroups really have that width is checked again in the shader, at run time.
+        auto supported = [](int w) { return w == 4 || w == 8 || w == 16 || w == 32 || w == 64; };
+        if (p_.lanes != 0 && !supported(p_.lanes))
+            throw RuntimeError("ptsv: lanes must be 0 (auto), 4, 8, 16, 32 or 64, not " + std::to_string(p_.lanes));
+        const bool ballotUsable = supported(subgroupSize_);
         const std::string vote = p_.vote;
         if (vote == "ballot" && !ballotUsable)
-            throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width dividing 32 or "
-                               "above it (this context: " + std::to_string(subgroupSize_) + ")");
-        vote_ = vote != "shared" && ballotUsable ? kVoteBallot : kVoteShared;
-        lanes_ = vote_ == kVoteBallot ? std::min(subgroupSize_, 32) : 32;
+            throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width of 4, 8, 16, 32 or "
+                               "64 (this context: " + std::to_string(subgroupSize_) + ")");
+        vote_ = vote != "shared" && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
+        lanes_ = p_.lanes != 0 ? p_.lanes : vote_ == kVoteBallot ? subgroupSize_ : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
         ShaderDefines defines = {instrumentationDefine(options_),
                                  {"PTSV_TILE", std::to_string(p_.tileSize)},
@@ -422,6 +445,7 @@ private:
     int subgroupSize_ = 0;
     Vote vote_ = kVoteShared;
     int lanes_ = 32; ///< invocations per traversal workgroup
+    bool fellBack_ = false; ///< ballots met subgroups of another width: shared votes from then on
     ptsv::KeyLayout layout_;
     std::array<float, 6> layoutKey_{};
     bool warnedSplit_ = false;

@@ -51,3 +51,4 @@
 #define PTSV_C_DISPATCH 17       // words 17..19: pass two's indirect dispatch (groups x, y, z)
 #define PTSV_C_LEAF_VISITS 21    // leaf clusters whose samples were tested
 #define PTSV_C_SHADOWED 20       // receivers written shadowed by the resolve pass
+#define PTSV_C_SUBGROUP_MISMATCH 22 // ballot workgroups on subgroups of another width than compiled: jobs not run (overflow)

@@ -11,9 +11,19 @@
 // PTSV_PASS 2: jobs are the pushed pairs, continued from their node.
 //
 // PTSV_BALLOT 1: the workgroup is one subgroup of PTSV_LANES invocations (the driver's subgroup
-//   width, at most 32) and each invocation tests 32 / PTSV_LANES children: votes are
-//   ARB_shader_ballot words, with no shared memory and no barrier at all.
-// PTSV_BALLOT 0: 32 invocations, one child each, votes through shared memory and a barrier.
+//   width, read on the host) and votes are ARB_shader_ballot words, with no shared memory and no
+//   barrier at all (a barrier anywhere in the shader costs llvmpipe 1.7x: it then runs every
+//   workgroup as coroutines). The shader checks gl_SubGroupSizeARB against PTSV_LANES: a
+//   workgroup that runs on subgroups of another width (a driver free to pick SIMD8/16/32, a
+//   wave32/wave64 choice), whose ballots would miss lanes, runs none of its jobs and counts itself
+//   in PTSV_C_SUBGROUP_MISMATCH, which overflowCount() reports (never a silent wrong image); the
+//   host then recompiles with shared-memory votes for the following frames.
+// PTSV_BALLOT 0: PTSV_LANES invocations (32 unless forced), votes through shared memory and a
+//   barrier.
+// PTSV_LANES up to 32: each invocation tests 32 / PTSV_LANES children of a node. PTSV_LANES 64
+//   (AMD's waves): two invocations per child, one testing volume planes 0-1 and culling plane 4,
+//   the other planes 2-3 and culling planes 5-6; the halves' 64-bit ballots are combined, so every
+//   lane of the wave works.
 //
 // The paper runs persistent threads, each warp taking jobs from a queue until it is empty; llvmpipe
 // caps the loop iterations of one invocation at 65535 in total, so here a workgroup takes a fixed
@@ -29,7 +39,10 @@
 #include "ptsv/ptsv.glsl"
 layout(local_size_x = PTSV_LANES) in;
 #define lane gl_LocalInvocationIndex
-#define ROUNDS (32u / uint(PTSV_LANES)) // children tested by each invocation per node
+#if PTSV_LANES != 4 && PTSV_LANES != 8 && PTSV_LANES != 16 && PTSV_LANES != 32 && PTSV_LANES != 64
+#error "PTSV_LANES must be 4, 8, 16, 32 or 64"
+#endif
+#define ROUNDS (PTSV_LANES == 64 ? 1u : 32u / uint(PTSV_LANES)) // children tested by each invocation per node
 
 uniform uint uTriangleCount;
 uniform int uSplitDepth;    // depth of the nodes pushed by pass one (1 .. levels)
@@ -42,24 +55,40 @@ uniform mat4 uInvView;      // view → world (implicit bounds test in view spac
 #if !PTSV_BALLOT
 // Three slots: slot i % 3 is written in vote i, read after its barrier, and cleared by invocation 0
 // after the barrier of vote i + 1 (when every invocation has read it), two votes before its reuse.
-shared uint sVote[3][2];
+// A vote holds up to three ballots of 64 bits (two words each).
+shared uint sVote[3][6];
 shared uint sBroadcast;
 uint voteSeq = 0u;
 #endif
 
-// Bit `lane` of x: a, bit `lane` of y: b, over the workgroup (children round * PTSV_LANES + lane).
+// Ballots of a, b and c over the workgroup, 64 bits each as (low, high) words: bit `lane`.
+void vote3(bool a, bool b, bool c, out uvec2 A, out uvec2 B, out uvec2 C) {
+#if PTSV_BALLOT
+    A = unpackUint2x32(ballotARB(a));
+    B = unpackUint2x32(ballotARB(b));
+    C = unpackUint2x32(ballotARB(c));
+#else
+    uint slot = voteSeq % 3u, w = lane >> 5u, bit = 1u << (lane & 31u);
+    if (a) atomicOr(sVote[slot][w], bit);
+    if (b) atomicOr(sVote[slot][2u + w], bit);
+    if (c) atomicOr(sVote[slot][4u + w], bit);
+    barrier();
+    A = uvec2(sVote[slot][0], sVote[slot][1]);
+    B = uvec2(sVote[slot][2], sVote[slot][3]);
+    C = uvec2(sVote[slot][4], sVote[slot][5]);
+    if (lane == 0u) sVote[(slot + 2u) % 3u] = uint[6](0u, 0u, 0u, 0u, 0u, 0u);
+    ++voteSeq;
+#endif
+}
+
+// Bit `lane` of x: a, bit `lane` of y: b, over a workgroup of at most 32 invocations.
 uvec2 vote2(bool a, bool b) {
 #if PTSV_BALLOT
     return uvec2(unpackUint2x32(ballotARB(a)).x, unpackUint2x32(ballotARB(b)).x);
 #else
-    uint slot = voteSeq % 3u;
-    if (a) atomicOr(sVote[slot][0], 1u << lane);
-    if (b) atomicOr(sVote[slot][1], 1u << lane);
-    barrier();
-    uvec2 r = uvec2(sVote[slot][0], sVote[slot][1]);
-    if (lane == 0u) sVote[(slot + 2u) % 3u] = uint[2](0u, 0u);
-    ++voteSeq;
-    return r;
+    uvec2 A, B, C;
+    vote3(a, b, false, A, B, C);
+    return uvec2(A.x, B.x);
 #endif
 }
 
@@ -117,6 +146,37 @@ bvec2 classify(uint childId, int depth) {
     return bvec2(rejected, accepted && !rejected);
 }
 
+#if PTSV_LANES == 64
+// Half of classify(): volume planes 2 side, 2 side + 1 and the culling planes 4 (side 0) or 5, 6
+// (side 1), unconditionally (visit() applies them where the four planes decide nothing).
+// x = rejected by one of its volume planes, y = inside both, z = rejected by a culling plane.
+bvec3 classifyHalf(uint childId, int depth, uint side) {
+#if PTSV_EXPLICIT_BOUNDS
+    uint b = 6u * (uNodeOffset[depth] + childId);
+    vec3 bmin = vec3(ptsvBounds[b], ptsvBounds[b + 1u], ptsvBounds[b + 2u]);
+    vec3 bmax = vec3(ptsvBounds[b + 3u], ptsvBounds[b + 4u], ptsvBounds[b + 5u]);
+    float pad = uTolerance;
+#define PTSV_RANGE(i) ptsvBoxRange(gPlane[i], bmin, bmax)
+#else
+    vec2 xr, yr, dr;
+    ptsvImplicitExtent(childId, depth, xr, yr, dr);
+    float pad = uTolerance + uImplicitPad;
+#define PTSV_RANGE(i) ptsvFrustumRange(gView[i], xr, yr, dr)
+#endif
+    bool rejected = false, accepted = true, culled = false;
+    for (int k = 0; k < 2; ++k) {
+        vec2 r = PTSV_RANGE(int(2u * side) + k);
+        rejected = rejected || r.x > pad;
+        accepted = accepted && r.y < -pad;
+    }
+#if PTSV_CULLING_PLANES
+    for (int i = side == 0u ? 4 : 5; i < (side == 0u ? 5 : 7); ++i) culled = culled || PTSV_RANGE(i).x > pad;
+#endif
+#undef PTSV_RANGE
+    return bvec3(rejected, accepted, culled);
+}
+#endif
+
 // Tests the samples of cluster `key`'s tile against the volume and marks the shadowed ones.
 void testSamples(uint key) {
     ++gIterations;
@@ -148,6 +208,20 @@ uint visit(int depth, uint id) {
     uint maskIndex = uMaskOffset[depth] + id;
     uint mask = ptsvMasks[maskIndex];
     uvec2 v = uvec2(0u);
+#if PTSV_LANES == 64
+    uint c = lane & 31u, side = lane >> 5u;
+    bool exists = ((mask >> c) & 1u) != 0u;
+    bvec3 r = exists ? classifyHalf(id * 32u + c, depth + 1, side) : bvec3(true, false, false);
+    if (exists && side == 0u) ++gNodeTests;
+    uvec2 R, A, C;
+    vote3(r.x, r.y, r.z, R, A, C);
+    // classify() of the whole child: rejected by a volume plane, or by a culling plane where the
+    // volume planes decide nothing; accepted inside all four and not rejected.
+    uint rejected4 = R.x | R.y, accepted4 = A.x & A.y;
+    uint rejected = rejected4 | ((C.x | C.y) & ~accepted4);
+    uint accepted = accepted4 & ~rejected4;
+    v = uvec2(mask & ~rejected & ~accepted, mask & accepted);
+#else
     for (uint round = 0u; round < ROUNDS; ++round) {
         uint c = round * uint(PTSV_LANES) + lane;
         bool exists = ((mask >> c) & 1u) != 0u;
@@ -155,6 +229,7 @@ uint visit(int depth, uint id) {
         if (exists) ++gNodeTests;
         v |= vote2(!r.x && !r.y, r.y) << (round * uint(PTSV_LANES));
     }
+#endif
     if (v.y != 0u && lane == 0u) {
         atomicAnd(ptsvMasks[maskIndex], ~v.y);
         gAccepted += uint(bitCount(v.y));
@@ -236,8 +311,14 @@ void main() {
 #else
     uint count = min(ptsvCounters[PTSV_C_JOBS_PUSHED], uJobCapacity);
 #endif
-#if !PTSV_BALLOT
-    if (lane == 0u) sVote[0] = sVote[1] = sVote[2] = uint[2](0u, 0u);
+#if PTSV_BALLOT
+    // Ballots only see one subgroup: the workgroup must be exactly one (see the top).
+    if (gl_SubGroupSizeARB != uint(PTSV_LANES)) {
+        if (lane == 0u) atomicAdd(ptsvCounters[PTSV_C_SUBGROUP_MISMATCH], 1u);
+        return;
+    }
+#else
+    if (lane == 0u) sVote[0] = sVote[1] = sVote[2] = uint[6](0u, 0u, 0u, 0u, 0u, 0u);
     barrier();
 #endif
     for (uint k = 0u; k < uint(PTSV_JOBS_PER_GROUP); ++k) {
