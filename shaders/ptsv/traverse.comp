@@ -111,6 +111,7 @@ vec4 gPlane[7] = kZero7; // world space: edges 0..2, triangle plane 3, culling p
 vec4 gView[7] = kZero7;  // the same in view space (implicit bounds)
 uint gTriangle = 0u;
 uint gTests = 0u, gNodeTests = 0u, gLeafVisits = 0u, gAccepted = 0u, gIterations = 0u;
+uint gIterMax = 0u, gIterSum = 0u, gJobs = 0u; // this batch's jobs, added up once at the workgroup's end
 bool gTruncated = false; // a loop ended without its exit condition: the driver's iteration cap
 
 // Classifies child `childId` at `depth` against the volume: x = rejected, y = trivially accepted.
@@ -285,21 +286,17 @@ void loadTriangle(uint t) {
     }
 }
 
-// Per job: the Figure 7 statistics (invocation 0 speaks for the workgroup).
+// Per job: the Figure 7 statistics (invocation 0 speaks for the workgroup), summed over the batch
+// and added with three atomics per workgroup at its end, not per job; compiled out in timing mode.
 void finishJob(uint job) {
 #if SHADOWLAB_INSTRUMENTATION
     if (lane != 0u) return;
 #if PTSV_JOB_ITERATIONS
     ptsvJobIterations[PTSV_PASS == 1 ? job : uTriangleCount + job] = gIterations;
 #endif
-#if PTSV_PASS == 1
-    atomicMax(ptsvCounters[PTSV_C_ITER_MAX_1], gIterations);
-    atomicAdd(ptsvCounters[PTSV_C_ITER_SUM_1], gIterations);
-    atomicAdd(ptsvCounters[PTSV_C_JOBS_1], 1u);
-#else
-    atomicMax(ptsvCounters[PTSV_C_ITER_MAX_2], gIterations);
-    atomicAdd(ptsvCounters[PTSV_C_ITER_SUM_2], gIterations);
-#endif
+    gIterMax = max(gIterMax, gIterations);
+    gIterSum += gIterations;
+    ++gJobs;
 #endif // SHADOWLAB_INSTRUMENTATION
 }
 
@@ -346,6 +343,16 @@ void main() {
     if (lane == 0u) {
         if (gAccepted != 0u) atomicAdd(ptsvCounters[PTSV_C_ACCEPTED], gAccepted);
         if (gLeafVisits != 0u) atomicAdd(ptsvCounters[PTSV_C_LEAF_VISITS], gLeafVisits);
+        if (gJobs != 0u) { // the batch's per-job statistics, three atomics per workgroup
+#if PTSV_PASS == 1
+            atomicMax(ptsvCounters[PTSV_C_ITER_MAX_1], gIterMax);
+            atomicAdd(ptsvCounters[PTSV_C_ITER_SUM_1], gIterSum);
+            atomicAdd(ptsvCounters[PTSV_C_JOBS_1], gJobs);
+#else
+            atomicMax(ptsvCounters[PTSV_C_ITER_MAX_2], gIterMax);
+            atomicAdd(ptsvCounters[PTSV_C_ITER_SUM_2], gIterSum);
+#endif
+        }
     }
 #endif
 }
