@@ -145,32 +145,24 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(BVH_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
-        if (!options_.instrumentation) // timing mode: the structure and what is still measured
-            return {{"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
-                    {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
-                    {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
-                    {"bvh_nodes", double(nodeCount_)},
-                    {"bvh_leaves", double(leaves_)},
-                    {"bvh_depth", double(depth_)},
-                    {"bvh_sah_cost", sahCost_},
-                    {"bvh_build_ms", buildMs_},
-                    {"node_bytes", double(nodes_.size())},
-                    {"triangle_bytes", double(triangles_.size())}};
-        return {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
-                {"nodes_visited_max", double(c[BVH_C_VISITED_MAX])},
-                {"triangles_tested_mean", perRay(wide(BVH_C_TRIS_LO))},
-                {"rays", rays},
-                {"traced_pixels", double(c[BVH_C_PIXELS])},
-                {"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
-                {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
-                {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
-                {"bvh_nodes", double(nodeCount_)},
-                {"bvh_leaves", double(leaves_)},
-                {"bvh_depth", double(depth_)},
-                {"bvh_sah_cost", sahCost_},
-                {"bvh_build_ms", buildMs_},
-                {"node_bytes", double(nodes_.size())},
-                {"triangle_bytes", double(triangles_.size())}};
+        // The structure and what is measured in both modes; timing mode compiles the rest out.
+        std::vector<Counter> out = {{"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
+                                    {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
+                                    {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
+                                    {"bvh_nodes", double(nodeCount_)},
+                                    {"bvh_leaves", double(leaves_)},
+                                    {"bvh_depth", double(depth_)},
+                                    {"bvh_sah_cost", sahCost_},
+                                    {"bvh_build_ms", buildMs_},
+                                    {"node_bytes", double(nodes_.size())},
+                                    {"triangle_bytes", double(triangles_.size())}};
+        if (!options_.instrumentation) return out;
+        out.insert(out.begin(), {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
+                                 {"nodes_visited_max", double(c[BVH_C_VISITED_MAX])},
+                                 {"triangles_tested_mean", perRay(wide(BVH_C_TRIS_LO))},
+                                 {"rays", rays},
+                                 {"traced_pixels", double(c[BVH_C_PIXELS])}});
+        return out;
     }
 
     std::vector<DebugView> debugViews() const override {

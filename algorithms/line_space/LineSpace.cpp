@@ -251,26 +251,8 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(LS_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
-        if (!options_.instrumentation) // timing mode: the structure and what is still measured
-            return {{"truncated_pixels", double(c[LS_C_TRUNCATED])},
-                    {"subdivided_nodes", double(tree_.nodes.size())},
-                    {"build_ms", tree_.buildMs},
-                    {"cache_hit", cacheHit_ ? 1.0 : 0.0},
-                    {"node_pool_bytes", double(poolBytes_[0])},
-                    {"tree_pool_bytes", double(poolBytes_[1])},
-                    {"line_space_pool_bytes", double(poolBytes_[2])},
-                    {"occupancy_pool_bytes", double(poolBytes_[3])},
-                    {"exact_start_bytes", double(poolBytes_[4])}};
-        std::vector<Counter> out = {{"nodes_visited_mean", perRay(wide(LS_C_VISITED_LO))},
-                                    {"nodes_visited_max", double(c[LS_C_VISITED_MAX])},
-                                    {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
-                                    {"cells_stepped_mean", perRay(wide(LS_C_CELLS_LO))},
-                                    {"leaf_cells_mean", perRay(wide(LS_C_LEAVES_LO))},
-                                    {"triangles_tested_mean", perRay(wide(LS_C_TRIS_LO))},
-                                    {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
-                                    {"rays", rays},
-                                    {"traced_pixels", double(c[LS_C_PIXELS])},
-                                    {"truncated_pixels", double(c[LS_C_TRUNCATED])},
+        // The structure and what is measured in both modes; timing mode compiles the rest out.
+        std::vector<Counter> out = {{"truncated_pixels", double(c[LS_C_TRUNCATED])},
                                     {"subdivided_nodes", double(tree_.nodes.size())},
                                     {"build_ms", tree_.buildMs},
                                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
@@ -279,6 +261,16 @@ public:
                                     {"line_space_pool_bytes", double(poolBytes_[2])},
                                     {"occupancy_pool_bytes", double(poolBytes_[3])},
                                     {"exact_start_bytes", double(poolBytes_[4])}};
+        if (!options_.instrumentation) return out;
+        out.insert(out.begin(), {{"nodes_visited_mean", perRay(wide(LS_C_VISITED_LO))},
+                                 {"nodes_visited_max", double(c[LS_C_VISITED_MAX])},
+                                 {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
+                                 {"cells_stepped_mean", perRay(wide(LS_C_CELLS_LO))},
+                                 {"leaf_cells_mean", perRay(wide(LS_C_LEAVES_LO))},
+                                 {"triangles_tested_mean", perRay(wide(LS_C_TRIS_LO))},
+                                 {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
+                                 {"rays", rays},
+                                 {"traced_pixels", double(c[LS_C_PIXELS])}});
         for (size_t l = 0; l < tree_.nodesPerLevel.size(); ++l)
             out.push_back({"nodes_level_" + std::to_string(l), double(tree_.nodesPerLevel[l])});
         if (p_.classify && pendingG_.width > 0) {

@@ -206,45 +206,34 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double jobs1 = c[PTSV_C_JOBS_1];
         const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(p_.jobCapacity));
-        if (!options_.instrumentation) // timing mode: the structure's shape and what is still measured
-            return {{"jobs", p_.twoPass ? pushed : 0.0},
-                    {"job_overflow", double(c[PTSV_C_JOB_OVERFLOW])},
-                    {"truncated_jobs", double(c[PTSV_C_TRUNCATED])},
-                    {"tree_levels", double(layout_.levels)},
-                    {"key_bits", double(layout_.keyBits)},
-                    {"slices_merged", double(layout_.merged)},
-                    {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
-                    {"vote_path", double(vote_)},
-                    {"traversal_lanes", double(lanes_)},
-                    {"subgroup_size", double(subgroupSize_)},
-                    {"subgroup_mismatch_groups", double(c[PTSV_C_SUBGROUP_MISMATCH])},
-                {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
-        std::vector<Counter> out = {{"test_and_set", wide(PTSV_C_TESTS_LO)},
-                {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
-                {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
-                {"iterations_mean_pass1", jobs1 > 0 ? c[PTSV_C_ITER_SUM_1] / jobs1 : 0.0},
-                {"iterations_max_pass2", double(c[PTSV_C_ITER_MAX_2])},
-                {"iterations_mean_pass2", pushed > 0 ? c[PTSV_C_ITER_SUM_2] / pushed : 0.0},
-                {"jobs", p_.twoPass ? pushed : 0.0},
-                {"job_overflow", double(c[PTSV_C_JOB_OVERFLOW])},
-                {"truncated_jobs", double(c[PTSV_C_TRUNCATED])},
-                {"accepted_nodes", double(c[PTSV_C_ACCEPTED])},
-                {"leaf_visits", double(c[PTSV_C_LEAF_VISITS])},
-                {"clusters", double(c[PTSV_C_CLUSTERS])},
-                {"receivers", double(c[PTSV_C_RECEIVERS])},
-                {"shadowed", double(c[PTSV_C_SHADOWED])},
-                {"casters", jobs1},
-                {"culled_front_facing", double(c[PTSV_C_CULLED_FACING])},
-                {"culled_edge_on", double(c[PTSV_C_CULLED_EDGE_ON])},
-                {"tree_levels", double(layout_.levels)},
-                {"key_bits", double(layout_.keyBits)},
-                {"slices_merged", double(layout_.merged)},
-                {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
-                {"vote_path", double(vote_)},
-                {"traversal_lanes", double(lanes_)},
-                {"subgroup_size", double(subgroupSize_)},
-                {"subgroup_mismatch_groups", double(c[PTSV_C_SUBGROUP_MISMATCH])},
-                {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
+        // The structure's shape and what is measured in both modes; timing mode compiles the rest out.
+        std::vector<Counter> out = {{"jobs", p_.twoPass ? pushed : 0.0},
+                                    {"job_overflow", double(c[PTSV_C_JOB_OVERFLOW])},
+                                    {"truncated_jobs", double(c[PTSV_C_TRUNCATED])},
+                                    {"tree_levels", double(layout_.levels)},
+                                    {"key_bits", double(layout_.keyBits)},
+                                    {"slices_merged", double(layout_.merged)},
+                                    {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
+                                    {"vote_path", double(vote_)},
+                                    {"traversal_lanes", double(lanes_)},
+                                    {"subgroup_size", double(subgroupSize_)},
+                                    {"subgroup_mismatch_groups", double(c[PTSV_C_SUBGROUP_MISMATCH])},
+                                    {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
+        if (!options_.instrumentation) return out;
+        out.insert(out.end(), {{"test_and_set", wide(PTSV_C_TESTS_LO)},
+                               {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
+                               {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
+                               {"iterations_mean_pass1", jobs1 > 0 ? c[PTSV_C_ITER_SUM_1] / jobs1 : 0.0},
+                               {"iterations_max_pass2", double(c[PTSV_C_ITER_MAX_2])},
+                               {"iterations_mean_pass2", pushed > 0 ? c[PTSV_C_ITER_SUM_2] / pushed : 0.0},
+                               {"accepted_nodes", double(c[PTSV_C_ACCEPTED])},
+                               {"leaf_visits", double(c[PTSV_C_LEAF_VISITS])},
+                               {"clusters", double(c[PTSV_C_CLUSTERS])},
+                               {"receivers", double(c[PTSV_C_RECEIVERS])},
+                               {"shadowed", double(c[PTSV_C_SHADOWED])},
+                               {"casters", jobs1},
+                               {"culled_front_facing", double(c[PTSV_C_CULLED_FACING])},
+                               {"culled_edge_on", double(c[PTSV_C_CULLED_EDGE_ON])}});
         if (p_.jobIterations) {
             // Figure 7: the jobs that keep a multiprocessor busy longest, against the average.
             const size_t n = scene_ ? scene_->triangleCount() : 0;
