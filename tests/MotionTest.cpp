@@ -143,7 +143,7 @@ TEST(MovingSceneTest, ConfigsRefuseStaticOnlyAlgorithmsOnMovingScenesUnlessTheyR
 TEST(GltfAnimationTest, PlaysNodeChannelsOnTheFilesClock) {
     const std::string file = test::makeTempDir("anim") + "/spin.gltf";
     test::writeAnimatedGltf(file);
-    Scene s = loadGltf(file, nullptr, 1000, "spin");
+    Scene s = loadGltf(file, nullptr, 1000, {"spin"});
     ASSERT_EQ(s.moving.size(), 1u);
     EXPECT_EQ(s.moving[0].triangleCount, 2u);
     EXPECT_EQ(s.motionTimeRange(), glm::dvec2(0, 2));
@@ -156,7 +156,7 @@ TEST(GltfAnimationTest, PlaysNodeChannelsOnTheFilesClock) {
     const float c = std::cos(glm::radians(45.0f)), sn = std::sin(glm::radians(45.0f));
     expectNear(apply(s.moving[0].worldFromLocal(0.5), {1, 0, 0}), {c, 2, -sn});
     // The same animation by index; without one, the file is static at its rest pose.
-    EXPECT_EQ(loadGltf(file, nullptr, 1000, "0").moving.size(), 1u);
+    EXPECT_EQ(loadGltf(file, nullptr, 1000, {"0"}).moving.size(), 1u);
     EXPECT_FALSE(loadGltf(file, nullptr, 1000).dynamic());
 
     // CUBICSPLINE with zero tangents eases between the same keys: through them, and half way at t = 0.5
@@ -165,7 +165,7 @@ TEST(GltfAnimationTest, PlaysNodeChannelsOnTheFilesClock) {
     o.rotationInterpolation = "CUBICSPLINE";
     o.translationInterpolation = "LINEAR";
     test::writeAnimatedGltf(file, o);
-    Scene cubic = loadGltf(file, nullptr, 1000, "spin");
+    Scene cubic = loadGltf(file, nullptr, 1000, {"spin"});
     expectNear(apply(cubic.moving[0].worldFromLocal(1.0), {1, 0, 0}), {0, 2, -1.2f});
     expectNear(apply(cubic.moving[0].worldFromLocal(0.5), {1, 0, 0}), {1.1f * c, 2, -1.1f * sn});
 }
@@ -192,7 +192,7 @@ TEST(GltfAnimationTest, ConfigNodePathsTurnAPartAboutItsCentreOrItsOrigin) {
 
 std::string gltfError(const std::string& file, const std::string& animation) {
     try {
-        loadGltf(file, nullptr, 1'000'000, animation);
+        loadGltf(file, nullptr, 1'000'000, {animation});
     } catch (const InputError& e) {
         return e.jsonPath() + ": " + e.cause();
     }

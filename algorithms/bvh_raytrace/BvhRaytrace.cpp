@@ -127,8 +127,7 @@ public:
         f.timer.begin("trace");
         counters_.clear();
         setLightUniforms(trace_, f.light);
-        const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
-        trace_.set("uRayOffset", p_.rayOffset * radius);
+        trace_.set("uRayOffset", rayOffsetLength(p_.rayOffset, *scene_));
         trace_.set("uSampleCount", sampleCount);
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_NODE_BINDING);
         triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_TRI_BINDING);

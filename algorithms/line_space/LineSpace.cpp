@@ -346,10 +346,7 @@ private:
         classifyProgram_ = ShaderProgram(); // compiled on first use
     }
 
-    float rayOffset() const {
-        const float radius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
-        return p_.rayOffset * radius;
-    }
+    float rayOffset() const { return rayOffsetLength(p_.rayOffset, *scene_); }
 
     /// The tree from the disk cache when allowed and valid, else built (and cached).
     ls::NTree obtainTree(const Scene& scene, int n, int d, size_t blockLimit, bool useCache) {

@@ -104,26 +104,28 @@ public:
         clusters_ = GlBuffer(), nodes_ = GlBuffer();
         for (GlBuffer& g : geometry_) g = GlBuffer();
         // A moving scene: clusters per part in the part's own space, posed each frame (sceneMoved).
-        const bool rigid = scene.dynamic() && p_.motion == "rigid";
-        mt::Clustering c = rigid ? clusterByPart(scene.cpu()) : cluster(scene.cpu());
-        upload(c, scene.cpu());
-        if (rigid) {
-            restClusters_ = GlBuffer::fromVector(c.clusters, 0);
-            clusterPart_ = GlBuffer::fromVector(clusterPart_cpu_, 0);
-            order_ = GlBuffer::fromVector(c.order, 0);
-            movingFirst_ = staticTriangles_;
+        if (!scene.dynamic() || p_.motion != "rigid") {
+            upload(cluster(scene.cpu(), p_.cache), scene.cpu());
+            return;
+        }
+        PartClustering pc = clusterByPart(scene.cpu());
+        upload(pc.clustering, scene.cpu());
+        restClusters_ = GlBuffer::fromVector(pc.clustering.clusters, 0);
+        clusterPart_ = GlBuffer::fromVector(pc.parts, 0);
+        order_ = GlBuffer::fromVector(pc.clustering.order, 0);
+        movingFirst_ = pc.staticTriangles;
+        movingClusterFirst_ = pc.staticClusters;
+        if (!poseClusters_) {  // no define of theirs changes: compiled once, for moving scenes only
+            poseClusters_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "1"}});
+            poseGeometry_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "0"}});
         }
     }
 
     void sceneMoved(const FrameInputs& f) override {
         if (p_.motion == "recluster") {
             f.timer.begin("recluster", false);
-            posed_ = scene_->posedScene();
-            const bool cache = p_.cache;
-            p_.cache = false; // a pose is never seen twice: caching would only write files
-            mt::Clustering c = cluster(posed_);
-            p_.cache = cache;
-            upload(c, posed_);
+            const Scene posed = scene_->posedScene();
+            upload(cluster(posed, false), posed);  // no cache: a pose is never seen twice
             f.timer.end();
             return;
         }
@@ -284,8 +286,6 @@ private:
                                        {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
                                        instrumentationDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
-        poseClusters_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "1"}});
-        poseGeometry_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "0"}});
         insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
     }
@@ -301,11 +301,11 @@ private:
         return o;
     }
 
-    /// The clustering from the disk cache when allowed and valid, else computed (and cached).
-    mt::Clustering cluster(const Scene& scene) {
+    /// The clustering from the disk cache when `useCache` and valid, else computed (and cached).
+    mt::Clustering cluster(const Scene& scene, bool useCache) {
         const auto start = std::chrono::steady_clock::now();
         const mt::ClusteringOptions o = clusteringOptions();
-        const std::string dir = p_.cache ? mt::cacheDirectory() : std::string();
+        const std::string dir = useCache ? mt::cacheDirectory() : std::string();
         const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
         const std::string path = dir.empty() ? std::string() : mt::cacheFile(dir, hash, o);
         const size_t n = scene.triangleCount();
@@ -318,15 +318,23 @@ private:
         return c;
     }
 
+    /// A clustering of a moving scene, and for each cluster its part (kStaticPart for static ones).
+    struct PartClustering {
+        mt::Clustering clustering;
+        std::vector<uint32_t> parts;
+        size_t staticTriangles = 0, staticClusters = 0; ///< the moving ones follow (in cluster order)
+    };
+
     /// Clusters that never span two parts: the static triangles (world space) first, then each
     /// moving part in its own space; `first` and `order` refer to the whole scene. Not cached: the
     /// cache's validation checks clusters against world positions.
-    mt::Clustering clusterByPart(const Scene& scene) {
+    PartClustering clusterByPart(const Scene& scene) {
         const auto start = std::chrono::steady_clock::now();
         mt::ClusteringOptions o = clusteringOptions();
         o.randomOrder = false; // shuffled once below, over all groups
-        mt::Clustering all;
-        std::vector<uint32_t> parts;
+        PartClustering out;
+        mt::Clustering& all = out.clustering;
+        std::vector<uint32_t>& parts = out.parts;
         auto addGroup = [&](const std::vector<uint32_t>& triangles, const glm::vec3* local, uint32_t part) {
             if (triangles.empty()) return;
             Scene g;
@@ -350,15 +358,11 @@ private:
             all.capsules += c.capsules;
         };
         std::vector<uint32_t> statics;
-        size_t next = 0;
-        for (const MovingPart& part : scene.moving) {
-            for (size_t t = next; t < part.firstTriangle; ++t) statics.push_back(uint32_t(t));
-            next = part.firstTriangle + part.triangleCount;
-        }
-        for (size_t t = next; t < scene.triangleCount(); ++t) statics.push_back(uint32_t(t));
+        for (auto [from, to] : scene.staticRuns())
+            for (size_t t = from; t < to; ++t) statics.push_back(uint32_t(t));
         addGroup(statics, nullptr, kStaticPart);
-        staticTriangles_ = statics.size();
-        movingClusterFirst_ = all.clusters.size();
+        out.staticTriangles = statics.size();
+        out.staticClusters = all.clusters.size();
         for (uint32_t p = 0; p < scene.moving.size(); ++p) {
             const MovingPart& part = scene.moving[p];
             std::vector<uint32_t> triangles(part.triangleCount);
@@ -376,13 +380,12 @@ private:
                     std::swap(parts[i - 1], parts[j]);
                 }
             };
-            shuffleRange(0, movingClusterFirst_);
-            shuffleRange(movingClusterFirst_, all.clusters.size());
+            shuffleRange(0, out.staticClusters);
+            shuffleRange(out.staticClusters, all.clusters.size());
         }
-        clusterPart_cpu_ = std::move(parts);
         cacheHit_ = false;
         clusteringMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        return all;
+        return out;
     }
 
     void bindGeometry() const {
@@ -462,9 +465,7 @@ private:
     // the static clusters and triangles come first, moving ones from these indices on.
     static constexpr uint32_t kStaticPart = 0xFFFFFFFFu;
     GlBuffer restClusters_, clusterPart_, order_;
-    std::vector<uint32_t> clusterPart_cpu_;
-    size_t staticTriangles_ = 0, movingFirst_ = 0, movingClusterFirst_ = 0;
-    Scene posed_; ///< recluster: the scene as last posed
+    size_t movingFirst_ = 0, movingClusterFirst_ = 0;
     GpuCounters<MT_COUNTER_WORDS> counters_;
     std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;
     GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;

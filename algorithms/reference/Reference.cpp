@@ -64,9 +64,7 @@ public:
         const CpuGBuffer& g = frame.cpuGBuffer();
         frame.timer.begin("trace", false); // CPU stage: no GPU query
         auto t0 = std::chrono::steady_clock::now();
-        // The current bounds, as every GPU algorithm reads them each frame: the same offset everywhere.
-        const float sceneRadius = scene_->bounds().empty() ? 1.0f : scene_->bounds().radius();
-        tracer_->traceVisibility(g, frame.light, p_.rayOffset * sceneRadius, p_.threads, visibility_);
+        tracer_->traceVisibility(g, frame.light, rayOffsetLength(p_.rayOffset, *scene_), p_.threads, visibility_);
         double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         frame.timer.end();
         rays_ = double(tracer_->lastRayCount());

@@ -2,6 +2,7 @@
 // Parameter rows that several algorithms share, declared once: the same key, default, range, unit
 // and meaning wherever they appear, so configs, the GUI and results compare like with like.
 #include "framework/core/Params.h"
+#include "framework/render/SceneGpu.h"
 
 #include <string>
 
@@ -19,6 +20,12 @@ template <class T> auto rayOffsetRow(float T::*member) {
         s.real("ray_offset", member, kDefaultRayOffset, 0.0, 1e-2, "× scene radius",
                "shadow query point (ray origin) offset along the surface normal, against self-shadowing", ParamChange::Update);
     };
+}
+
+/// The ray offset in scene units: `offset` radii of the scene as currently posed (1 for an empty
+/// scene). Every algorithm reads it per frame, so all trace from the same points even as parts move.
+inline float rayOffsetLength(float offset, const SceneGpu& scene) {
+    return offset * (scene.bounds().empty() ? 1.0f : scene.bounds().radius());
 }
 
 /// `stack_size`: a fixed-size traversal stack, compiled into the shader. Overflow is never silent:

@@ -46,12 +46,6 @@ void writeImages(const std::string& dir, const std::string& id, int frame, glm::
     }
 }
 
-size_t movingTriangles(const Scene& s) {
-    size_t n = 0;
-    for (const MovingPart& p : s.moving) n += p.triangleCount;
-    return n;
-}
-
 /// `timeSource` is summary.json's stage_time_source: which column of frames.csv the stage plot uses.
 void runPlots(const std::string& dir, const std::string& finalDir, const std::string& timeSource) {
     // SHADOWLAB_PYTHON picks another interpreter (one with matplotlib) than the one found at build time.
@@ -124,7 +118,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"timing_mode", cfg.timingMode},
                     {"triangles", cfg.scene->triangleCount()},
                     {"moving_parts", cfg.scene->moving.size()},
-                    {"moving_triangles", movingTriangles(*cfg.scene)},
+                    {"moving_triangles", cfg.scene->movingTriangleCount()},
                     {"light", toString(cfg.light.type)},
                     {"reference", cfg.reference}};
 
@@ -156,12 +150,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         Camera cam = cfg.cameraAt(frame);
         Light light = cfg.lightAt(frame);
         // Posing the moving parts is shared work: done once, its cost reported in every algorithm's frame.
-        TimedWork sceneUpdate;
-        if (sceneGpu.dynamic()) sceneUpdate = timeWork(timer, [&] {
-            timer.begin("scene_update");
-            sceneGpu.setTime(cfg.sceneTimeAt(frame));
-            timer.end();
-        });
+        const TimedWork sceneUpdate = sceneGpu.setTime(cfg.sceneTimeAt(frame), timer);
         if (sceneGpu.dynamic()) checkPoseBounds(cfg, frame, sceneGpu.bounds());
         renderFrame(cam);
         glFinish();

@@ -105,13 +105,8 @@ FrameMeasurement Viewer::runOn(AlgorithmHost& host, StageTimer& timer) {
 void Viewer::renderFrame() {
     if (resolution_.x <= 0) return;
     // Moving parts follow the playback frame (and so the scrubber) on the runner's clock.
-    TimedWork sceneUpdate;
-    if (sceneGpu_->dynamic()) sceneUpdate = timeWork(timer_, [&] {
-        timer_.begin("scene_update");
-        sceneTime_ = config_.sceneTimeAt(playback.frame);
-        sceneGpu_->setTime(sceneTime_);
-        timer_.end();
-    });
+    sceneTime_ = config_.sceneTimeAt(playback.frame);
+    TimedWork sceneUpdate = sceneGpu_->setTime(sceneTime_, timer_);
     gbuffer_->render(*sceneGpu_, camera);
     cpuG_.reset();
     lastStages_.clear();

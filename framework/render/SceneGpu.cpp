@@ -60,7 +60,6 @@ void SceneGpu::uploadMotion() {
             index.emplace_back(uint32_t(part.firstTriangle + i), uint32_t(p));
         }
     }
-    movingTriangles_ = index.size();
     local_ = GlBuffer::fromVector(local, 0);
     movingIndex_ = GlBuffer::fromVector(index, 0);
     transforms_ = GlBuffer(scene_->moving.size() * sizeof(glm::mat4), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -114,11 +113,21 @@ void SceneGpu::setTime(double time) {
     positions_.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
     triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
     vertexNormals_.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
-    update_.set("uCount", unsigned(movingTriangles_));
+    const size_t moving = scene_->movingTriangleCount();
+    update_.set("uCount", unsigned(moving));
     update_.use();
-    update_.dispatchLinear(movingTriangles_, 64);
+    update_.dispatchLinear(moving, 64);
     // Everything after reads the posed scene: algorithms as SSBOs, the G-buffer as vertex attributes.
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+TimedWork SceneGpu::setTime(double time, StageTimer& timer) {
+    if (!dynamic()) return {};
+    return timeWork(timer, [&] {
+        timer.begin("scene_update");
+        setTime(time);
+        timer.end();
+    });
 }
 
 void SceneGpu::bindStorage() const {

@@ -5,6 +5,7 @@
 // copies (shaders/common/scene_update.comp), the static rest is never touched.
 #include "framework/gl/GlObjects.h"
 #include "framework/gl/Shader.h"
+#include "framework/gl/StageTimer.h"
 #include "framework/scene/Scene.h"
 
 namespace shadowlab {
@@ -30,8 +31,9 @@ public:
     /// Poses the moving parts at `time` (a no-op for a static scene or an unchanged pose): one
     /// compute pass over their triangles rewriting positions and normals in place.
     void setTime(double time);
-    /// The moving parts' current matrices (Scene::poseAt of the last setTime, else of time 0).
-    const std::vector<glm::mat4>& pose() const { return pose_; }
+    /// setTime() as the shared per-frame stage `scene_update`, timed as algorithms' frames are
+    /// (timeWork); nothing, and no stage, for a static scene.
+    TimedWork setTime(double time, StageTimer& timer);
     /// Changes whenever the pose does: 0 is Scene::positions as they are (a static scene's only
     /// version); a moving scene is posed by the GPU from the start, so its versions begin at 1.
     uint64_t poseVersion() const { return poseVersion_; }
@@ -43,8 +45,6 @@ public:
     /// The whole scene as posed now, on the CPU (positions, normals and bounds), for algorithms that
     /// rebuild from scratch at each pose.
     Scene posedScene() const;
-    /// Bytes of the object-space copies and part tables (0 for a static scene).
-    size_t motionBytes() const { return local_.size() + movingIndex_.size() + transforms_.size(); }
 
     const GlBuffer& positions() const { return positions_; }
     const GlBuffer& triangles() const { return triangles_; }
@@ -68,7 +68,6 @@ private:
     std::vector<glm::mat4> pose_;
     uint64_t poseVersion_ = 0;
     GlBuffer local_, movingIndex_, transforms_;
-    size_t movingTriangles_ = 0;
     ShaderProgram update_;
 };
 

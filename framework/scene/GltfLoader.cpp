@@ -854,16 +854,6 @@ Scene Loader::run(GltfStats* stats) {
 
 Scene loadGltf(const std::string& file) { return loadGltf(file, nullptr); }
 
-Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles) {
-    return loadGltf(file, stats, maxTriangles, "");
-}
-
-Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const std::string& animation) {
-    GltfMotion motion;
-    motion.animation = animation;
-    return loadGltf(file, stats, maxTriangles, motion);
-}
-
 Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const GltfMotion& motion) {
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file, "", "cannot open file");

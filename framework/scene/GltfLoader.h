@@ -24,16 +24,6 @@ struct GltfStats {
     size_t meshTriangles = 0;      ///< in the meshes the scene uses, each mesh counted once (what viewers report)
     size_t instanceTriangles = 0;  ///< over every node instance, before degenerate (zero-area) ones are dropped
 };
-/// As above, also filling `stats` when it is not null. More than `maxTriangles` triangle instances
-/// is an InputError raised before they are allocated (a few nodes instancing a big mesh can ask
-/// for billions).
-Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles = 200'000'000);
-/// As above, playing the file's animation `animation` (its name, else its index; "" = none): the
-/// meshes of animated nodes (or of nodes below one) become moving parts posed by its translation,
-/// rotation and scale channels (LINEAR, STEP, CUBICSPLINE) on the file's own clock, in seconds.
-/// Skinned meshes and morph-target (weights) channels are an InputError, as is an unknown name.
-Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const std::string& animation);
-
 /// A motion a config gives one node, in the node's own frame (after its local transform): the
 /// meshes at and below the node move with it.
 struct GltfNodeMotion {
@@ -42,10 +32,19 @@ struct GltfNodeMotion {
     double startTime = 0, endTime = 0;
     bool aboutCentre = true; ///< about the centre of the node's meshes (else its frame's origin)
 };
+/// What moves in a file: `animation` (its name, else its index; "" = none) plays that animation:
+/// the meshes of animated nodes (or of nodes below one) become moving parts posed by its
+/// translation, rotation and scale channels (LINEAR, STEP, CUBICSPLINE) on the file's own clock,
+/// in seconds. Skinned meshes and morph-target (weights) channels are an InputError, as is an
+/// unknown name. `nodes` are composed after the animation's channels of each node.
 struct GltfMotion {
-    std::string animation;             ///< "" = none
-    std::vector<GltfNodeMotion> nodes; ///< composed after the animation's channels of each node
+    std::string animation;
+    std::vector<GltfNodeMotion> nodes;
 };
-Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const GltfMotion& motion);
+
+/// As above, also filling `stats` when it is not null, with `motion`. More than `maxTriangles`
+/// triangle instances is an InputError raised before they are allocated (a few nodes instancing a
+/// big mesh can ask for billions).
+Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles = 200'000'000, const GltfMotion& motion = {});
 
 } // namespace shadowlab

@@ -1,6 +1,7 @@
 #include "framework/scene/Motion.h"
 
 #include "framework/core/JsonParse.h"
+#include "framework/core/Spline.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -17,18 +18,16 @@ glm::mat4 composeTransform(glm::vec3 translate, glm::vec3 rotateDeg, glm::vec3 s
     return glm::translate(glm::mat4(1.0f), translate) * r * glm::scale(glm::mat4(1.0f), scale);
 }
 
-RigidPath::RigidPath(std::vector<RigidKey> keys, Interpolation interpolation)
-    : keys_(std::move(keys)), interpolation_(interpolation) {}
-
-namespace {
-
-glm::vec3 catmullRom(glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, float u) {
-    float u2 = u * u, u3 = u2 * u;
-    return 0.5f * ((2.0f * p1) + (-p0 + p2) * u + (2.0f * p0 - 5.0f * p1 + 4.0f * p2 - p3) * u2 +
-                   (-p0 + 3.0f * p1 - 3.0f * p2 + p3) * u3);
+glm::vec3 readScale(JsonNode& node) {
+    // A number or three numbers; JsonNode has no getter for "either", so dispatch on the type.
+    const Json* raw = node.has("scale") ? &node.raw().at("scale") : nullptr;
+    if (!raw || raw->is_number()) return glm::vec3(float(node.getFloat("scale", 1.0)));
+    if (!raw->is_array()) node.fail("scale", "expected a number or an array of 3 numbers, got " + shortDump(*raw));
+    return node.getVec3("scale", glm::vec3(1.0f));
 }
 
-} // namespace
+RigidPath::RigidPath(std::vector<RigidKey> keys, Interpolation interpolation)
+    : keys_(std::move(keys)), interpolation_(interpolation) {}
 
 glm::mat4 RigidPath::at(double time) const {
     if (keys_.empty()) return glm::mat4(1.0f);
@@ -69,10 +68,7 @@ RigidPath RigidPath::parse(JsonNode node) {
         key.rotateDeg = k.getVec3("rotate_deg", glm::vec3(0.0f));
         if (glm::any(glm::greaterThan(glm::abs(key.rotateDeg), glm::vec3(1e6f))))
             k.fail("rotate_deg", "angles must lie within ±1e6 degrees (float precision)");
-        const Json* raw = k.has("scale") ? &k.raw().at("scale") : nullptr;
-        if (!raw || raw->is_number()) key.scale = glm::vec3(float(k.getFloat("scale", 1.0)));
-        else if (raw->is_array()) key.scale = k.getVec3("scale", glm::vec3(1.0f));
-        else k.fail("scale", "expected a number or an array of 3 numbers, got " + shortDump(*raw));
+        key.scale = readScale(k);
         if (!glm::all(glm::greaterThan(key.scale, glm::vec3(0.0f))))
             k.fail("scale", "path scales must be greater than 0 (mirror the object in its \"transform\")");
         if (!keys.empty() && key.time <= keys.back().time)
@@ -83,6 +79,10 @@ RigidPath RigidPath::parse(JsonNode node) {
     if (keys.empty()) node.fail("keyframes", "a path needs at least one keyframe");
     node.finish();
     return RigidPath(std::move(keys), interp);
+}
+
+MotionFn RigidPath::motion() const {
+    return [path = *this](double time) { return path.at(time); };
 }
 
 void MovingPart::setLocal(std::vector<glm::vec3> vertices) {

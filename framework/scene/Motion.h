@@ -19,6 +19,9 @@ namespace shadowlab {
 /// (the convention of a config's "transform").
 glm::mat4 composeTransform(glm::vec3 translate, glm::vec3 rotateDeg, glm::vec3 scale);
 
+/// The "scale" key of a transform or keyframe: a number (uniform) or [sx, sy, sz]; 1 when absent.
+glm::vec3 readScale(JsonNode& node);
+
 /// One keyframe of a rigid path.
 struct RigidKey {
     double time = 0;
@@ -37,6 +40,8 @@ public:
     RigidPath(std::vector<RigidKey> keys, Interpolation interpolation);
 
     glm::mat4 at(double time) const;
+    /// The path as a motion function (a copy: it outlives this object).
+    std::function<glm::mat4(double)> motion() const;
     double startTime() const { return keys_.empty() ? 0 : keys_.front().time; }
     double endTime() const { return keys_.empty() ? 0 : keys_.back().time; }
 

@@ -78,15 +78,25 @@ void Scene::updateBounds() {
     bounds = Bounds{};
     for (const auto& p : positions) bounds.extend(p);
     staticBounds = Bounds{};
-    size_t next = 0; // triangles before moving[k] are static
-    auto addStatic = [&](size_t from, size_t to) {
+    for (auto [from, to] : staticRuns())
         for (size_t i = 3 * from; i < 3 * to; ++i) staticBounds.extend(positions[i]);
-    };
+}
+
+std::vector<std::pair<size_t, size_t>> Scene::staticRuns() const {
+    std::vector<std::pair<size_t, size_t>> runs;
+    size_t next = 0;  // triangles before moving[k] are static
     for (const MovingPart& part : moving) {
-        addStatic(next, part.firstTriangle);
+        if (part.firstTriangle > next) runs.emplace_back(next, part.firstTriangle);
         next = part.firstTriangle + part.triangleCount;
     }
-    addStatic(next, triangleCount());
+    if (triangleCount() > next) runs.emplace_back(next, triangleCount());
+    return runs;
+}
+
+size_t Scene::movingTriangleCount() const {
+    size_t n = 0;
+    for (const MovingPart& part : moving) n += part.triangleCount;
+    return n;
 }
 
 std::vector<glm::mat4> Scene::poseAt(double time) const {
@@ -128,8 +138,7 @@ glm::dvec2 Scene::motionTimeRange() const {
 
 void Scene::attachMotion(const MotionFn& motion, double startTime, double endTime) {
     std::vector<MovingPart> parts;
-    auto addStaticRun = [&](size_t from, size_t to) {
-        if (from == to) return;
+    for (auto [from, to] : staticRuns()) {
         MovingPart part;
         part.firstTriangle = from;
         part.triangleCount = to - from;
@@ -138,18 +147,14 @@ void Scene::attachMotion(const MotionFn& motion, double startTime, double endTim
         part.startTime = startTime;
         part.endTime = endTime;
         parts.push_back(std::move(part));
-    };
-    size_t next = 0;
+    }
     for (MovingPart& part : moving) {
-        addStaticRun(next, part.firstTriangle);
-        next = part.firstTriangle + part.triangleCount;
         MotionFn inner = part.worldFromLocal;
         part.worldFromLocal = [inner, motion](double time) { return motion(time) * inner(time); };
         part.startTime = std::min(part.startTime, startTime);
         part.endTime = std::max(part.endTime, endTime);
         parts.push_back(std::move(part));
     }
-    addStaticRun(next, triangleCount());
     std::sort(parts.begin(), parts.end(),
               [](const MovingPart& a, const MovingPart& b) { return a.firstTriangle < b.firstTriangle; });
     moving = std::move(parts);

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shadowlab {
@@ -42,6 +43,9 @@ struct Scene {
 
     size_t triangleCount() const { return normals.size(); }
     bool dynamic() const { return !moving.empty(); }
+    size_t movingTriangleCount() const;
+    /// The ranges [from, to) of triangles outside every moving part, in order.
+    std::vector<std::pair<size_t, size_t>> staticRuns() const;
     /// Each moving part's world matrix at `time`.
     std::vector<glm::mat4> poseAt(double time) const;
     /// Rewrites the moving parts' positions and normals for `pose` (poseAt()), and the bounds.

@@ -84,12 +84,7 @@ struct Transform {
 Transform readTransform(JsonNode node) {
     glm::vec3 translate = node.getPoint("translate", glm::vec3(0.0f));
     glm::vec3 rotDeg = node.getVec3("rotate_deg", glm::vec3(0.0f));
-    glm::vec3 scale(1.0f);
-    // "scale" is a number or three numbers; JsonNode has no getter for "either", so dispatch on the type.
-    const Json* raw = node.has("scale") ? &node.raw().at("scale") : nullptr;
-    if (!raw || raw->is_number()) scale = glm::vec3(float(node.getFloat("scale", 1.0)));
-    else if (raw->is_array()) scale = node.getVec3("scale", glm::vec3(1.0f));
-    else node.fail("scale", "expected a number or an array of 3 numbers, got " + raw->dump());
+    glm::vec3 scale = readScale(node);
     if (glm::any(glm::equal(scale, glm::vec3(0.0f)))) node.fail("scale", "scale factors must be non-zero");
     Transform t;
     t.fitSize = float(node.getFloat("fit_size", 0.0, 0.0));
@@ -246,7 +241,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
             nm.node = size_t(np.getInt("node", 0, 0));
             nm.aboutCentre = np.getEnum("pivot", "centre", {"centre", "origin"}) == "centre";
             RigidPath path = RigidPath::parse(np.child("path"));
-            nm.motion = [path](double time) { return path.at(time); };
+            nm.motion = path.motion();
             nm.startTime = path.startTime();
             nm.endTime = path.endTime();
             np.finish();
@@ -284,7 +279,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         }
         if (m != glm::mat4(1.0f)) transformInPlace(s, m);
         // The path moves the placed object: world(t) = path(t) · transform · object.
-        if (path) s.attachMotion([p = *path](double time) { return p.at(time); }, path->startTime(), path->endTime());
+        if (path) s.attachMotion(path->motion(), path->startTime(), path->endTime());
         checkBuilt(s, node);
         return s;
     };

@@ -1,16 +1,12 @@
 #include "framework/view/Path.h"
 
+#include "framework/core/Spline.h"
+
 #include <algorithm>
 
 namespace shadowlab {
 
 Path::Path(std::vector<Keyframe> keys) : keys_(std::move(keys)) {}
-
-static glm::vec3 catmullRom(glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, float u) {
-    float u2 = u * u, u3 = u2 * u;
-    return 0.5f * ((2.0f * p1) + (-p0 + p2) * u + (2.0f * p0 - 5.0f * p1 + 4.0f * p2 - p3) * u2 +
-                   (-p0 + 3.0f * p1 - 3.0f * p2 + p3) * u3);
-}
 
 PathSample Path::at(double time) const {
     if (keys_.empty()) return {glm::vec3(0), glm::vec3(0, 0, -1)};
