@@ -225,7 +225,9 @@ TEST_F(DynamicSceneGLTest, LineSpaceRebuildsEveryFrameWhenAskedAndTimesIt) {
         auto rebuild = std::find_if(f.stages.begin(), f.stages.end(), [](const StageTime& s) { return s.name == "rebuild"; });
         ASSERT_NE(rebuild, f.stages.end()) << "frame " << f.frame;
         EXPECT_GT(rebuild->cpuMs, 0.0);
-        // Approximate (line space), but it follows the caster: not the static image's error.
+        // line_space is approximate by design (shadows grow by up to a leaf: 1.1-2.6 % of lit pixels
+        // on the static test scenes, tests/ExperimentGLTest.cpp). 5 % still fails a tree left at
+        // the rest pose, whose shadow of the sphere would sit where the sphere no longer is.
         EXPECT_LE(f.accuracy.mismatchRatio, 0.05) << "frame " << f.frame;
     }
 }
