@@ -174,6 +174,10 @@ public:
             geometryBytes_ += geometry_[chunk].size();
         }
         if (!geometry_[0]) geometry_[0] = GlBuffer(36, nullptr, 0); // an empty scene still binds its blocks
+        nodeTexels_ = makeBufferTexture(nodes_, GL_RGBA32UI, 16, "metric_tree nodes");
+        clusterTexels_ = makeBufferTexture(clusters_.size() ? clusters_ : nodes_, GL_RGBA32UI, 16, "metric_tree clusters");
+        for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i)
+            geometryTexels_[i] = geometry_[i] ? makeBufferTexture(geometry_[i], GL_RGB32F, 12, "metric_tree geometry") : GlTexture();
         // The query reads the blocks that hold triangles only (a #define): recompiled when that changes.
         const int used = int(std::max<size_t>(1, (n + MT_TRIANGLES_PER_CHUNK - 1) / MT_TRIANGLES_PER_CHUNK));
         if (used != geometryUsed_) {
@@ -214,6 +218,10 @@ public:
         f.timer.end();
 
         f.timer.begin("traverse");
+        glBindTextureUnit(MT_NODE_UNIT, nodeTexels_.id());
+        glBindTextureUnit(MT_CLUSTER_UNIT, clusterTexels_.id());
+        for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i) // unused blocks alias chunk 0: never read, but bound
+            glBindTextureUnit(MT_GEOMETRY_UNIT_0 + i, (geometryTexels_[i] ? geometryTexels_[i] : geometryTexels_[0]).id());
         if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &triangleTests_, &fruitless_, &overflow_});
         else runPixelPass(f, query_, {});
         f.timer.end();
@@ -468,6 +476,8 @@ private:
     size_t movingFirst_ = 0, movingClusterFirst_ = 0;
     GpuCounters<MT_COUNTER_WORDS> counters_;
     std::array<GlBuffer, MT_GEOMETRY_CHUNKS> geometry_;
+    GlTexture nodeTexels_, clusterTexels_; ///< the query's views of nodes_ and clusters_
+    std::array<GlTexture, MT_GEOMETRY_CHUNKS> geometryTexels_;
     GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;
     size_t clusterCount_ = 0, capsuleCount_ = 0, geometryBytes_ = 0;
     int geometryUsed_ = 1; ///< geometry blocks holding triangles (MT_GEOMETRY_USED)

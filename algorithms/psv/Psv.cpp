@@ -77,6 +77,7 @@ public:
         nodes_ = GlBuffer(psv::nodeCount(n) * PSV_NODE_BYTES, nullptr, 0);
         counters_.allocate();
         nodes_.clearUint(0);
+        nodeTexels_ = makeBufferTexture(nodes_, GL_RGBA32UI, 16, "psv nodes");
         permutation_ = psv::makePermutation(uint32_t(n), uint32_t(p_.seed));
     }
 
@@ -105,11 +106,12 @@ public:
         scene_->bindStorage();
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, PSV_NODE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, PSV_COUNTER_BINDING);
+        glBindTextureUnit(PSV_NODE_UNIT, nodeTexels_.id());
         if (scene_->triangleCount() > 0) {
             dispatchPerTriangle(frusta_);
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
             dispatchPerTriangle(build_);
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         }
         f.timer.end();
 
@@ -209,6 +211,7 @@ private:
     GlBuffer nodes_;
     GpuCounters<PSV_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
+    GlTexture nodeTexels_; ///< nodes_ as a buffer texture: how the build reads planes and the query whole nodes
     psv::Permutation permutation_;
 };
 

@@ -110,6 +110,7 @@ public:
         if (n * PTSV_PLANES_PER_TRIANGLE * 16 > maxShaderStorageBlockBytes())
             throw RuntimeError("ptsv: " + std::to_string(n) + " triangles exceed the largest storage block");
         planes_ = GlBuffer(std::max<size_t>(n, 1) * PTSV_PLANES_PER_TRIANGLE * 16, nullptr, 0);
+        planeTexels_ = makeBufferTexture(planes_, GL_RGBA32F, 16, "ptsv planes");
         counters_.allocate();
         layoutKey_ = {}; // the per-job iteration record is sized by the triangle count
     }
@@ -164,12 +165,17 @@ public:
         if (n > 0) {
             setup_.set("uTriangleCount", unsigned(n));
             dispatchLinear(setup_, n);
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         }
+        // The traversal reads the hierarchy's and setup's output through buffer textures.
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         f.timer.end();
 
         f.timer.begin("traverse");
         if (n > 0) {
+            glBindTextureUnit(PTSV_BOUNDS_UNIT, boundsTexels_.id());
+            glBindTextureUnit(PTSV_SAMPLE_UNIT, sampleTexels_.id());
+            glBindTextureUnit(PTSV_KEY_UNIT, keyTexels_.id());
+            glBindTextureUnit(PTSV_PLANE_UNIT, planeTexels_.id());
             // One workgroup per batch of triangles, as a 2D grid past 65535.
             const size_t perGroup = size_t(p_.jobsPerWorkgroup);
             const size_t groups = (n + perGroup - 1) / perGroup;
@@ -355,6 +361,9 @@ private:
         const size_t jobSlots = scene_->triangleCount() + (p_.twoPass ? size_t(p_.jobCapacity) : 0);
         // Zero-filled: a culled triangle (no workgroup writes its slot) counts 0 iterations.
         jobIterations_ = GlBuffer(p_.jobIterations ? std::max<size_t>(jobSlots, 1) * 4 : 4, nullptr, 0);
+        boundsTexels_ = makeBufferTexture(bounds_, GL_RGB32F, 12, "ptsv bounds");
+        sampleTexels_ = makeBufferTexture(samples_, GL_RGBA32F, 16, "ptsv samples");
+        keyTexels_ = makeBufferTexture(keys_, GL_R32UI, 4, "ptsv keys");
         warnedSplit_ = false;
     }
 
@@ -440,6 +449,7 @@ private:
     bool warnedSplit_ = false;
     ShaderProgram hierarchy_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
     GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
+    GlTexture boundsTexels_, sampleTexels_, keyTexels_, planeTexels_; ///< the traversal's views of those buffers
     GpuCounters<PTSV_COUNTER_WORDS> counters_;
     GlTexture heat_;
 };

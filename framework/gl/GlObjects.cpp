@@ -1,5 +1,9 @@
 #include "framework/gl/GlObjects.h"
 
+#include "framework/core/Error.h"
+
+#include <string>
+
 #include <algorithm>
 
 namespace shadowlab {
@@ -38,6 +42,19 @@ GlTexture makeTexture2D(GLenum internalFormat, int width, int height, GLenum fil
     glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
     glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return GlTexture(id);
+}
+
+GlTexture makeBufferTexture(const GlBuffer& buffer, GLenum internalFormat, size_t texelBytes, const char* what) {
+    GLint maxTexels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
+    const size_t texels = buffer.size() / texelBytes;
+    if (texels > size_t(maxTexels))
+        throw RuntimeError(std::string(what) + ": " + std::to_string(texels) + " texels exceed this context's " +
+                           "GL_MAX_TEXTURE_BUFFER_SIZE (" + std::to_string(maxTexels) + ")");
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &id);
+    glTextureBuffer(id, internalFormat, buffer.id());
     return GlTexture(id);
 }
 

@@ -82,6 +82,13 @@ size_t maxShaderStorageBlockBytes();
 /// A 2D texture with immutable storage.
 GlTexture makeTexture2D(GLenum internalFormat, int width, int height, GLenum filter = GL_NEAREST);
 
+/// A buffer texture (GL_TEXTURE_BUFFER) over all of `buffer`, read as texels of `internalFormat`
+/// (GL_RGBA32UI, GL_RGBA32F, GL_RGB32F, ...) of `texelBytes` bytes. Kernels read their read-only
+/// structures through it: texel fetches take the sampler's gather path, which on a CPU SIMD back end
+/// (llvmpipe) is far cheaper than per-lane storage-buffer loads. Throws RuntimeError when the buffer
+/// holds more texels than GL_MAX_TEXTURE_BUFFER_SIZE.
+GlTexture makeBufferTexture(const GlBuffer& buffer, GLenum internalFormat, size_t texelBytes, const char* what);
+
 /// Reads a whole single-channel float texture (level 0) into a vector of width*height floats.
 std::vector<float> readTextureR32F(GLuint texture, int width, int height);
 /// Reads an RGBA float texture into 4*width*height floats.

@@ -18,6 +18,7 @@ static_assert(sizeof(TriangleInfo) == 16 && sizeof(MaterialInfo) == 16);
 
 SceneGpu::SceneGpu(const Scene& scene) : scene_(&scene), bounds_(scene.bounds) {
     positions_ = GlBuffer::fromVector(scene.positions, 0);
+    positionTexels_ = makeBufferTexture(positions_, GL_RGB32F, 12, "scene positions");
     std::vector<TriangleInfo> tris(scene.triangleCount());
     // Per-vertex attribute (normal.xyz, material): the rasteriser needs per-triangle data at each
     // vertex; reading it from an SSBO by gl_VertexID would cap the scene at the SSBO size limit.
@@ -118,7 +119,8 @@ void SceneGpu::setTime(double time) {
     update_.use();
     update_.dispatchLinear(moving, 64);
     // Everything after reads the posed scene: algorithms as SSBOs, the G-buffer as vertex attributes.
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
+                    GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 
 TimedWork SceneGpu::setTime(double time, StageTimer& timer) {
@@ -134,6 +136,7 @@ void SceneGpu::bindStorage() const {
     positions_.bindBase(GL_SHADER_STORAGE_BUFFER, kScenePositionsBinding);
     triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, kSceneTrianglesBinding);
     materials_.bindBase(GL_SHADER_STORAGE_BUFFER, kSceneMaterialsBinding);
+    glBindTextureUnit(kScenePositionUnit, positionTexels_.id());
 }
 
 void SceneGpu::draw() const {

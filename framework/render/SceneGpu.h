@@ -16,6 +16,8 @@ enum SceneBinding : GLuint {
     kSceneTrianglesBinding = 1, ///< TriangleInfo[n]: normal.xyz + material id
     kSceneMaterialsBinding = 2, ///< MaterialInfo[]: albedo.rgb + opacity
 };
+/// Texture unit of the positions' buffer-texture view (scene.glsl, SCENE_POSITION_TEXELS).
+constexpr GLuint kScenePositionUnit = 15;
 
 class SceneGpu {
 public:
@@ -53,7 +55,8 @@ public:
     const GlBuffer& partTransforms() const { return transforms_; }
     GLuint vertexArray() const { return vao_.id(); }
 
-    /// Binds positions, triangles and materials to their SceneBinding points.
+    /// Binds positions, triangles and materials to their SceneBinding points, and the positions'
+    /// buffer-texture view (RGB32F, vertex k of triangle i = texel 3i + k) to kScenePositionUnit.
     void bindStorage() const;
     /// Draws every triangle (non-indexed) with the bound program.
     void draw() const;
@@ -63,6 +66,7 @@ private:
 
     const Scene* scene_;
     GlBuffer positions_, triangles_, materials_, vertexNormals_;
+    GlTexture positionTexels_;
     GlVertexArray vao_;
     Bounds bounds_;
     std::vector<glm::mat4> pose_;

@@ -11,6 +11,11 @@
 // MT_TRIANGLES_PER_CHUNK triangles: one SSBO may not exceed 128 MiB on llvmpipe (and on many
 // GPUs), and 3.5 M triangles are 126 MB. Six chunks hold 21 M triangles.
 #define MT_GEOMETRY_BINDING_0 6
+// Texture units of the query's buffer-texture views of the nodes, clusters and geometry blocks
+// (units 0 and 1 are the G-buffer).
+#define MT_NODE_UNIT 2
+#define MT_CLUSTER_UNIT 3
+#define MT_GEOMETRY_UNIT_0 4
 #define MT_GEOMETRY_CHUNKS 6
 #define MT_TRIANGLES_PER_CHUNK 3500000
 

@@ -9,17 +9,41 @@
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "metric_tree/tree.glsl"
+#include "common/pixel_order.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, binding = MT_GEOMETRY_BINDING_0) readonly buffer MtGeometry0 { float mtGeometry0[]; };
-layout(std430, binding = MT_GEOMETRY_BINDING_0 + 1) readonly buffer MtGeometry1 { float mtGeometry1[]; };
-layout(std430, binding = MT_GEOMETRY_BINDING_0 + 2) readonly buffer MtGeometry2 { float mtGeometry2[]; };
-layout(std430, binding = MT_GEOMETRY_BINDING_0 + 3) readonly buffer MtGeometry3 { float mtGeometry3[]; };
-layout(std430, binding = MT_GEOMETRY_BINDING_0 + 4) readonly buffer MtGeometry4 { float mtGeometry4[]; };
-layout(std430, binding = MT_GEOMETRY_BINDING_0 + 5) readonly buffer MtGeometry5 { float mtGeometry5[]; };
+// The tree, clusters and cluster-ordered triangles as buffer textures (views of the SSBOs the build
+// writes): texel fetches are gathered per SIMD group, storage loads per lane on llvmpipe.
+layout(binding = MT_NODE_UNIT) uniform usamplerBuffer uNodeTexels;       // 4 texels per node
+layout(binding = MT_CLUSTER_UNIT) uniform usamplerBuffer uClusterTexels; // 4 texels per cluster
+layout(binding = MT_GEOMETRY_UNIT_0) uniform samplerBuffer uGeometry0;   // 3 texels per triangle
+layout(binding = MT_GEOMETRY_UNIT_0 + 1) uniform samplerBuffer uGeometry1;
+layout(binding = MT_GEOMETRY_UNIT_0 + 2) uniform samplerBuffer uGeometry2;
+layout(binding = MT_GEOMETRY_UNIT_0 + 3) uniform samplerBuffer uGeometry3;
+layout(binding = MT_GEOMETRY_UNIT_0 + 4) uniform samplerBuffer uGeometry4;
+layout(binding = MT_GEOMETRY_UNIT_0 + 5) uniform samplerBuffer uGeometry5;
 #if MT_GEOMETRY_CHUNKS != 6
 #error "query.comp declares six geometry blocks"
 #endif
+
+MtNode mtNode(uint i) {
+    int t = int(4u * i);
+    uvec4 t0 = texelFetch(uNodeTexels, t), t1 = texelFetch(uNodeTexels, t + 1);
+    uvec4 t2 = texelFetch(uNodeTexels, t + 2), t3 = texelFetch(uNodeTexels, t + 3);
+    MtNode n;
+    n.a = uintBitsToFloat(t0);
+    n.b = uintBitsToFloat(t1);
+    n.child[0] = t2.x; n.child[1] = t2.y; n.child[2] = t2.z;
+    n.minDist = t2.w; n.overlapMin = t3.x; n.overlapMax = t3.y; n.flags = t3.z; n.pad = t3.w;
+    return n;
+}
+
+MtCluster mtCluster(uint i) {
+    int t = int(4u * i);
+    uvec4 t0 = texelFetch(uClusterTexels, t), t1 = texelFetch(uClusterTexels, t + 1);
+    uvec4 t2 = texelFetch(uClusterTexels, t + 2), t3 = texelFetch(uClusterTexels, t + 3);
+    return MtCluster(uintBitsToFloat(t0), uintBitsToFloat(t1), uintBitsToFloat(t2), uintBitsToFloat(t3.x), t3.y, t3.z, t3.w);
+}
 
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
@@ -35,8 +59,8 @@ uniform float uSlabTolerance; // world units added on both sides of a cluster's 
 
 // Triangle t of the cluster-ordered geometry. Vertices come out as vec3s: an array return value
 // would live in scratch memory on llvmpipe.
-#define MT_LOAD(buf, base, v0, v1, v2) { v0 = vec3(buf[base], buf[base + 1u], buf[base + 2u]); \
-    v1 = vec3(buf[base + 3u], buf[base + 4u], buf[base + 5u]); v2 = vec3(buf[base + 6u], buf[base + 7u], buf[base + 8u]); }
+#define MT_LOAD(tex, base, v0, v1, v2) { v0 = texelFetch(tex, int(base)).xyz; \
+    v1 = texelFetch(tex, int(base) + 1).xyz; v2 = texelFetch(tex, int(base) + 2).xyz; }
 // MT_GEOMETRY_USED (1..MT_GEOMETRY_CHUNKS, set from the scene at compile time) is how many blocks
 // hold triangles: one below 3.5 M triangles, where the load is a single unconditional read. A
 // CPU SIMD back end (llvmpipe) runs every arm of a divergent if/else chain, so only the blocks
@@ -46,33 +70,33 @@ uniform float uSlabTolerance; // world units added on both sides of a cluster's 
 #endif
 void mtTriangle(uint t, out vec3 v0, out vec3 v1, out vec3 v2) {
 #if MT_GEOMETRY_USED == 1
-    MT_LOAD(mtGeometry0, 9u * t, v0, v1, v2)
+    MT_LOAD(uGeometry0, 3u * t, v0, v1, v2)
 #else
     uint chunk = t / uint(MT_TRIANGLES_PER_CHUNK);
-    uint base = 9u * (t - chunk * uint(MT_TRIANGLES_PER_CHUNK));
-    if (chunk == 0u) MT_LOAD(mtGeometry0, base, v0, v1, v2)
+    uint base = 3u * (t - chunk * uint(MT_TRIANGLES_PER_CHUNK));
+    if (chunk == 0u) MT_LOAD(uGeometry0, base, v0, v1, v2)
 #if MT_GEOMETRY_USED > 2
-    else if (chunk == 1u) MT_LOAD(mtGeometry1, base, v0, v1, v2)
+    else if (chunk == 1u) MT_LOAD(uGeometry1, base, v0, v1, v2)
 #endif
 #if MT_GEOMETRY_USED > 3
-    else if (chunk == 2u) MT_LOAD(mtGeometry2, base, v0, v1, v2)
+    else if (chunk == 2u) MT_LOAD(uGeometry2, base, v0, v1, v2)
 #endif
 #if MT_GEOMETRY_USED > 4
-    else if (chunk == 3u) MT_LOAD(mtGeometry3, base, v0, v1, v2)
+    else if (chunk == 3u) MT_LOAD(uGeometry3, base, v0, v1, v2)
 #endif
 #if MT_GEOMETRY_USED > 5
-    else if (chunk == 4u) MT_LOAD(mtGeometry4, base, v0, v1, v2)
+    else if (chunk == 4u) MT_LOAD(uGeometry4, base, v0, v1, v2)
 #endif
 #if MT_GEOMETRY_USED == 2
-    else MT_LOAD(mtGeometry1, base, v0, v1, v2)
+    else MT_LOAD(uGeometry1, base, v0, v1, v2)
 #elif MT_GEOMETRY_USED == 3
-    else MT_LOAD(mtGeometry2, base, v0, v1, v2)
+    else MT_LOAD(uGeometry2, base, v0, v1, v2)
 #elif MT_GEOMETRY_USED == 4
-    else MT_LOAD(mtGeometry3, base, v0, v1, v2)
+    else MT_LOAD(uGeometry3, base, v0, v1, v2)
 #elif MT_GEOMETRY_USED == 5
-    else MT_LOAD(mtGeometry4, base, v0, v1, v2)
+    else MT_LOAD(uGeometry4, base, v0, v1, v2)
 #else
-    else MT_LOAD(mtGeometry5, base, v0, v1, v2)
+    else MT_LOAD(uGeometry5, base, v0, v1, v2)
 #endif
 #endif
 }
@@ -122,7 +146,7 @@ Result query(vec3 q) {
         }
         uint node = next - 1u;
         ++r.visited;
-        MtNode n = mtNodes[node];
+        MtNode n = mtNode(node);
 #if MT_DEPTH_SKIP
         // Mora et al. 2016: nothing in this subtree is nearer the light than q, so nothing in it
         // can lie between q and the light.
@@ -131,7 +155,7 @@ Result query(vec3 q) {
         float dq = mtPointDist(p, n.a.xyz, n.b.xyz);
         if (dq <= n.a.w + uLsEps) { // inside the cone or capsule-cone: the cluster may occlude q
             ++r.coneHits;
-            MtCluster c = mtClusters[node];
+            MtCluster c = mtCluster(node);
             bool test = true;
 #if MT_SLABS
             // The shadow ray must cross the slab between the cluster's two planes (paper step 2).
@@ -190,7 +214,7 @@ void main() {
     }
     barrier();
 #endif
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 px = pixelOfInvocation();
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)

@@ -66,8 +66,12 @@ float mtAngle(vec3 u, vec3 v) { return atan(length(cross(u, v)), dot(u, v)); }
 // arc. Arcs are shorter than pi (prepare.comp makes longer ones cover every direction).
 bool mtOnArc(vec3 y, vec3 a, vec3 b, vec3 n) { return dot(cross(a, y), n) >= 0.0 && dot(cross(y, b), n) >= 0.0; }
 
+// One atan per call, whatever the element: the nearer end is the one with the larger cosine, and
+// where p's foot on the great circle lies on the arc that foot is nearer than either end. Capsules
+// and spheres (a = b: no circle) take the same path, so a SIMD group mixing them runs it once.
 float mtPointArc(vec3 p, vec3 a, vec3 b) {
-    float d = min(mtAngle(p, a), mtAngle(p, b));
+    vec3 e = dot(p, a) >= dot(p, b) ? a : b;
+    float y = length(cross(p, e)), x = dot(p, e); // atan(y, x): the angle from p to e
     vec3 n = cross(a, b);
     float nl = length(n);
     if (nl > 1e-12) {
@@ -75,9 +79,9 @@ float mtPointArc(vec3 p, vec3 a, vec3 b) {
         float s = dot(p, n);
         vec3 q = p - s * n; // p projected on the arc's great circle
         // atan rather than asin: asin loses half the digits near the circle's poles.
-        if (mtOnArc(q, a, b, n)) d = min(d, atan(abs(s), length(q)));
+        if (mtOnArc(q, a, b, n)) { y = abs(s); x = length(q); }
     }
-    return d;
+    return atan(y, x);
 }
 
 // Smallest angle between two arcs: 0 where they cross, else attained at an end of one of them
@@ -119,8 +123,8 @@ float mtSegSeg(vec3 a1, vec3 b1, vec3 a2, vec3 b2) {
 
 // Distance from a light-space point to an element's centre.
 float mtPointDist(vec3 p, vec3 a, vec3 b) {
-    if (a == b) return lightIsDirectional() ? length(p - a) : mtAngle(p, a);
-    return lightIsDirectional() ? mtPointSeg(p, a, b) : mtPointArc(p, a, b);
+    if (lightIsDirectional()) return a == b ? length(p - a) : mtPointSeg(p, a, b);
+    return mtPointArc(p, a, b); // a sphere (a = b) included
 }
 
 // Smallest distance between two elements' centres.

@@ -6,6 +6,7 @@
 // so concurrent insertions never lose a triangle and never wait for each other (lock-free).
 // The nodes themselves were written by frusta.comp, before this dispatch.
 #include "common/light.glsl"
+#define SCENE_POSITION_TEXELS 1
 #include "common/scene.glsl"
 #include "psv/tree.glsl"
 layout(local_size_x = 64) in;
@@ -54,7 +55,7 @@ uint insertTriangle(uint t, out uint tested) {
         while (true) { // down the frustum's own nodes until a child field has to be followed
             // A frustum adds at most 4 levels, so a longer descent can only be a cycle.
             if (++tested > nodeCount) return PSV_C_BUILD_ERRORS;
-            vec4 plane = psvNodes[node].plane;
+            vec4 plane = psvPlane(node); // written by frusta.comp: fixed here
             int c = psvClassify(plane, v0, v1, v2);
             if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
                 if (c < 0) { ++node; continue; }

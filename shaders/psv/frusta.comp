@@ -5,6 +5,7 @@
 // reads half-written planes, without relying on memory ordering between the node writes and the
 // atomic that publishes them (GLSL atomics carry no acquire/release semantics).
 #include "common/light.glsl"
+#define SCENE_POSITION_TEXELS 1
 #include "common/scene.glsl"
 #include "psv/tree.glsl"
 layout(local_size_x = 64) in;

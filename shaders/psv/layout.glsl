@@ -5,6 +5,9 @@
 // SSBO binding points (0..2 are the scene buffers of shaders/common/scene.glsl).
 #define PSV_NODE_BINDING 3
 #define PSV_COUNTER_BINDING 4
+// Texture unit of the nodes' buffer-texture view (RGBA32UI, two texels per node; units 0 and 1
+// are the query's G-buffer).
+#define PSV_NODE_UNIT 2
 
 // TOP tree: node 0 is a sentinel whose `pos` field is the root pointer; triangle t owns the four
 // nodes 4t+1 .. 4t+4 (three shadow planes, then its capping plane), so `index % 4 == 0` marks a

@@ -7,12 +7,14 @@
 #include "common/scene.glsl"
 #include "common/counters.glsl"
 #include "psv/tree.glsl"
+#include "common/pixel_order.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-uniform float uRayOffset; // world units: the reference's shadow-ray origin offset along the normal
+uniform float uRayOffset;
+ // world units: the reference's shadow-ray origin offset along the normal
 
 struct Result {
     float visibility;
@@ -32,14 +34,14 @@ Result query(vec3 q) {
 #endif
     // Pushing onto a full stack would drop a subtree that may hold the occluder: stop and report.
 #define PSV_PUSH(node) { if (sp == PSV_STACK_SIZE) { r.overflow = true; break; } stack[sp++] = (node); }
-    uint node = psvNodes[0].pos;
+    uint node = psvNode(0u).pos;
     while (true) {
         if (node == 0u) {
             if (sp == 0) break;
             node = stack[--sp];
         }
         ++r.visited;
-        PsvNode n = psvNodes[node];
+        PsvNode n = psvNode(node);
         float s = psvSigned(n.plane, q);
         if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
             // Only one side can hold frusta containing q; at s == 0 both sides would do, and the
@@ -97,7 +99,7 @@ void main() {
     if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = 0u;
     barrier();
 #endif
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 px = pixelOfInvocation();
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)

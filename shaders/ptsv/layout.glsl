@@ -14,6 +14,13 @@
 #define PTSV_HEAT_BINDING 11   // per view sample (tile-major): test-and-set operations (heat map)
 #define PTSV_JOB_ITER_BINDING 12 // per job: traversal iterations (pass one: triangle t at t; pass two: n + job)
 
+// Texture units of the traversal's buffer-texture views of what it reads but never writes: the
+// explicit bounds (RGB32F, 2 texels per node), samples (RGBA32F), keys (R32UI) and planes (RGBA32F).
+#define PTSV_BOUNDS_UNIT 2
+#define PTSV_SAMPLE_UNIT 3
+#define PTSV_KEY_UNIT 4
+#define PTSV_PLANE_UNIT 5
+
 // A tree has at most this many levels of child masks (32-bit keys, 5 bits per level).
 #define PTSV_MAX_LEVELS 7
 #define PTSV_MAX_KEY_BITS 30

@@ -72,7 +72,31 @@ float ptsvSigned(vec4 plane, vec3 x) {
     return s;
 }
 
+#if PTSV_TEXEL_READS
+// The traversal reads what earlier passes wrote through buffer textures (Ptsv binds the views to
+// the PTSV_*_UNIT units): a SIMD CPU back end (llvmpipe) gathers texel fetches for all its lanes at
+// once but loads storage buffers lane by lane; a GPU reads both through its caches.
+layout(binding = PTSV_BOUNDS_UNIT) uniform samplerBuffer uPtsvBoundsTexels;
+layout(binding = PTSV_SAMPLE_UNIT) uniform samplerBuffer uPtsvSampleTexels;
+layout(binding = PTSV_KEY_UNIT) uniform usamplerBuffer uPtsvKeyTexels;
+layout(binding = PTSV_PLANE_UNIT) uniform samplerBuffer uPtsvPlaneTexels;
+vec4 ptsvPlane(uint triangle, uint i) { return texelFetch(uPtsvPlaneTexels, int(PTSV_PLANES_PER_TRIANGLE * triangle + i)); }
+uint ptsvKeyAt(uint slot) { return texelFetch(uPtsvKeyTexels, int(slot)).x; }
+vec3 ptsvSampleAt(uint slot) { return texelFetch(uPtsvSampleTexels, int(slot)).xyz; }
+void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
+    bmin = texelFetch(uPtsvBoundsTexels, int(2u * node)).xyz;
+    bmax = texelFetch(uPtsvBoundsTexels, int(2u * node + 1u)).xyz;
+}
+#else
 vec4 ptsvPlane(uint triangle, uint i) { return ptsvPlanes[PTSV_PLANES_PER_TRIANGLE * triangle + i]; }
+uint ptsvKeyAt(uint slot) { return ptsvKeys[slot]; }
+vec3 ptsvSampleAt(uint slot) { return ptsvSamples[slot].xyz; }
+void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
+    uint b = 6u * node;
+    bmin = vec3(ptsvBounds[b], ptsvBounds[b + 1u], ptsvBounds[b + 2u]);
+    bmax = vec3(ptsvBounds[b + 3u], ptsvBounds[b + 4u], ptsvBounds[b + 5u]);
+}
+#endif
 uint ptsvStatus(uint triangle) { return floatBitsToUint(ptsvPlane(triangle, 7u).x); }
 
 // The exact per-sample test (the test of test-and-set): inside the three edge planes (closed) and

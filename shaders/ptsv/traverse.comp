@@ -36,6 +36,7 @@
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "common/counters.glsl"
+#define PTSV_TEXEL_READS 1
 #include "ptsv/ptsv.glsl"
 layout(local_size_x = PTSV_LANES) in;
 #define lane gl_LocalInvocationIndex
@@ -118,9 +119,8 @@ bool gTruncated = false; // a loop ended without its exit condition: the driver'
 bvec2 classify(uint childId, int depth) {
     vec2 r[4];
 #if PTSV_EXPLICIT_BOUNDS
-    uint b = 6u * (uNodeOffset[depth] + childId);
-    vec3 bmin = vec3(ptsvBounds[b], ptsvBounds[b + 1u], ptsvBounds[b + 2u]);
-    vec3 bmax = vec3(ptsvBounds[b + 3u], ptsvBounds[b + 4u], ptsvBounds[b + 5u]);
+    vec3 bmin, bmax;
+    ptsvBoxAt(uNodeOffset[depth] + childId, bmin, bmax);
     float pad = uTolerance;
     for (int i = 0; i < 4; ++i) r[i] = ptsvBoxRange(gPlane[i], bmin, bmax);
 #else
@@ -153,9 +153,8 @@ bvec2 classify(uint childId, int depth) {
 // x = rejected by one of its volume planes, y = inside both, z = rejected by a culling plane.
 bvec3 classifyHalf(uint childId, int depth, uint side) {
 #if PTSV_EXPLICIT_BOUNDS
-    uint b = 6u * (uNodeOffset[depth] + childId);
-    vec3 bmin = vec3(ptsvBounds[b], ptsvBounds[b + 1u], ptsvBounds[b + 2u]);
-    vec3 bmax = vec3(ptsvBounds[b + 3u], ptsvBounds[b + 4u], ptsvBounds[b + 5u]);
+    vec3 bmin, bmax;
+    ptsvBoxAt(uNodeOffset[depth] + childId, bmin, bmax);
     float pad = uTolerance;
 #define PTSV_RANGE(i) ptsvBoxRange(gPlane[i], bmin, bmax)
 #else
@@ -186,7 +185,7 @@ void testSamples(uint key) {
     uint first = (lo.y * uint(uTilesX) + lo.x) * ptsvTileSamples();
     uint s = lane;
     for (; s < ptsvTileSamples(); s += uint(PTSV_LANES)) {
-        uint k = ptsvKeys[first + s];
+        uint k = ptsvKeyAt(first + s);
 #if PTSV_LEAF_CLUSTER_ONLY
         if (k != key) continue;
 #else
@@ -196,7 +195,7 @@ void testSamples(uint key) {
 #if PTSV_HEAT_MAP
         atomicAdd(ptsvHeat[first + s], 1u);
 #endif
-        if (ptsvInVolume(gPlane[0], gPlane[1], gPlane[2], gPlane[3], ptsvSamples[first + s].xyz))
+        if (ptsvInVolume(gPlane[0], gPlane[1], gPlane[2], gPlane[3], ptsvSampleAt(first + s)))
             ptsvShadow[first + s] = 1u;
     }
     if (s < ptsvTileSamples()) gTruncated = true;
