@@ -69,17 +69,23 @@ bool mtOnArc(vec3 y, vec3 a, vec3 b, vec3 n) { return dot(cross(a, y), n) >= 0.0
 // One atan per call, whatever the element: the nearer end is the one with the larger cosine, and
 // where p's foot on the great circle lies on the arc that foot is nearer than either end. Capsules
 // and spheres (a = b: no circle) take the same path, so a SIMD group mixing them runs it once.
+// The foot lies on the arc when p is on b's side of a and on a's side of b along the circle:
+// with g = a x b, (a x foot).g and (foot x b).g are, up to |g|, p.b - (a.b)(p.a) and
+// p.a - (a.b)(p.b) (a, b unit), so neither the circle's normal nor the foot is needed for the test.
 float mtPointArc(vec3 p, vec3 a, vec3 b) {
-    vec3 e = dot(p, a) >= dot(p, b) ? a : b;
-    float y = length(cross(p, e)), x = dot(p, e); // atan(y, x): the angle from p to e
-    vec3 n = cross(a, b);
-    float nl = length(n);
-    if (nl > 1e-12) {
-        n /= nl;
-        float s = dot(p, n);
-        vec3 q = p - s * n; // p projected on the arc's great circle
-        // atan rather than asin: asin loses half the digits near the circle's poles.
-        if (mtOnArc(q, a, b, n)) { y = abs(s); x = length(q); }
+    float pa = dot(p, a), pb = dot(p, b);
+    vec3 e = pa >= pb ? a : b;
+    float y = length(cross(p, e)), x = max(pa, pb); // atan(y, x): the angle from p to e
+    vec3 g = cross(a, b);
+    float g2 = dot(g, g);
+    if (g2 > 1e-24) {
+        float ab = dot(a, b);
+        if (pb - ab * pa >= 0.0 && pa - ab * pb >= 0.0) {
+            float s = dot(p, g) * inversesqrt(g2); // sine of the angle from p to the circle
+            // atan rather than asin: asin loses half the digits near the circle's poles.
+            y = abs(s);
+            x = sqrt(max(dot(p, p) - s * s, 0.0));
+        }
     }
     return atan(y, x);
 }
