@@ -17,9 +17,14 @@ uniform uint uInvocationsPerRow; // gl_NumWorkGroups.x * 64: 2D dispatch past 65
 #define SLOT_INTER 1u
 #define SLOT_NEG 2u // capping nodes only: a shadow plane's negative child is its index + 1
 
-uint psvChild(uint node, uint slot) {
-    return slot == SLOT_POS ? psvNodes[node].pos : (slot == SLOT_INTER ? psvNodes[node].inter : psvNodes[node].wedgeOrNeg);
-}
+// A node's child fields (pos, inter, wedgeOrNeg, minDepth) as this invocation sees them, through the
+// buffer texture: other invocations change them during the dispatch, and a texel fetch may return
+// an older value. A child field only ever goes from 0 to its final value (one successful
+// compare-and-swap), so an older value is 0, which only makes the compare-and-swap below fail and
+// return the current child; a wedge only grows, so an older one only costs an atomicMax in vain.
+uvec4 psvFields(uint node) { return texelFetch(uPsvNodeTexels, int(2u * node + 1u)); }
+
+uint psvChild(uvec4 fields, uint slot) { return slot == SLOT_POS ? fields.x : (slot == SLOT_INTER ? fields.y : fields.z); }
 
 uint psvLinkChild(uint node, uint slot, uint child) {
     if (slot == SLOT_POS) return atomicCompSwap(psvNodes[node].pos, 0u, child);
@@ -43,8 +48,9 @@ uint insertTriangle(uint t, out uint tested) {
     PsvWedgeTriangle wedgeTriangle = psvWedgeTriangle(v0, v1, v2);
 #endif
     uint node = 0u, slot = SLOT_POS; // the sentinel's `pos` holds the root
+    uvec4 fields = psvFields(0u);
     while (true) {
-        uint child = psvChild(node, slot); // a stale 0 only makes the CAS below fail
+        uint child = psvChild(fields, slot);
         if (child == 0u) {
             child = psvLinkChild(node, slot, root);
             if (child == 0u) return PSV_C_INSERTED;
@@ -52,25 +58,17 @@ uint insertTriangle(uint t, out uint tested) {
         // Every link points at the first node of a frustum; anything else is a corrupt tree.
         if (child >= nodeCount || child % PSV_NODES_PER_TRIANGLE != 1u) return PSV_C_BUILD_ERRORS;
         node = child;
+        bool widen = false; // a shadow plane the triangle straddles: its wedge may have to grow
+        vec4 plane;
         while (true) { // down the frustum's own nodes until a child field has to be followed
             // A frustum adds at most 4 levels, so a longer descent can only be a cycle.
             if (++tested > nodeCount) return PSV_C_BUILD_ERRORS;
-            vec4 plane = psvPlane(node); // written by frusta.comp: fixed here
+            plane = psvPlane(node); // written by frusta.comp: fixed here
             int c = psvClassify(plane, v0, v1, v2);
             if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
                 if (c < 0) { ++node; continue; }
-                if (c == 0) {
-#if PSV_WEDGE
-                    // Non-negative floats order like their bit patterns: an integer max suffices.
-                    // A stale read only costs an exact wedge computed in vain.
-                    float current = uintBitsToFloat(psvNodes[node].wedgeOrNeg);
-                    if (psvWedgeBound(plane, wedgeTriangle) > current)
-                        atomicMax(psvNodes[node].wedgeOrNeg, floatBitsToUint(psvWedge(plane, wedgeTriangle)));
-#endif
-                    slot = SLOT_INTER;
-                } else {
-                    slot = SLOT_POS;
-                }
+                widen = c == 0;
+                slot = c == 0 ? SLOT_INTER : SLOT_POS;
                 break;
             }
 #if !PSV_TRANSPARENCY
@@ -84,6 +82,12 @@ uint insertTriangle(uint t, out uint tested) {
             slot = c > 0 ? SLOT_POS : (c == 0 ? SLOT_INTER : SLOT_NEG);
             break;
         }
+        fields = psvFields(node); // one fetch per node left: its wedge and the child to follow
+#if PSV_WEDGE
+        // Non-negative floats order like their bit patterns: an integer max suffices.
+        if (widen && psvWedgeBound(plane, wedgeTriangle) > uintBitsToFloat(fields.z))
+            atomicMax(psvNodes[node].wedgeOrNeg, floatBitsToUint(psvWedge(plane, wedgeTriangle)));
+#endif
     }
     return PSV_C_BUILD_ERRORS; // not reached
 }

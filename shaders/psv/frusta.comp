@@ -20,6 +20,11 @@ void main() {
     if (f.status != PSV_CASTER_OK) return; // never linked into the tree, so never read
     uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
     for (uint i = 0u; i < 3u; ++i) psvNodes[base + i] = PsvNode(f.planes[i], 0u, 0u, 0u, 0u);
+#if PSV_DEPTH_SKIP
     // The capping node's depth starts at its own triangle's: the subtree it roots includes it.
-    psvNodes[base + 3u] = PsvNode(f.planes[3], 0u, 0u, 0u, floatBitsToUint(psvTriangleMinDepth(v0, v1, v2)));
+    uint minDepth = floatBitsToUint(psvTriangleMinDepth(v0, v1, v2));
+#else
+    uint minDepth = 0u; // never read
+#endif
+    psvNodes[base + 3u] = PsvNode(f.planes[3], 0u, 0u, 0u, minDepth);
 }
