@@ -67,7 +67,8 @@ public:
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
-        nodes_ = GlBuffer(), triangles_ = GlBuffer(); // free the old tree before building the new one
+        nodeTexels_ = GlTexture(), triTexels_ = GlTexture(); // free the old tree before building the new one
+        nodes_ = GlBuffer(), triangles_ = GlBuffer();
         auto t0 = Clock::now();
         bvh::BuildOptions opt;
         opt.maxLeafSize = p_.leafSize;
@@ -84,6 +85,8 @@ public:
         const GLbitfield flags = scene.dynamic() ? GL_DYNAMIC_STORAGE_BIT : 0;  // refitted trees are re-uploaded
         nodes_ = GlBuffer::fromVector(tree.nodes, flags);
         triangles_ = GlBuffer::fromVector(tree.triangles, flags);
+        nodeTexels_ = makeBufferTexture(nodes_, GL_RGBA32UI, 16, "bvh_raytrace nodes");
+        triTexels_ = makeBufferTexture(triangles_, GL_RGBA32F, 16, "bvh_raytrace triangles");
         counters_.allocate();
         nodeCount_ = tree.nodes.size();
         depth_ = tree.depth;
@@ -129,8 +132,8 @@ public:
         setLightUniforms(trace_, f.light);
         trace_.set("uRayOffset", rayOffsetLength(p_.rayOffset, *scene_));
         trace_.set("uSampleCount", sampleCount);
-        nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_NODE_BINDING);
-        triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_TRI_BINDING);
+        glBindTextureUnit(BVH_NODE_UNIT, nodeTexels_.id());
+        glBindTextureUnit(BVH_TRI_UNIT, triTexels_.id());
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
         if (options_.instrumentation) runPixelPass(f, trace_, {&nodesVisited_, &overflow_});
@@ -194,6 +197,7 @@ private:
     const SceneGpu* scene_ = nullptr;
     ShaderProgram trace_;
     GlBuffer nodes_, triangles_, samples_;
+    GlTexture nodeTexels_, triTexels_; ///< nodes_ and triangles_ as buffer textures: how the trace reads them
     bvh::Bvh tree_;                  ///< kept for refits (moving scenes only)
     std::vector<glm::vec3> posed_;   ///< the posed scene positions the last refit used
     GpuCounters<BVH_COUNTER_WORDS> counters_;

@@ -2,12 +2,14 @@
 // (algorithms/bvh_raytrace/BvhGpuLayout.h includes this very file). #defines and comments only,
 // so it is valid in both languages and the numbers exist once.
 
-// SSBO binding points (3.. after the scene buffers 0..2 of shaders/common/scene.glsl, which the BVH
+// SSBO binding points (after the scene buffers 0..2 of shaders/common/scene.glsl, which the BVH
 // does not read: it holds its own copy of the triangles, in leaf order).
-#define BVH_NODE_BINDING 3
-#define BVH_TRI_BINDING 4
 #define BVH_SAMPLE_BINDING 5
 #define BVH_COUNTER_BINDING 6
+// Texture units of the trace's buffer-texture views of the nodes (RGBA32UI, 4 texels per node) and
+// the leaf-ordered triangles (RGBA32F, 3 texels per triangle); units 0 and 1 are the G-buffer.
+#define BVH_NODE_UNIT 2
+#define BVH_TRI_UNIT 3
 
 // A node stores the bounds of both children (Aila & Laine 2009), so one 64-byte fetch decides
 // which children a ray enters. countK > 0: child K is a leaf of countK triangles starting at

@@ -17,8 +17,20 @@ struct BvhNode { // 64 bytes, mirrored by bvh::NodeGpu (algorithms/bvh_raytrace/
     vec3 lo1; uint count0;
     vec3 hi1; uint count1;
 };
-layout(std430, binding = BVH_NODE_BINDING) readonly buffer BvhNodes { BvhNode bvhNodes[]; };
-layout(std430, binding = BVH_TRI_BINDING) readonly buffer BvhTriangles { vec4 bvhTris[]; }; // 3 per triangle, leaf order
+// Nodes and leaf-ordered triangles (3 vec4 each) are read through buffer textures over their
+// buffers (BvhRaytrace binds them to BVH_NODE_UNIT, BVH_TRI_UNIT): a SIMD CPU back end (llvmpipe)
+// gathers a texel fetch for all its lanes at once but loads storage buffers lane by lane; a GPU
+// reads both through its caches.
+layout(binding = BVH_NODE_UNIT) uniform usamplerBuffer uBvhNodeTexels;  // RGBA32UI, 4 texels per node
+layout(binding = BVH_TRI_UNIT) uniform samplerBuffer uBvhTriTexels;     // RGBA32F, 3 texels per triangle
+BvhNode bvhNode(uint i) {
+    int t = int(4u * i);
+    uvec4 a = texelFetch(uBvhNodeTexels, t), b = texelFetch(uBvhNodeTexels, t + 1);
+    uvec4 c = texelFetch(uBvhNodeTexels, t + 2), d = texelFetch(uBvhNodeTexels, t + 3);
+    return BvhNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w,
+                   uintBitsToFloat(c.xyz), c.w, uintBitsToFloat(d.xyz), d.w);
+}
+vec3 bvhVertex(uint tri, int k) { return texelFetch(uBvhTriTexels, int(3u * tri) + k).xyz; }
 layout(std430, binding = BVH_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = BVH_COUNTER_BINDING) buffer BvhCounters { uint bvhCounters[]; };
 
@@ -51,7 +63,7 @@ Ray makeRay(vec3 o, vec3 d, float tfar) {
 }
 
 bool hitTriangle(Ray r, uint tri) {
-    return watertightHit(r.w, bvhTris[3u * tri].xyz, bvhTris[3u * tri + 1u].xyz, bvhTris[3u * tri + 2u].xyz);
+    return watertightHit(r.w, bvhVertex(tri, 0), bvhVertex(tri, 1), bvhVertex(tri, 2));
 }
 
 // Slab test on [0, tfar]; tnear is where the ray enters (for near-first ordering). The far end
@@ -122,7 +134,7 @@ Trace trace(Ray r) {
         // neighbouring invocations (lanes in lockstep) test their triangles together below.
         while (node != NONE && !isLeaf(node) && leaf == NONE) {
             ++res.visited;
-            BvhNode n = bvhNodes[node];
+            BvhNode n = bvhNode(node);
             float tn0, tn1;
             bool h0 = n.child0 != BVH_ABSENT && hitBox(n.lo0, n.hi0, r, tn0);
             bool h1 = n.child1 != BVH_ABSENT && hitBox(n.lo1, n.hi1, r, tn1);
