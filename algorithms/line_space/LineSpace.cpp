@@ -109,6 +109,7 @@ public:
 
     void build(const Scene& cpu, bool useCache) {
         tracer_.reset();
+        texels_ = {}; // the views first: a buffer texture keeps its buffer alive
         nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(), occBuf_ = GlBuffer(); // free the old pools first
         for (GlBuffer& b : bitsBuf_) b = GlBuffer();
         const int n = p_.n, d = p_.d;
@@ -167,11 +168,12 @@ public:
             leafTris_ = GlBuffer::fromVector(lists.tris, 0);
         }
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
-            // Unused chunks get a 4-byte buffer so every binding the shader declares is valid.
+            // Unused chunks get a 4-byte buffer so every buffer texture the shader may declare has one.
             const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
             const size_t last = std::min(tree_.bits.size(), (c + 1) * nodesPerChunk_ * words);
             bitsBuf_[c] = GlBuffer((last - first) * sizeof(uint32_t), last > first ? tree_.bits.data() + first : nullptr, 0);
         }
+        makeTexels(occupancy, exact);
         // The shader reads the line-space pool with one load when it is a single block; a tree that
         // needs more blocks gets the program that picks the block per node.
         const int usedChunks = int(std::max<size_t>(1, chunks));
@@ -221,17 +223,9 @@ public:
         p.set("uLeafCell", region.leafCell);
         p.set("uStartCells", region.cells);
         p.set("uStartMaxCells", region.maxCells);
-        nodesBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_NODE_BINDING);
-        treeBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_TREE_BINDING);
-        if (region.mode != ls::StartMode::Node || lastLeaves()) occBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_OCC_BINDING);
-        if (region.mode == ls::StartMode::Exact) {
-            scene_->bindStorage();
-            leafBase_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_BASE_BINDING);
-            leafPrefix_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_PREFIX_BINDING);
-            leafTris_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_LEAF_TRIS_BINDING);
-        }
-        const GLuint bitBindings[LS_BIT_CHUNKS] = {LS_BITS_BINDING, LS_BITS_BINDING_1, LS_BITS_BINDING_2, LS_BITS_BINDING_3};
-        for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) bitsBuf_[c].bindBase(GL_SHADER_STORAGE_BUFFER, bitBindings[c]);
+        if (region.mode == ls::StartMode::Exact) scene_->bindStorage(); // the positions' buffer texture
+        for (size_t u = 0; u < kTexelUnits; ++u)
+            if (texels_[u]) glBindTextureUnit(GLuint(LS_NODE_UNIT + u), texels_[u].id());
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_COUNTER_BINDING);
         if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
@@ -341,6 +335,22 @@ private:
         return r;
     }
 
+    /// The trace's buffer-texture views of the pools, one per texture unit from LS_NODE_UNIT on
+    /// (layout.glsl); the occupancy pool and the leaf lists only where the start region reads them.
+    void makeTexels(bool occupancy, bool exact) {
+        static_assert(LS_BITS_UNIT - LS_NODE_UNIT + LS_BIT_CHUNKS == kTexelUnits);
+        texels_[0] = makeBufferTexture(nodesBuf_, GL_RGBA32UI, 16, "line_space node pool");
+        texels_[LS_TREE_UNIT - LS_NODE_UNIT] = makeBufferTexture(treeBuf_, GL_R32UI, 4, "line_space tree pool");
+        if (occupancy) texels_[LS_OCC_UNIT - LS_NODE_UNIT] = makeBufferTexture(occBuf_, GL_R32UI, 4, "line_space occupancy pool");
+        if (exact) {
+            texels_[LS_LEAF_RANK_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafBase_, GL_R32UI, 4, "line_space leaf ranks");
+            texels_[LS_LEAF_PREFIX_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafPrefix_, GL_R32UI, 4, "line_space leaf prefixes");
+            texels_[LS_LEAF_TRIS_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafTris_, GL_R32UI, 4, "line_space leaf triangles");
+        }
+        for (size_t c = 0; c < LS_BIT_CHUNKS; ++c)
+            texels_[LS_BITS_UNIT - LS_NODE_UNIT + c] = makeBufferTexture(bitsBuf_[c], GL_R32UI, 4, "line_space line-space pool");
+    }
+
     void compile() {
         trace_ = ShaderProgram::compute("line_space/trace.comp", defines(false));
         classifyProgram_ = ShaderProgram(); // compiled on first use
@@ -388,6 +398,8 @@ private:
     GlBuffer nodesBuf_, treeBuf_, occBuf_, leafBase_, leafPrefix_, leafTris_, samples_, classifyBuf_;
     GpuCounters<LS_COUNTER_WORDS> counters_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
+    static constexpr size_t kTexelUnits = 10;
+    std::array<GlTexture, kTexelUnits> texels_; ///< the pools as buffer textures (makeTexels): how the trace reads them
     size_t nodesPerChunk_ = 1;
     int bitChunks_ = 1; ///< line-space pool blocks the compiled programs read (LS_BIT_CHUNK_COUNT)
     GlTexture nodesVisited_;

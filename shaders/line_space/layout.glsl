@@ -2,26 +2,28 @@
 // (algorithms/line_space/LineSpaceLayout.h includes this very file). #defines and comments only,
 // so it is valid in both languages and the numbers exist once.
 
-// SSBO binding points (0..2 are the scene buffers, which line_space never reads: the paper's
-// point is that the shadow rays need no geometry).
-#define LS_NODE_BINDING 3       // node pool: one LsNode per subdivided node, breadth-first, root = 0
-#define LS_TREE_BINDING 4       // tree pool: children groups of N³ entries, one per node above the last level
-#define LS_BITS_BINDING 5       // line-space pool, chunk 0: LS_WORDS_PER_NODE(N) words per node, node order
+// SSBO binding points (0..2 are the scene buffers; only start_region exact reads the scene, its
+// positions, through their buffer texture, unit 15).
 #define LS_SAMPLE_BINDING 6     // light sample points (vec4)
 #define LS_COUNTER_BINDING 7    // per-frame counters
 #define LS_CLASSIFY_BINDING 8   // with classify: per pixel, start node + one occlusion bit per sample
-// The line-space pool is the one that outgrows a shader storage block (128 MiB here): (8, 3) on a
-// 2 M-triangle scene needs ~220 MB. It is split at node boundaries into up to LS_BIT_CHUNKS blocks
-// of uNodesPerChunk nodes each, bound at LS_BITS_BINDING and LS_BITS_BINDING_1..3.
+
+// The pools, read-only in the trace, are read through buffer textures over their buffers (texture
+// units; 0 and 1 are the G-buffer): nodes as RGBA32UI (2 texels per node), the others as R32UI
+// (one texel per word).
+#define LS_NODE_UNIT 2          // node pool: one LsNode per subdivided node, breadth-first, root = 0
+#define LS_TREE_UNIT 3          // tree pool: children groups of N³ entries, one per node above the last level
+#define LS_OCC_UNIT 4           // occupancy pool: LS_OCC_WORDS_PER_NODE(N) words per node, node order
+// start_region exact: the leaf lists (ls::LeafLists); the triangles' vertices are the scene's.
+#define LS_LEAF_RANK_UNIT 5
+#define LS_LEAF_PREFIX_UNIT 6
+#define LS_LEAF_TRIS_UNIT 7
+// Line-space pool: LS_WORDS_PER_NODE(N) words per node, node order. It is the one that outgrows a
+// shader storage block (128 MiB here): (8, 3) on a 2 M-triangle scene needs ~220 MB. It is split at
+// node boundaries into up to LS_BIT_CHUNKS buffers of uNodesPerChunk nodes each; chunk c is read
+// at unit LS_BITS_UNIT + c.
 #define LS_BIT_CHUNKS 4
-#define LS_BITS_BINDING_1 9
-#define LS_BITS_BINDING_2 10
-#define LS_BITS_BINDING_3 11
-#define LS_OCC_BINDING 12       // occupancy pool: LS_OCC_WORDS_PER_NODE(N) words per node, node order
-// start_region exact: the leaf lists (ls::LeafLists); the triangles' vertices are the scene's (binding 0).
-#define LS_LEAF_BASE_BINDING 13
-#define LS_LEAF_PREFIX_BINDING 14
-#define LS_LEAF_TRIS_BINDING 15
+#define LS_BITS_UNIT 8
 
 // Node pool entry: vec3 lo; uint children; vec3 size; uint level (32 bytes, std430).
 #define LS_NODE_BYTES 32

@@ -27,6 +27,7 @@
 #define LS_START_DISTANCE 1
 #define LS_START_EXACT 2
 #if LS_START_MODE == LS_START_EXACT
+#define SCENE_POSITION_TEXELS 1
 #include "common/scene.glsl"
 #include "common/watertight.glsl"
 #endif
@@ -36,23 +37,38 @@ struct LsNode { // 32 bytes, mirrored by ls::NodeGpu (algorithms/line_space/NTre
     vec3 lo; uint children;
     vec3 size; uint level;
 };
-layout(std430, binding = LS_NODE_BINDING) readonly buffer LsNodes { LsNode lsNodes[]; };
-layout(std430, binding = LS_TREE_BINDING) readonly buffer LsTree { uint lsTree[]; };
-layout(std430, binding = LS_BITS_BINDING) readonly buffer LsBits0 { uint lsBits0[]; };
-layout(std430, binding = LS_BITS_BINDING_1) readonly buffer LsBits1 { uint lsBits1[]; };
-layout(std430, binding = LS_BITS_BINDING_2) readonly buffer LsBits2 { uint lsBits2[]; };
-layout(std430, binding = LS_BITS_BINDING_3) readonly buffer LsBits3 { uint lsBits3[]; };
+// The pools are read through buffer textures over their buffers (LineSpace binds them to the
+// LS_*_UNIT units, layout.glsl), and the exact start region's vertices through the scene's
+// (SCENE_POSITION_TEXELS): a SIMD CPU back end (llvmpipe) gathers a texel fetch for all its lanes
+// at once but loads storage buffers lane by lane; a GPU reads both through its caches.
+layout(binding = LS_NODE_UNIT) uniform usamplerBuffer uLsNodeTexels; // RGBA32UI, 2 texels per node
+layout(binding = LS_TREE_UNIT) uniform usamplerBuffer uLsTreeTexels; // R32UI, one texel per word (likewise below)
+layout(binding = LS_BITS_UNIT) uniform usamplerBuffer uLsBitsTexels0;
+#if LS_BIT_CHUNK_COUNT > 1
+layout(binding = LS_BITS_UNIT + 1) uniform usamplerBuffer uLsBitsTexels1;
+layout(binding = LS_BITS_UNIT + 2) uniform usamplerBuffer uLsBitsTexels2;
+layout(binding = LS_BITS_UNIT + 3) uniform usamplerBuffer uLsBitsTexels3;
+#endif
 #if LS_START_MODE != LS_START_NODE || LS_LAST_LEAVES
-layout(std430, binding = LS_OCC_BINDING) readonly buffer LsOccupancy { uint lsOcc[]; };
+layout(binding = LS_OCC_UNIT) uniform usamplerBuffer uLsOccTexels;
+uint lsOcc(uint word) { return texelFetch(uLsOccTexels, int(word)).x; }
 #endif
 #if LS_START_MODE == LS_START_EXACT
 // The leaf lists (ls::LeafLists): per node and occupancy word the number of the occupied leaves
 // before it, per occupied leaf the start of its triangles (plus one end), the triangles (scene
-// indices, vertices at binding 0).
-layout(std430, binding = LS_LEAF_BASE_BINDING) readonly buffer LsLeafRank { uint lsLeafRank[]; };
-layout(std430, binding = LS_LEAF_PREFIX_BINDING) readonly buffer LsLeafPrefix { uint lsLeafPrefix[]; };
-layout(std430, binding = LS_LEAF_TRIS_BINDING) readonly buffer LsLeafTris { uint lsLeafTris[]; };
+// indices, vertices from the scene's positions).
+layout(binding = LS_LEAF_RANK_UNIT) uniform usamplerBuffer uLsLeafRankTexels;
+layout(binding = LS_LEAF_PREFIX_UNIT) uniform usamplerBuffer uLsLeafPrefixTexels;
+layout(binding = LS_LEAF_TRIS_UNIT) uniform usamplerBuffer uLsLeafTrisTexels;
+uint lsLeafRank(uint word) { return texelFetch(uLsLeafRankTexels, int(word)).x; }
+uint lsLeafPrefix(uint leaf) { return texelFetch(uLsLeafPrefixTexels, int(leaf)).x; }
+uint lsLeafTri(uint i) { return texelFetch(uLsLeafTrisTexels, int(i)).x; }
 #endif
+LsNode lsNode(uint i) {
+    uvec4 a = texelFetch(uLsNodeTexels, int(2u * i)), b = texelFetch(uLsNodeTexels, int(2u * i + 1u));
+    return LsNode(uintBitsToFloat(a.xyz), a.w, uintBitsToFloat(b.xyz), b.w);
+}
+uint lsTree(uint i) { return texelFetch(uLsTreeTexels, int(i)).x; }
 layout(std430, binding = LS_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = LS_COUNTER_BINDING) buffer LsCounters { uint lsCounters[]; };
 #if LS_CLASSIFY
@@ -115,13 +131,14 @@ uint subFace(ivec3 c, int axis) {
 // is the number of chunks the pool really uses (the host compiles per tree): with one chunk, one load.
 uint lineSpaceWord(uint index, uint w) {
 #if LS_BIT_CHUNK_COUNT <= 1
-    return lsBits0[index * WORDS + w];
+    return texelFetch(uLsBitsTexels0, int(index * WORDS + w)).x;
 #else
-    uint chunk = index / uNodesPerChunk, i = (index - chunk * uNodesPerChunk) * WORDS + w;
-    if (chunk == 0u) return lsBits0[i];
-    if (chunk == 1u) return lsBits1[i];
-    if (chunk == 2u) return lsBits2[i];
-    return lsBits3[i];
+    uint chunk = index / uNodesPerChunk;
+    int i = int((index - chunk * uNodesPerChunk) * WORDS + w);
+    if (chunk == 0u) return texelFetch(uLsBitsTexels0, i).x;
+    if (chunk == 1u) return texelFetch(uLsBitsTexels1, i).x;
+    if (chunk == 2u) return texelFetch(uLsBitsTexels2, i).x;
+    return texelFetch(uLsBitsTexels3, i).x;
 #endif
 }
 
@@ -168,7 +185,7 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
 #if LS_START_MODE == LS_START_EXACT
         if (next < end) {
             ++trianglesTested;
-            uint tri = lsLeafTris[next++];
+            uint tri = lsLeafTri(next++);
             if (watertightHit(exactRay, sceneVertex(tri, 0u), sceneVertex(tri, 1u), sceneVertex(tri, 2u))) return true;
             continue;
         }
@@ -186,13 +203,13 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
         step = true;
         ++leafCells;
         uint leaf = uint((c.z * LS_N + c.y) * LS_N + c.x);
-        uint word = base + (leaf >> 5u), bits = lsOcc[word];
+        uint word = base + (leaf >> 5u), bits = lsOcc(word);
         if (((bits >> (leaf & 31u)) & 1u) != 0u) {
 #if LS_START_MODE == LS_START_EXACT
             if (tEnter >= tS) return true;
-            uint rank = lsLeafRank[word] + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
-            next = lsLeafPrefix[rank];
-            end = lsLeafPrefix[rank + 1u];
+            uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
+            next = lsLeafPrefix(rank);
+            end = lsLeafPrefix(rank + 1u);
 #else
             return true;
 #endif
@@ -226,7 +243,7 @@ uint rayVisited = 0u, sumShafts = 0u, startNode = LS_NONE;
 // `start`: the node holds the ray origin (the first cell of a start node's walk); a node entered
 // before `tS` (the end of the start region, -inf for the paper's) is in the start region too.
 int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Frame f) {
-    LsNode n = lsNodes[index];
+    LsNode n = lsNode(index);
     float tIn, tOut;
     int ia, oa;
     slabs(n.lo, n.size, r, tIn, tOut, ia, oa);
@@ -428,7 +445,7 @@ void main() {
                                 vec3 ahead = cur.lo + vec3(cur.cell + up) * cur.cellSize;
                                 cur.tNext = mix(cur.tNext, (ahead - r.o) * r.invD, axis);
                                 cur.start = false;
-                                uint child = lsTree[cur.children + uint(cell)];
+                                uint child = lsTree(cur.children + uint(cell));
                                 if (child != LS_EMPTY) { node = child; break; } // Algorithm 1, line 8: empty children are skipped
                             }
                             if (node == LS_NONE) break; // walked past the root: the ray is free
