@@ -22,6 +22,7 @@ uniform uint uInvocationsPerRow; // gl_NumWorkGroups.x * 64: 2D dispatch past 65
 // an older value. A child field only ever goes from 0 to its final value (one successful
 // compare-and-swap), so an older value is 0, which only makes the compare-and-swap below fail and
 // return the current child; a wedge only grows, so an older one only costs an atomicMax in vain.
+// Nothing older than this frame's frusta.comp is seen: its barrier includes texture fetches.
 uvec4 psvFields(uint node) { return texelFetch(uPsvNodeTexels, int(2u * node + 1u)); }
 
 uint psvChild(uvec4 fields, uint slot) { return slot == SLOT_POS ? fields.x : (slot == SLOT_INTER ? fields.y : fields.z); }
