@@ -137,58 +137,68 @@ Result query(vec3 q) {
     uint stack[MT_STACK_SIZE];
     int sp = 0;
     // Pushing onto a full stack would drop a subtree that may hold the occluder: stop and report.
-#define MT_PUSH(x) { if (sp == MT_STACK_SIZE) { r.overflow = true; break; } stack[sp++] = (x); }
+#define MT_PUSH(x) { if (sp == MT_STACK_SIZE) { r.overflow = true; done = true; break; } stack[sp++] = (x); }
     uint next = mtCounters[MT_C_ROOT];
-    while (true) {
-        if (next == MT_NO_CHILD) {
-            if (sp == 0) break;
-            next = stack[--sp];
-        }
-        uint node = next - 1u;
-        ++r.visited;
-        MtNode n = mtNode(node);
-#if MT_DEPTH_SKIP
-        // Mora et al. 2016: nothing in this subtree is nearer the light than q, so nothing in it
-        // can lie between q and the light.
-        if (depth <= uintBitsToFloat(n.minDist)) { ++r.depthSkips; next = MT_NO_CHILD; continue; }
-#endif
-        float dq = mtPointDist(p, n.a.xyz, n.b.xyz);
-        if (dq <= n.a.w + uLsEps) { // inside the cone or capsule-cone: the cluster may occlude q
-            ++r.coneHits;
-            MtCluster c = mtCluster(node);
-            bool test = true;
-#if MT_SLABS
-            // The shadow ray must cross the slab between the cluster's two planes (paper step 2).
-            float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
-            float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
-            float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
-            float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
-            test = sFar >= lo && sNear <= hi;
-            if (!test) ++r.slabRejects;
-#endif
-            if (test) {
-                bool hit = false;
-                for (uint k = 0u; k < c.count && !hit; ++k) {
-                    ++r.triangles;
-                    vec3 v0, v1, v2;
-                    mtTriangle(c.first + k, v0, v1, v2);
-                    hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
-                }
-                if (hit) { r.visibility = 0.0; break; }
-                ++r.fruitless;
+    // Two phases, each a loop of its own: walk the tree until this pixel has a cluster to test (or
+    // nothing left), then test that cluster's triangles. In a SIMD group (8 to 64 pixels in
+    // lockstep) a pixel that found its cluster waits for the others to find theirs, and the group
+    // tests all its pixels' clusters in one triangle loop instead of one loop per pixel's cluster.
+    bool done = false;
+    uint triangle = 0u, trianglesEnd = 0u; // the cluster to test: [triangle, trianglesEnd)
+    while (!done) {
+        while (true) {
+            if (next == MT_NO_CHILD) {
+                if (sp == 0) { done = true; break; }
+                next = stack[--sp];
             }
-        }
-        uint follow = dq <= n.b.w ? n.child[MT_CHILD_NEAR] : n.child[MT_CHILD_FAR];
-        uint overlap = n.child[MT_CHILD_OVERLAP];
-#if MT_OVERLAP_INTERVAL
-        if (overlap != MT_NO_CHILD && (dq < uintBitsToFloat(n.overlapMin) || dq > uintBitsToFloat(n.overlapMax)))
-            overlap = MT_NO_CHILD;
+            uint node = next - 1u;
+            ++r.visited;
+            MtNode n = mtNode(node);
+#if MT_DEPTH_SKIP
+            // Mora et al. 2016: nothing in this subtree is nearer the light than q, so nothing in it
+            // can lie between q and the light.
+            if (depth <= uintBitsToFloat(n.minDist)) { ++r.depthSkips; next = MT_NO_CHILD; continue; }
 #endif
-        if (overlap != MT_NO_CHILD) {
-            if (follow == MT_NO_CHILD) follow = overlap;
-            else MT_PUSH(overlap);
+            float dq = mtPointDist(p, n.a.xyz, n.b.xyz);
+            if (dq <= n.a.w + uLsEps) { // inside the cone or capsule-cone: the cluster may occlude q
+                ++r.coneHits;
+                MtCluster c = mtCluster(node);
+                bool test = true;
+#if MT_SLABS
+                // The shadow ray must cross the slab between the cluster's two planes (paper step 2).
+                float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
+                float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
+                float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
+                float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
+                test = sFar >= lo && sNear <= hi;
+                if (!test) ++r.slabRejects;
+#endif
+                if (test) { triangle = c.first; trianglesEnd = c.first + c.count; }
+            }
+            uint follow = dq <= n.b.w ? n.child[MT_CHILD_NEAR] : n.child[MT_CHILD_FAR];
+            uint overlap = n.child[MT_CHILD_OVERLAP];
+#if MT_OVERLAP_INTERVAL
+            if (overlap != MT_NO_CHILD && (dq < uintBitsToFloat(n.overlapMin) || dq > uintBitsToFloat(n.overlapMax)))
+                overlap = MT_NO_CHILD;
+#endif
+            if (overlap != MT_NO_CHILD) {
+                if (follow == MT_NO_CHILD) follow = overlap;
+                else MT_PUSH(overlap);
+            }
+            next = follow;
+            if (triangle < trianglesEnd) break;
         }
-        next = follow;
+        if (r.overflow) break;
+        bool hit = false;
+        for (; triangle < trianglesEnd && !hit; ++triangle) {
+            ++r.triangles;
+            vec3 v0, v1, v2;
+            mtTriangle(triangle, v0, v1, v2);
+            hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
+        }
+        if (hit) { r.visibility = 0.0; break; }
+        if (trianglesEnd != 0u) ++r.fruitless;
+        triangle = trianglesEnd = 0u;
     }
 #undef MT_PUSH
     // An overflowed pixel is never reported lit: it is written shadowed and counted.
