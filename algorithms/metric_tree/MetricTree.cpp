@@ -146,7 +146,7 @@ public:
         poseGeometry_.set("uFirst", unsigned(movingFirst_));
         poseGeometry_.set("uCount", unsigned(moving));
         poseGeometry_.dispatchLinear(moving, kGroup);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT); // the query fetches them
         f.timer.end();
     }
 
@@ -207,21 +207,18 @@ public:
         counters_.clear(); // also empties the tree: its root pointer is counter word 0
         if (clusterCount_ > 0) {
             dispatchPerCluster(prepare_);
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+            // The insertion and the query read the nodes through their buffer texture.
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
             if (p_.treeBuilder == "cpu") {
                 buildOnCpu(f.light);
             } else {
                 dispatchPerCluster(insert_);
-                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
             }
         }
         f.timer.end();
 
         f.timer.begin("traverse");
-        glBindTextureUnit(MT_NODE_UNIT, nodeTexels_.id());
-        glBindTextureUnit(MT_CLUSTER_UNIT, clusterTexels_.id());
-        for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i) // unused blocks alias chunk 0: never read, but bound
-            glBindTextureUnit(MT_GEOMETRY_UNIT_0 + i, (geometryTexels_[i] ? geometryTexels_[i] : geometryTexels_[0]).id());
         if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &triangleTests_, &fruitless_, &overflow_});
         else runPixelPass(f, query_, {});
         f.timer.end();
@@ -406,6 +403,11 @@ private:
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_NODE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, MT_COUNTER_BINDING);
         bindGeometry();
+        // The views the insertion (nodes) and the query (nodes, clusters, geometry) fetch through.
+        glBindTextureUnit(MT_NODE_UNIT, nodeTexels_.id());
+        glBindTextureUnit(MT_CLUSTER_UNIT, clusterTexels_.id());
+        for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i) // unused blocks alias chunk 0: never read, but bound
+            glBindTextureUnit(MT_GEOMETRY_UNIT_0 + i, (geometryTexels_[i] ? geometryTexels_[i] : geometryTexels_[0]).id());
     }
 
     void setUniforms(const Light& light) {

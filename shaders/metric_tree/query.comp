@@ -14,7 +14,6 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 // The tree, clusters and cluster-ordered triangles as buffer textures (views of the SSBOs the build
 // writes): texel fetches are gathered per SIMD group, storage loads per lane on llvmpipe.
-layout(binding = MT_NODE_UNIT) uniform usamplerBuffer uNodeTexels;       // 4 texels per node
 layout(binding = MT_CLUSTER_UNIT) uniform usamplerBuffer uClusterTexels; // 4 texels per cluster
 layout(binding = MT_GEOMETRY_UNIT_0) uniform samplerBuffer uGeometry0;   // 3 texels per triangle
 layout(binding = MT_GEOMETRY_UNIT_0 + 1) uniform samplerBuffer uGeometry1;
@@ -25,18 +24,6 @@ layout(binding = MT_GEOMETRY_UNIT_0 + 5) uniform samplerBuffer uGeometry5;
 #if MT_GEOMETRY_CHUNKS != 6
 #error "query.comp declares six geometry blocks"
 #endif
-
-MtNode mtNode(uint i) {
-    int t = int(4u * i);
-    uvec4 t0 = texelFetch(uNodeTexels, t), t1 = texelFetch(uNodeTexels, t + 1);
-    uvec4 t2 = texelFetch(uNodeTexels, t + 2), t3 = texelFetch(uNodeTexels, t + 3);
-    MtNode n;
-    n.a = uintBitsToFloat(t0);
-    n.b = uintBitsToFloat(t1);
-    n.child[0] = t2.x; n.child[1] = t2.y; n.child[2] = t2.z;
-    n.minDist = t2.w; n.overlapMin = t3.x; n.overlapMax = t3.y; n.flags = t3.z; n.pad = t3.w;
-    return n;
-}
 
 MtCluster mtCluster(uint i) {
     int t = int(4u * i);

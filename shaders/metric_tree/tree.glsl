@@ -38,6 +38,23 @@ layout(std430, binding = MT_CLUSTER_BINDING) readonly buffer MtClusters { MtClus
 layout(std430, binding = MT_NODE_BINDING) MT_NODE_ACCESS buffer MtNodes { MtNode mtNodes[]; };
 layout(std430, binding = MT_COUNTER_BINDING) coherent buffer MtCounters { uint mtCounters[]; };
 
+// The nodes through a buffer texture (four RGBA32UI texels each), for reads of what the current
+// dispatch does not change (the query) or changes only monotonically (the insertion; see there).
+// A SIMD CPU back end (llvmpipe) gathers a texel fetch for all its lanes at once but loads a
+// storage buffer lane by lane; a GPU reads both through its caches.
+layout(binding = MT_NODE_UNIT) uniform usamplerBuffer uNodeTexels;
+MtNode mtNode(uint i) {
+    int t = int(4u * i);
+    uvec4 t0 = texelFetch(uNodeTexels, t), t1 = texelFetch(uNodeTexels, t + 1);
+    uvec4 t2 = texelFetch(uNodeTexels, t + 2), t3 = texelFetch(uNodeTexels, t + 3);
+    MtNode n;
+    n.a = uintBitsToFloat(t0);
+    n.b = uintBitsToFloat(t1);
+    n.child[0] = t2.x; n.child[1] = t2.y; n.child[2] = t2.z;
+    n.minDist = t2.w; n.overlapMin = t3.x; n.overlapMax = t3.y; n.flags = t3.z; n.pad = t3.w;
+    return n;
+}
+
 const float kMtPi = 3.14159265358979;
 const float kMtInf = uintBitsToFloat(0x7F800000u);
 
