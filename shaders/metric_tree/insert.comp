@@ -29,9 +29,6 @@ uint mtLink(uint node, uint slot, uint child) {
     return atomicCompSwap(mtNodes[node].child[2], MT_NO_CHILD, child);
 }
 
-uint mtChild(uint node, uint slot) {
-    return node == 0xFFFFFFFFu ? mtCounters[MT_C_ROOT] : mtNodes[node].child[slot];
-}
 
 // Inserts cluster i; returns the counter its outcome adds to and the nodes it crossed.
 uint insertCluster(uint i, out uint crossed) {
@@ -41,8 +38,13 @@ uint insertCluster(uint i, out uint crossed) {
     vec3 a = me.a.xyz, b = me.b.xyz;
     float alpha = me.a.w, delta = uDelta0;
     uint node = 0xFFFFFFFFu, slot = 0u; // the root pointer
+    uint child = mtCounters[MT_C_ROOT];
     while (true) {
-        uint child = mtChild(node, slot); // a stale 0 only makes the CAS below fail
+        // `child` comes from the node's texels (below), which may be older than the node: a child
+        // field only goes from 0 to its final value, so an older one is 0 and only makes the CAS
+        // fail (it returns the current child); delta is pending or final (see the top); the light
+        // distance and the overlap interval only shrink or grow, so an older value only costs an
+        // atomic in vain. Nothing older than prepare.comp is seen: its barrier covers fetches.
         if (child == MT_NO_CHILD) {
             child = mtLink(node, slot, i + 1u);
             if (child == MT_NO_CHILD) {
@@ -52,7 +54,7 @@ uint insertCluster(uint i, out uint crossed) {
         }
         if (child > uClusterCount || ++crossed > uClusterCount) return MT_C_BUILD_ERRORS;
         node = child - 1u;
-        MtNode n = mtNodes[node];
+        MtNode n = mtNode(node);
 #if MT_DEPTH_SKIP
         // Non-negative floats order like their bits. The bound only ever decreases, so a value read
         // earlier is never below the current one: skipping the atomic when it is not smaller is
@@ -78,6 +80,7 @@ uint insertCluster(uint i, out uint crossed) {
             if (hi > n.overlapMax) atomicMax(mtNodes[node].overlapMax, hi);
 #endif
         }
+        child = n.child[slot];
     }
     return MT_C_BUILD_ERRORS; // not reached
 }

@@ -38,9 +38,8 @@ layout(std430, binding = MT_CLUSTER_BINDING) readonly buffer MtClusters { MtClus
 layout(std430, binding = MT_NODE_BINDING) MT_NODE_ACCESS buffer MtNodes { MtNode mtNodes[]; };
 layout(std430, binding = MT_COUNTER_BINDING) coherent buffer MtCounters { uint mtCounters[]; };
 
-// The nodes through a buffer texture (four RGBA32UI texels each), for the query, which reads what
-// the build finished. (The insertion keeps coherent storage reads: read through this view, its
-// trees failed ConcurrentBuildYieldsAValidTree though every value read matched the storage read.)
+// The nodes through a buffer texture (four RGBA32UI texels each), for reads of what the current
+// dispatch does not change (the query) or changes only monotonically (the insertion; see there).
 // A SIMD CPU back end (llvmpipe) gathers a texel fetch for all its lanes at once but loads a
 // storage buffer lane by lane; a GPU reads both through its caches.
 layout(binding = MT_NODE_UNIT) uniform usamplerBuffer uNodeTexels;
