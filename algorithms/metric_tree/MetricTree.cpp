@@ -175,7 +175,7 @@ public:
         }
         if (!geometry_[0]) geometry_[0] = GlBuffer(36, nullptr, 0); // an empty scene still binds its blocks
         nodeTexels_ = makeBufferTexture(nodes_, GL_RGBA32UI, 16, "metric_tree nodes");
-        clusterTexels_ = makeBufferTexture(clusters_.size() ? clusters_ : nodes_, GL_RGBA32UI, 16, "metric_tree clusters");
+        clusterTexels_ = makeBufferTexture(clusters_, GL_RGBA32UI, 16, "metric_tree clusters");
         for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i)
             geometryTexels_[i] = geometry_[i] ? makeBufferTexture(geometry_[i], GL_RGB32F, 12, "metric_tree geometry") : GlTexture();
         // The query reads the blocks that hold triangles only (a #define): recompiled when that changes.

@@ -29,7 +29,6 @@ uint mtLink(uint node, uint slot, uint child) {
     return atomicCompSwap(mtNodes[node].child[2], MT_NO_CHILD, child);
 }
 
-
 // Inserts cluster i; returns the counter its outcome adds to and the nodes it crossed.
 uint insertCluster(uint i, out uint crossed) {
     crossed = 0u;

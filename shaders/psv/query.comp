@@ -13,8 +13,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-uniform float uRayOffset;
- // world units: the reference's shadow-ray origin offset along the normal
+uniform float uRayOffset; // world units: the reference's shadow-ray origin offset along the normal
 
 struct Result {
     float visibility;

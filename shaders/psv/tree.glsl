@@ -22,10 +22,11 @@ struct PsvNode {
 layout(std430, binding = PSV_NODE_BINDING) PSV_NODE_ACCESS buffer PsvNodes { PsvNode psvNodes[]; };
 layout(std430, binding = PSV_COUNTER_BINDING) coherent buffer PsvCounters { uint psvCounters[]; };
 
-// The same nodes through a buffer texture (two RGBA32UI texels each), for reads of what no
-// invocation of the current dispatch writes: the planes during the build, whole nodes in the
-// query. A SIMD CPU back end (llvmpipe) gathers a texel fetch for its lanes at once but loads
-// storage per lane, which made the query a third slower; a GPU reads both through its caches.
+// The same nodes through a buffer texture (two RGBA32UI texels each): whole nodes in the query;
+// in the build the planes, which nothing changes there, and the child fields and wedges, which
+// other insertions change but where an older value is harmless (build.comp says why). A SIMD CPU
+// back end (llvmpipe) gathers a texel fetch for its lanes at once but loads storage per lane, which
+// made the query a third slower; a GPU reads both through its caches.
 layout(binding = PSV_NODE_UNIT) uniform usamplerBuffer uPsvNodeTexels;
 vec4 psvPlane(uint i) { return uintBitsToFloat(texelFetch(uPsvNodeTexels, int(2u * i))); }
 PsvNode psvNode(uint i) {
