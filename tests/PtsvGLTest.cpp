@@ -52,6 +52,10 @@ Shot engine() {
     return s;
 }
 
+// The two traversals (`traversal` = auto picks one per device), named so every row can say which.
+const std::pair<const std::string, ParamValue> kCooperative{"traversal", std::string("cooperative")};
+const std::pair<const std::string, ParamValue> kPerInvocation{"traversal", std::string("invocation")};
+
 // ---- Running ptsv and the reference --------------------------------------------------------------
 
 struct Outcome : AlgorithmRun {
@@ -99,12 +103,24 @@ const AccuracyCase kAccuracy[] = {
     {"fence_tile_4", fenceDiscontinuity, {{"tile_size", 4}}, 1e-4},
     {"fence_tile_16_implicit", fenceDiscontinuity, {{"tile_size", 16}, {"bounds", std::string("implicit")}}, 1e-4},
     {"fence_leaf_cluster", fenceDiscontinuity, {{"leaf_samples", std::string("cluster")}}, 1e-4},
-    {"fence_batches_of_5", fenceDiscontinuity, {{"jobs_per_workgroup", 5}}, 1e-4},
+    {"fence_batches_of_5", fenceDiscontinuity, {kCooperative, {"jobs_per_workgroup", 5}}, 1e-4},
     {"fence_slices_merged", fenceDiscontinuity, {{"max_key_bits", 11}}, 1e-4}, // 15 bits → 4 merges, 2 levels
     {"fence_slices_merged_implicit", fenceDiscontinuity, {{"max_key_bits", 11}, {"bounds", std::string("implicit")}}, 1e-4},
-    {"fence_batches_of_3_shared", fenceDiscontinuity, {{"jobs_per_workgroup", 3}, {"vote", std::string("shared")}}, 1e-4},
-    {"thousands_shared_vote", thousandsOfTriangles, {{"vote", std::string("shared")}}, 1e-4},
-    {"thousands_shared_vote_implicit", thousandsOfTriangles, {{"vote", std::string("shared")}, {"bounds", std::string("implicit")}}, 1e-4},
+    {"fence_batches_of_3_shared", fenceDiscontinuity, {kCooperative, {"jobs_per_workgroup", 3}, {"vote", std::string("shared")}}, 1e-4},
+    {"thousands_shared_vote", thousandsOfTriangles, {kCooperative, {"vote", std::string("shared")}}, 1e-4},
+    {"thousands_shared_vote_implicit", thousandsOfTriangles, {kCooperative, {"vote", std::string("shared")}, {"bounds", std::string("implicit")}}, 1e-4},
+    // Both traversals by name (the rows above run the device's `auto` choice).
+    {"directional_cooperative", directionalObjects, {kCooperative}, 1e-4},
+    {"directional_invocation", directionalObjects, {kPerInvocation}, 1e-4},
+    {"fence_cooperative", fenceDiscontinuity, {kCooperative}, 1e-4},
+    {"fence_cooperative_implicit_one_pass", fenceDiscontinuity, {kCooperative, {"bounds", std::string("implicit")}, {"two_pass", false}}, 1e-4},
+    {"fence_invocation", fenceDiscontinuity, {kPerInvocation}, 1e-4},
+    {"fence_invocation_implicit_one_pass", fenceDiscontinuity, {kPerInvocation, {"bounds", std::string("implicit")}, {"two_pass", false}}, 1e-4},
+    {"fence_invocation_split_1_cluster", fenceDiscontinuity, {kPerInvocation, {"split_level", 1}, {"leaf_samples", std::string("cluster")}}, 1e-4},
+    {"thousands_cooperative", thousandsOfTriangles, {kCooperative}, 1e-4},
+    {"thousands_invocation", thousandsOfTriangles, {kPerInvocation}, 1e-4},
+    {"engine_cooperative", engine, {kCooperative}, 1e-4},
+    {"engine_invocation", engine, {kPerInvocation}, 1e-4},
     {"thousands_no_planes", thousandsOfTriangles, {{"culling_planes", false}}, 1e-4},
     {"thousands_plane_bias", thousandsOfTriangles, {{"plane_bias", 1e-6}}, 1e-4}, // no caster touches a receiver
     {"engine", engine, {}, 1e-4},
@@ -152,36 +168,44 @@ TEST_F(PtsvGLTest, ExplicitBoundsNeedFewerTestAndSets) {
 }
 
 // Pass one stops at the split depth; pass two's jobs then need few iterations each (Figure 7: the
-// largest jobs of the one-pass traversal take many times the average).
+// largest jobs of the one-pass traversal take many times the average). The default split: the
+// clusters' parents (paper) with cooperative jobs, the clusters themselves with one job per invocation.
 TEST_F(PtsvGLTest, TwoPassesSplitTheLargestJobs) {
     Shot s = fenceDiscontinuity();
-    Outcome one = run(s, {{"two_pass", false}, {"job_iterations", true}}, false);
-    Outcome two = run(s, {{"job_iterations", true}}, false);
-    std::printf("[ptsv] fence: largest job %.0f iterations in one pass (1024 largest: mean %.1f, all: %.2f); "
-                "two passes: %.0f / %.0f (1024 largest: %.1f / %.1f), %.0f jobs\n",
-                one.counters["iterations_max_pass1"], one.counters["iterations_top1024_mean_pass1"],
-                one.counters["iterations_mean_pass1"], two.counters["iterations_max_pass1"],
-                two.counters["iterations_max_pass2"], two.counters["iterations_top1024_mean_pass1"],
-                two.counters["iterations_top1024_mean_pass2"], two.counters["jobs"]);
-    EXPECT_GT(two.counters["jobs"], 0.0);
-    EXPECT_LT(two.counters["iterations_max_pass1"], one.counters["iterations_max_pass1"]);
-    EXPECT_LT(two.counters["iterations_max_pass2"], one.counters["iterations_max_pass1"]);
-    EXPECT_LT(two.counters["iterations_top1024_mean_pass2"], one.counters["iterations_top1024_mean_pass1"]);
-    EXPECT_GE(one.counters["iterations_top1024_mean_pass1"], one.counters["iterations_mean_pass1"]);
-    EXPECT_EQ(two.counters["split_depth"], two.counters["tree_levels"] - 1); // the default: level above the clusters
-    EXPECT_EQ(two.visibility, one.visibility);
+    for (const auto& traversal : {kCooperative, kPerInvocation}) {
+        SCOPED_TRACE(std::get<std::string>(traversal.second));
+        const bool cooperative = std::get<std::string>(traversal.second) == "cooperative";
+        Outcome one = run(s, {traversal, {"two_pass", false}, {"job_iterations", true}}, false);
+        Outcome two = run(s, {traversal, {"job_iterations", true}}, false);
+        std::printf("[ptsv] fence: largest job %.0f iterations in one pass (1024 largest: mean %.1f, all: %.2f); "
+                    "two passes: %.0f / %.0f (1024 largest: %.1f / %.1f), %.0f jobs\n",
+                    one.counters["iterations_max_pass1"], one.counters["iterations_top1024_mean_pass1"],
+                    one.counters["iterations_mean_pass1"], two.counters["iterations_max_pass1"],
+                    two.counters["iterations_max_pass2"], two.counters["iterations_top1024_mean_pass1"],
+                    two.counters["iterations_top1024_mean_pass2"], two.counters["jobs"]);
+        EXPECT_GT(two.counters["jobs"], 0.0);
+        EXPECT_LT(two.counters["iterations_max_pass1"], one.counters["iterations_max_pass1"]);
+        EXPECT_LT(two.counters["iterations_max_pass2"], one.counters["iterations_max_pass1"]);
+        EXPECT_LT(two.counters["iterations_top1024_mean_pass2"], one.counters["iterations_top1024_mean_pass1"]);
+        EXPECT_GE(one.counters["iterations_top1024_mean_pass1"], one.counters["iterations_mean_pass1"]);
+        EXPECT_EQ(two.counters["split_depth"], two.counters["tree_levels"] - (cooperative ? 1 : 0));
+        EXPECT_EQ(two.visibility, one.visibility);
+    }
 }
 
 // A job list of one entry overflows at once: every further job is finished by pass one, counted,
 // and the image stays exact.
 TEST_F(PtsvGLTest, TinyJobListOverflowsButStaysExact) {
-    Outcome o = run(thousandsOfTriangles(), {{"job_capacity", 1}});
-    std::printf("[ptsv] job_capacity 1: %.0f jobs overflowed, overflowCount %llu, mismatch %.5f%%\n",
-                o.counters["job_overflow"], (unsigned long long)o.overflow, 100 * o.accuracy.mismatchRatio);
-    EXPECT_GT(o.counters["job_overflow"], 100.0);
-    EXPECT_EQ(o.overflow, uint64_t(o.counters["job_overflow"]));
-    EXPECT_EQ(o.counters["jobs"], 1.0);
-    EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+    for (const auto& traversal : {kCooperative, kPerInvocation}) {
+        SCOPED_TRACE(std::get<std::string>(traversal.second));
+        Outcome o = run(thousandsOfTriangles(), {traversal, {"job_capacity", 1}});
+        std::printf("[ptsv] job_capacity 1: %.0f jobs overflowed, overflowCount %llu, mismatch %.5f%%\n",
+                    o.counters["job_overflow"], (unsigned long long)o.overflow, 100 * o.accuracy.mismatchRatio);
+        EXPECT_GT(o.counters["job_overflow"], 100.0);
+        EXPECT_EQ(o.overflow, uint64_t(o.counters["job_overflow"]));
+        EXPECT_EQ(o.counters["jobs"], 1.0);
+        EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+    }
 }
 
 // The heat map (Figure 3) counts exactly the test-and-set operations.
@@ -199,21 +223,30 @@ TEST_F(PtsvGLTest, HeatMapSumsToTheTestAndSetCount) {
 }
 
 // ARB_shader_ballot votes (one subgroup, 32 / width children per invocation; llvmpipe: 8 lanes × 4)
-// and shared-memory votes (32 lanes, a barrier per node) give the same image; the path is reported.
+// and shared-memory votes (32 lanes, a barrier per node) give the same image, and so does one job
+// per invocation (no votes); the path is reported.
 TEST_F(PtsvGLTest, VotePathsAgree) {
     const int width = querySubgroupSize();
     const bool ballotUsable = width == 4 || width == 8 || width == 16 || width == 32 || width == 64;
     Shot s = fenceDiscontinuity();
-    Outcome shared = run(s, {{"vote", std::string("shared")}}, false);
+    Outcome shared = run(s, {kCooperative, {"vote", std::string("shared")}}, false);
     EXPECT_EQ(shared.counters["vote_path"], 0.0);
     EXPECT_EQ(shared.counters["traversal_lanes"], 32.0);
-    Outcome autoVote = run(s, {}, false);
+    Outcome perInvocation = run(s, {kPerInvocation}, false);
+    EXPECT_EQ(perInvocation.counters["vote_path"], 2.0);
+    EXPECT_EQ(perInvocation.counters["traversal_lanes"], 1.0);
+    EXPECT_EQ(perInvocation.visibility, shared.visibility);
+    EXPECT_EQ(perInvocation.counters["receivers"], shared.counters["receivers"]);
+    // auto: cooperative on ballot subgroups of 32 lanes or more, else one job per invocation.
+    Outcome autoTraversal = run(s, {}, false);
+    EXPECT_EQ(autoTraversal.counters["vote_path"], ballotUsable && width >= 32 ? 1.0 : 2.0);
+    Outcome autoVote = run(s, {kCooperative}, false);
     EXPECT_EQ(autoVote.counters["vote_path"], ballotUsable ? 1.0 : 0.0);
     EXPECT_EQ(autoVote.counters["subgroup_size"], double(width));
     // Only a driver without ARB_shader_ballot (or with an unusual width) has no ballot path to
     // compare; llvmpipe, NVIDIA and AMD all have one.
     if (!ballotUsable) GTEST_SKIP() << "no usable ARB_shader_ballot (subgroup " << width << ")";
-    Outcome ballot = run(s, {{"vote", std::string("ballot")}}, false);
+    Outcome ballot = run(s, {kCooperative, {"vote", std::string("ballot")}}, false);
     EXPECT_EQ(ballot.counters["vote_path"], 1.0);
     EXPECT_EQ(ballot.counters["traversal_lanes"], double(width));
     EXPECT_EQ(ballot.counters["subgroup_mismatch_groups"], 0.0);
@@ -232,7 +265,7 @@ TEST_F(PtsvGLTest, SubgroupWidthMismatchIsReportedThenFallsBack) {
     const int width = querySubgroupSize();
     const bool ballot = width == 4 || width == 8 || width == 16 || width == 32 || width == 64;
     Shot s = thousandsOfTriangles();
-    Outcome base = run(s, {{"vote", std::string("shared")}});
+    Outcome base = run(s, {kCooperative, {"vote", std::string("shared")}});
     EXPECT_LE(base.accuracy.mismatchRatio, 1e-4);
     for (int lanes : {8, 16, 32, 64})
         for (const char* vote : {"auto", "shared"}) {
@@ -240,7 +273,7 @@ TEST_F(PtsvGLTest, SubgroupWidthMismatchIsReportedThenFallsBack) {
             const bool mismatch = ballot && std::string(vote) == "auto" && lanes != width;
             RunOptions first;
             first.withReference = false;
-            AlgorithmRun once = runAlgorithm(ptsvInfo(), s, {{"lanes", lanes}, {"vote", std::string(vote)}}, first);
+            AlgorithmRun once = runAlgorithm(ptsvInfo(), s, {kCooperative, {"lanes", lanes}, {"vote", std::string(vote)}}, first);
             if (mismatch) {
                 EXPECT_GT(once.counters["subgroup_mismatch_groups"], 0.0);
                 EXPECT_GE(once.overflow, uint64_t(once.counters["subgroup_mismatch_groups"])) << "reported as overflow";
@@ -251,7 +284,7 @@ TEST_F(PtsvGLTest, SubgroupWidthMismatchIsReportedThenFallsBack) {
             }
             RunOptions second;
             second.warmUp = true; // the frame after the one that met the mismatch
-            AlgorithmRun o = runAlgorithm(ptsvInfo(), s, {{"lanes", lanes}, {"vote", std::string(vote)}}, second);
+            AlgorithmRun o = runAlgorithm(ptsvInfo(), s, {kCooperative, {"lanes", lanes}, {"vote", std::string(vote)}}, second);
             EXPECT_EQ(o.counters["subgroup_fallback"], mismatch ? 1.0 : 0.0);
             EXPECT_EQ(o.counters["vote_path"], mismatch || std::string(vote) == "shared" || !ballot ? 0.0 : 1.0);
             EXPECT_EQ(o.counters["traversal_lanes"], double(lanes));

@@ -22,6 +22,7 @@ struct PtsvParams {
     float planeBias, rayOffset; ///< × scene radius
     std::string vote;        ///< "auto" | "ballot" | "shared"
     std::string leafSamples; ///< "tile" | "cluster"
+    std::string traversal;   ///< "auto" | "cooperative" | "invocation"
 };
 
 const ParamStruct<PtsvParams>& ptsvParams() {
@@ -39,7 +40,8 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  "two-pass traversal (paper 2.2): pass one stops at split_level and queues jobs, pass two finishes them",
                  ParamChange::Recompile)
         .integer("split_level", &P::splitLevel, 0, 0, PTSV_MAX_LEVELS, "tree depth",
-                 "depth L where pass one queues its jobs (root 0, clusters = levels); 0 = levels - 1",
+                 "depth L where pass one queues its jobs (root 0, clusters = levels); 0 = levels - 1 with "
+                 "cooperative traversal, levels (one cluster per job) with invocation traversal",
                  ParamChange::Update)
         .integer("tile_size", &P::tileSize, 8, 2, 16, "px", "cluster tile width and height (paper: 8)", ParamChange::Recompile)
         // 22 bits keep the full tree's explicit bounds under 100 MiB (the paper's 1024² needs 24:
@@ -67,6 +69,15 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  "consecutive jobs one traversal workgroup runs in turn (the paper's persistent threads run "
                  "until the queue is empty; bounded here by llvmpipe's per-invocation loop cap)",
                  ParamChange::Recompile)
+        // auto: on llvmpipe's 8-lane subgroups a cooperative job takes 4 rounds per node for about 9
+        // existing children; one job per invocation measured 2.5-3x faster on the peer engine scene
+        // (docs/algorithms/ptsv.md). Subgroups of 32 or more test a node in one round, the paper's case.
+        .choice("traversal", &P::traversal, "auto", {"auto", "cooperative", "invocation"},
+                "who walks a job: cooperative (paper: a subgroup per job, its lanes testing a node's 32 children "
+                "together, see vote and lanes), invocation (each invocation its own job, testing a node's "
+                "existing children in turn; no votes), auto (cooperative on ballot subgroups of 32 or more lanes, "
+                "else invocation)",
+                ParamChange::Recompile)
         .choice("vote", &P::vote, "auto", {"auto", "ballot", "shared"},
                 "how a node's 32 children are tested together: ballot (ARB_shader_ballot: one subgroup, each "
                 "invocation testing 32 / width children, no barrier), shared (32 invocations, shared memory and a "
@@ -94,7 +105,7 @@ constexpr GLuint kSetupGroup = 64;   ///< local_size_x of setup.comp and reduce.
 constexpr GLuint kMaxGroups = 65535; ///< GL's minimum max work group count per dimension
 
 /// Vote paths (PTSV_BALLOT in traverse.comp), reported as the `vote_path` counter.
-enum Vote { kVoteShared = 0, kVoteBallot = 1 };
+enum Vote { kVoteShared = 0, kVoteBallot = 1, kVoteNone = 2 /* traversal = invocation */ };
 
 class Ptsv final : public ShadowAlgorithm {
 public:
@@ -150,6 +161,9 @@ public:
         glBindTextureUnit(1, f.gbuffer.normal());
         hierarchy_.use();
         glDispatchCompute(GLuint(layout_.tilesX), GLuint(layout_.tilesY), 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        clusters_.use();
+        glDispatchCompute(GLuint(layout_.tilesX), GLuint(layout_.tilesY), 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         for (int d = layout_.levels - 1; d >= 1; --d) {
             const size_t count = layout_.nodesAt(d);
@@ -172,12 +186,8 @@ public:
 
         f.timer.begin("traverse");
         if (n > 0) {
-            glBindTextureUnit(PTSV_BOUNDS_UNIT, boundsTexels_.id());
-            glBindTextureUnit(PTSV_SAMPLE_UNIT, sampleTexels_.id());
-            glBindTextureUnit(PTSV_KEY_UNIT, keyTexels_.id());
-            glBindTextureUnit(PTSV_PLANE_UNIT, planeTexels_.id());
             // One workgroup per batch of triangles, as a 2D grid past 65535.
-            const size_t perGroup = size_t(p_.jobsPerWorkgroup);
+            const size_t perGroup = perInvocation_ ? size_t(PTSV_INVOCATION_GROUP) : size_t(p_.jobsPerWorkgroup);
             const size_t groups = (n + perGroup - 1) / perGroup;
             const GLuint gx = GLuint(std::min<size_t>(groups, kMaxGroups)), gy = GLuint((groups + gx - 1) / gx);
             pass1_.use();
@@ -191,8 +201,9 @@ public:
                 pass2_.use();
                 glDispatchComputeIndirect(GLintptr(PTSV_C_DISPATCH * sizeof(uint32_t)));
                 glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
-                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
             }
+            // The resolve pass reads the shadow marks and the masks through buffer textures.
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         }
         f.timer.end();
 
@@ -291,7 +302,10 @@ private:
 
     int splitDepth() const {
         const int l = p_.splitLevel;
-        return l == 0 ? std::max(1, layout_.levels - 1) : std::min(l, layout_.levels);
+        // 0: the parents of the clusters (paper), or the clusters themselves with one job per
+        // invocation (on the peer engine scene 512², 220 against 253 ms of traversal).
+        if (l == 0) return perInvocation_ ? layout_.levels : std::max(1, layout_.levels - 1);
+        return std::min(l, layout_.levels);
     }
 
     void compile() {
@@ -306,8 +320,10 @@ private:
         if (vote == "ballot" && !ballotUsable)
             throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width of 4, 8, 16, 32 or "
                                "64 (this context: " + std::to_string(subgroupSize_) + ")");
-        vote_ = vote != "shared" && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
-        lanes_ = p_.lanes != 0 ? p_.lanes : vote_ == kVoteBallot ? subgroupSize_ : 32;
+        perInvocation_ = p_.traversal == "invocation" ||
+                         (p_.traversal == "auto" && !(ballotUsable && subgroupSize_ >= 32));
+        vote_ = perInvocation_ ? kVoteNone : vote != "shared" && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
+        lanes_ = perInvocation_ ? 1 : p_.lanes != 0 ? p_.lanes : vote_ == kVoteBallot ? subgroupSize_ : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
         ShaderDefines defines = {instrumentationDefine(options_),
                                  {"PTSV_TILE", std::to_string(p_.tileSize)},
@@ -318,10 +334,12 @@ private:
                                  {"PTSV_LEAF_CLUSTER_ONLY", flag(p_.leafSamples == "cluster")},
                                  {"PTSV_HEAT_MAP", flag(p_.heatMap)},
                                  {"PTSV_JOB_ITERATIONS", flag(p_.jobIterations)},
+                                 {"PTSV_PER_INVOCATION", flag(perInvocation_)},
                                  {"PTSV_BALLOT", flag(vote_ == kVoteBallot)},
                                  {"PTSV_LANES", std::to_string(lanes_)},
                                  {"PTSV_JOBS_PER_GROUP", std::to_string(p_.jobsPerWorkgroup)}};
         hierarchy_ = ShaderProgram::compute("ptsv/hierarchy.comp", defines);
+        clusters_ = ShaderProgram::compute("ptsv/clusters.comp", defines);
         reduce_ = ShaderProgram::compute("ptsv/reduce.comp", defines);
         setup_ = ShaderProgram::compute("ptsv/setup.comp", defines);
         resolve_ = ShaderProgram::compute("ptsv/resolve.comp", defines);
@@ -364,6 +382,8 @@ private:
         boundsTexels_ = makeBufferTexture(bounds_, GL_RGB32F, 12, "ptsv bounds");
         sampleTexels_ = makeBufferTexture(samples_, GL_RGBA32F, 16, "ptsv samples");
         keyTexels_ = makeBufferTexture(keys_, GL_R32UI, 4, "ptsv keys");
+        maskTexels_ = makeBufferTexture(masks_, GL_R32UI, 4, "ptsv masks");
+        shadowTexels_ = makeBufferTexture(shadow_, GL_R32UI, 4, "ptsv shadow marks");
         warnedSplit_ = false;
     }
 
@@ -387,7 +407,7 @@ private:
                          p_.splitLevel, layout_.levels, split);
             warnedSplit_ = true;
         }
-        for (const ShaderProgram* p : {&hierarchy_, &reduce_, &setup_, &pass1_, &pass2_, &jobArgs_, &resolve_}) {
+        for (const ShaderProgram* p : {&hierarchy_, &clusters_, &reduce_, &setup_, &pass1_, &pass2_, &jobArgs_, &resolve_}) {
             setLightUniforms(*p, light);
             p->set("uResolution", resolution_);
             p->set("uTile", layout_.tile);
@@ -431,6 +451,14 @@ private:
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_COUNTER_BINDING);
         jobIterations_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_JOB_ITER_BINDING);
         heatCounts_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_HEAT_BINDING);
+        // Views of what a pass reads but does not write (each writer's barrier includes the
+        // texture-fetch bit).
+        glBindTextureUnit(PTSV_BOUNDS_UNIT, boundsTexels_.id());
+        glBindTextureUnit(PTSV_SAMPLE_UNIT, sampleTexels_.id());
+        glBindTextureUnit(PTSV_KEY_UNIT, keyTexels_.id());
+        glBindTextureUnit(PTSV_PLANE_UNIT, planeTexels_.id());
+        glBindTextureUnit(PTSV_MASK_UNIT, maskTexels_.id());
+        glBindTextureUnit(PTSV_SHADOW_UNIT, shadowTexels_.id());
     }
 
     /// One invocation per item, as a 2D grid when the count needs more than 65535 groups of 64.
@@ -442,14 +470,15 @@ private:
     glm::ivec2 resolution_{0, 0};
     int subgroupSize_ = 0;
     Vote vote_ = kVoteShared;
-    int lanes_ = 32; ///< invocations per traversal workgroup
+    int lanes_ = 32; ///< invocations per traversal job (1 with traversal = invocation)
+    bool perInvocation_ = false; ///< traversal = invocation
     bool fellBack_ = false; ///< ballots met subgroups of another width: shared votes from then on
     ptsv::KeyLayout layout_;
     std::array<float, 6> layoutKey_{};
     bool warnedSplit_ = false;
-    ShaderProgram hierarchy_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
+    ShaderProgram hierarchy_, clusters_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
     GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
-    GlTexture boundsTexels_, sampleTexels_, keyTexels_, planeTexels_; ///< the traversal's views of those buffers
+    GlTexture boundsTexels_, sampleTexels_, keyTexels_, planeTexels_, maskTexels_, shadowTexels_; ///< read-only views of those buffers
     GpuCounters<PTSV_COUNTER_WORDS> counters_;
     GlTexture heat_;
 };

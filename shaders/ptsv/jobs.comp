@@ -10,7 +10,12 @@ uniform uint uJobCapacity;
 
 void main() {
     uint count = min(ptsvCounters[PTSV_C_JOBS_PUSHED], uJobCapacity);
-    uint groups = (count + uint(PTSV_JOBS_PER_GROUP) - 1u) / uint(PTSV_JOBS_PER_GROUP);
+#if PTSV_PER_INVOCATION
+    const uint perGroup = uint(PTSV_INVOCATION_GROUP); // one job per invocation
+#else
+    const uint perGroup = uint(PTSV_JOBS_PER_GROUP);   // a batch per workgroup
+#endif
+    uint groups = (count + perGroup - 1u) / perGroup;
     uint gx = min(groups, 65535u);
     ptsvCounters[PTSV_C_DISPATCH] = gx;
     ptsvCounters[PTSV_C_DISPATCH + 1] = gx == 0u ? 0u : (groups + gx - 1u) / gx;

@@ -20,6 +20,11 @@
 #define PTSV_SAMPLE_UNIT 3
 #define PTSV_KEY_UNIT 4
 #define PTSV_PLANE_UNIT 5
+#define PTSV_MASK_UNIT 6   // child masks (R32UI)
+#define PTSV_SHADOW_UNIT 7 // shadow marks (R32UI), read by the resolve pass
+
+// Traversal workgroup size with traversal = invocation (one job per invocation).
+#define PTSV_INVOCATION_GROUP 64
 
 // A tree has at most this many levels of child masks (32-bit keys, 5 bits per level).
 #define PTSV_MAX_LEVELS 7

@@ -80,6 +80,13 @@ layout(binding = PTSV_BOUNDS_UNIT) uniform samplerBuffer uPtsvBoundsTexels;
 layout(binding = PTSV_SAMPLE_UNIT) uniform samplerBuffer uPtsvSampleTexels;
 layout(binding = PTSV_KEY_UNIT) uniform usamplerBuffer uPtsvKeyTexels;
 layout(binding = PTSV_PLANE_UNIT) uniform samplerBuffer uPtsvPlaneTexels;
+layout(binding = PTSV_MASK_UNIT) uniform usamplerBuffer uPtsvMaskTexels;
+layout(binding = PTSV_SHADOW_UNIT) uniform usamplerBuffer uPtsvShadowTexels; // resolve.comp only
+uint ptsvShadowAt(uint slot) { return texelFetch(uPtsvShadowTexels, int(slot)).x; }
+// A child mask as the hierarchy built it, or with bits that trivial accepts have cleared since
+// (atomicAnd on the storage buffer): a fetch may miss those clears, which only sends the
+// traversal into a subtree whose samples are already shadowed.
+uint ptsvMaskAt(uint word) { return texelFetch(uPtsvMaskTexels, int(word)).x; }
 vec4 ptsvPlane(uint triangle, uint i) { return texelFetch(uPtsvPlaneTexels, int(PTSV_PLANES_PER_TRIANGLE * triangle + i)); }
 uint ptsvKeyAt(uint slot) { return texelFetch(uPtsvKeyTexels, int(slot)).x; }
 vec3 ptsvSampleAt(uint slot) { return texelFetch(uPtsvSampleTexels, int(slot)).xyz; }
@@ -89,6 +96,8 @@ void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
 }
 #else
 vec4 ptsvPlane(uint triangle, uint i) { return ptsvPlanes[PTSV_PLANES_PER_TRIANGLE * triangle + i]; }
+uint ptsvMaskAt(uint word) { return ptsvMasks[word]; }
+uint ptsvShadowAt(uint slot) { return ptsvShadow[slot]; }
 uint ptsvKeyAt(uint slot) { return ptsvKeys[slot]; }
 vec3 ptsvSampleAt(uint slot) { return ptsvSamples[slot].xyz; }
 void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {

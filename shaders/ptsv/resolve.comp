@@ -4,6 +4,7 @@
 // its bit in its parent's mask: that node was trivially accepted by some triangle's volume.
 #include "common/light.glsl"
 #include "common/scene.glsl"
+#define PTSV_TEXEL_READS 1
 #include "ptsv/ptsv.glsl"
 layout(local_size_x = PTSV_TILE, local_size_y = PTSV_TILE) in;
 
@@ -19,14 +20,14 @@ void main() {
     uint tile = gl_WorkGroupID.y * uint(uTilesX) + gl_WorkGroupID.x;
     uint slot = tile * ptsvTileSamples() + gl_LocalInvocationIndex;
     if (all(lessThan(px, uResolution))) {
-        uint key = ptsvKeys[slot];
+        uint key = ptsvKeyAt(slot);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)
         if (key == PTSV_KEY_AWAY) {
             visibility = 0.0;
         } else if (key != PTSV_KEY_BACKGROUND) {
-            bool shadowed = ptsvShadow[slot] != 0u;
+            bool shadowed = ptsvShadowAt(slot) != 0u;
             for (int d = 0; d < uLevels && !shadowed; ++d) {
-                uint word = ptsvMasks[uMaskOffset[d] + (key >> uint(5 * (uLevels - d)))];
+                uint word = ptsvMaskAt(uMaskOffset[d] + (key >> uint(5 * (uLevels - d))));
                 shadowed = ((word >> ((key >> uint(5 * (uLevels - 1 - d))) & 31u)) & 1u) == 0u;
             }
             visibility = shadowed ? 0.0 : 1.0;

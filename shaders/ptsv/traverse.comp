@@ -29,7 +29,7 @@
 // caps the loop iterations of one invocation at 65535 in total, so here a workgroup takes a fixed
 // batch of PTSV_JOBS_PER_GROUP consecutive jobs and the hardware scheduler hands out the batches;
 // a job cut short by such a cap is detected (a loop left without its exit condition) and reported.
-#if PTSV_BALLOT
+#if PTSV_BALLOT && !PTSV_PER_INVOCATION
 #extension GL_ARB_shader_ballot : require
 #extension GL_ARB_gpu_shader_int64 : require
 #endif
@@ -38,10 +38,20 @@
 #include "common/counters.glsl"
 #define PTSV_TEXEL_READS 1
 #include "ptsv/ptsv.glsl"
+#if PTSV_PER_INVOCATION
+// Every invocation walks a job of its own: no votes, and no subgroup width to depend on.
+layout(local_size_x = PTSV_INVOCATION_GROUP) in;
+#define lane 0u
+#define LEADER true
+#define SAMPLE_STEP 1u
+#else
 layout(local_size_x = PTSV_LANES) in;
 #define lane gl_LocalInvocationIndex
+#define LEADER (lane == 0u)
+#define SAMPLE_STEP uint(PTSV_LANES)
 #if PTSV_LANES != 4 && PTSV_LANES != 8 && PTSV_LANES != 16 && PTSV_LANES != 32 && PTSV_LANES != 64
 #error "PTSV_LANES must be 4, 8, 16, 32 or 64"
+#endif
 #endif
 #define ROUNDS (PTSV_LANES == 64 ? 1u : 32u / uint(PTSV_LANES)) // children tested by each invocation per node
 
@@ -53,6 +63,7 @@ uniform float uImplicitPad; // world units: how far a sample's q may lie outside
 uniform mat4 uInvView;      // view → world (implicit bounds test in view space)
 
 // ---- Votes ---------------------------------------------------------------------------------------
+#if !PTSV_PER_INVOCATION // (a per-invocation job votes with no one)
 #if !PTSV_BALLOT
 // Three slots: slot i % 3 is written in vote i, read after its barrier, and cleared by invocation 0
 // after the barrier of vote i + 1 (when every invocation has read it), two votes before its reuse.
@@ -105,6 +116,8 @@ uint broadcast(uint v) {
     return r;
 #endif
 }
+
+#endif // !PTSV_PER_INVOCATION
 
 // ---- One job -------------------------------------------------------------------------------------
 const vec4 kZero7[7] = vec4[7](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
@@ -184,7 +197,7 @@ void testSamples(uint key) {
     ptsvNodeRange(key, uLevels, lo, hi);
     uint first = (lo.y * uint(uTilesX) + lo.x) * ptsvTileSamples();
     uint s = lane;
-    for (; s < ptsvTileSamples(); s += uint(PTSV_LANES)) {
+    for (; s < ptsvTileSamples(); s += SAMPLE_STEP) {
         uint k = ptsvKeyAt(first + s);
 #if PTSV_LEAF_CLUSTER_ONLY
         if (k != key) continue;
@@ -199,16 +212,24 @@ void testSamples(uint key) {
             ptsvShadow[first + s] = 1u;
     }
     if (s < ptsvTileSamples()) gTruncated = true;
-    if (lane == 0u) ++gLeafVisits;
+    if (LEADER) ++gLeafVisits;
 }
 
 // Tests the children of node (depth, id); returns the intersected ones, clears the accepted ones.
 uint visit(int depth, uint id) {
     ++gIterations;
     uint maskIndex = uMaskOffset[depth] + id;
-    uint mask = ptsvMasks[maskIndex];
+    uint mask = ptsvMaskAt(maskIndex);
     uvec2 v = uvec2(0u);
-#if PTSV_LANES == 64
+#if PTSV_PER_INVOCATION
+    // The existing children in turn (about 9 of 32 on the peer scene).
+    for (uint m = mask; m != 0u; m &= m - 1u) {
+        uint c = uint(findLSB(m));
+        bvec2 r = classify(id * 32u + c, depth + 1);
+        ++gNodeTests;
+        if (!r.x) v |= (r.y ? uvec2(0u, 1u) : uvec2(1u, 0u)) << c;
+    }
+#elif PTSV_LANES == 64
     uint c = lane & 31u, side = lane >> 5u;
     bool exists = ((mask >> c) & 1u) != 0u;
     bvec3 r = exists ? classifyHalf(id * 32u + c, depth + 1, side) : bvec3(true, false, false);
@@ -230,37 +251,42 @@ uint visit(int depth, uint id) {
         v |= vote2(!r.x && !r.y, r.y) << (round * uint(PTSV_LANES));
     }
 #endif
-    if (v.y != 0u && lane == 0u) {
+    if (v.y != 0u && LEADER) {
         atomicAnd(ptsvMasks[maskIndex], ~v.y);
         gAccepted += uint(bitCount(v.y));
     }
     return v.x;
 }
 
-// Depth-first walk below node (depth, id). Entry d of the stack holds the node visited at depth d
-// and its intersected children still to visit; every invocation keeps the same stack.
+// Depth-first walk below node (depth, id). Entry d of the stack holds the intersected children
+// still to visit of the node on the path at depth d; every invocation of a job keeps the same stack.
 void traverse(int depth, uint id) {
-    uint stackId[PTSV_MAX_LEVELS];
     uint stackMask[PTSV_MAX_LEVELS];
     int top = depth;
-    stackId[top] = id;
+    uint node = id; // visited at depth top; node ids are key prefixes, so its parent is node >> 5
     stackMask[top] = visit(depth, id);
     while (true) {
-        while (top >= depth && stackMask[top] == 0u) --top; // deepest level with children left
+        while (top >= depth && stackMask[top] == 0u) { // deepest level with children left
+            --top;
+            node >>= 5u;
+        }
         if (top < depth) break;
         int c = findLSB(stackMask[top]);
         stackMask[top] &= stackMask[top] - 1u;
-        uint childId = stackId[top] * 32u + uint(c);
+        uint childId = node * 32u + uint(c);
         int childDepth = top + 1;
 #if PTSV_PASS == 1 && PTSV_TWO_PASS
         if (childDepth == uSplitDepth) {
             uint slot = 0u;
-            if (lane == 0u) {
+            if (LEADER) {
                 slot = atomicAdd(ptsvCounters[PTSV_C_JOBS_PUSHED], 1u);
                 if (slot < uJobCapacity) ptsvJobs[slot] = uvec2(gTriangle, childId);
                 else atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], 1u);
             }
-            if (broadcast(slot) < uJobCapacity) continue; // pass two finishes it
+#if !PTSV_PER_INVOCATION
+            slot = broadcast(slot);
+#endif
+            if (slot < uJobCapacity) continue; // pass two finishes it
             // The list is full: finish this subtree here, exactly as the one-pass traversal would.
         }
 #endif
@@ -269,7 +295,7 @@ void traverse(int depth, uint id) {
             continue;
         }
         top = childDepth;
-        stackId[top] = childId;
+        node = childId;
         stackMask[top] = visit(childDepth, childId);
     }
     if (top >= depth) gTruncated = true;
@@ -289,7 +315,7 @@ void loadTriangle(uint t) {
 // and added with three atomics per workgroup at its end, not per job; compiled out in timing mode.
 void finishJob(uint job) {
 #if SHADOWLAB_INSTRUMENTATION
-    if (lane != 0u) return;
+    if (!LEADER) return;
 #if PTSV_JOB_ITERATIONS
     ptsvJobIterations[PTSV_PASS == 1 ? job : uTriangleCount + job] = gIterations;
 #endif
@@ -299,14 +325,35 @@ void finishJob(uint job) {
 #endif // SHADOWLAB_INSTRUMENTATION
 }
 
+// Job `job` from the start (pass one: a triangle from the root) or from its node (pass two).
+void runJob(uint job) {
+    gIterations = 0u;
+#if PTSV_PASS == 1
+    if (ptsvStatus(job) != PTSV_CASTER_OK) return;
+    loadTriangle(job);
+    traverse(0, 0u);
+#else
+    uvec2 pair = ptsvJobs[job];
+    loadTriangle(pair.x);
+    if (uSplitDepth == uLevels) testSamples(pair.y); // the job is a leaf cluster
+    else traverse(uSplitDepth, pair.y);
+#endif
+    finishJob(job);
+}
+
 void main() {
-    // Each workgroup takes PTSV_JOBS_PER_GROUP consecutive jobs (2D grid past 65535 groups).
     uint group = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
 #if PTSV_PASS == 1
     uint count = uTriangleCount;
 #else
     uint count = min(ptsvCounters[PTSV_C_JOBS_PUSHED], uJobCapacity);
 #endif
+#if PTSV_PER_INVOCATION
+    // One job per invocation (2D grid past 65535 groups).
+    uint job = group * uint(PTSV_INVOCATION_GROUP) + gl_LocalInvocationIndex;
+    if (job < count) runJob(job);
+#else
+    // Each workgroup takes PTSV_JOBS_PER_GROUP consecutive jobs (2D grid past 65535 groups).
 #if PTSV_BALLOT
     // Ballots only see one subgroup: the workgroup must be exactly one (see the top).
     if (gl_SubGroupSizeARB != uint(PTSV_LANES)) {
@@ -320,26 +367,16 @@ void main() {
     for (uint k = 0u; k < uint(PTSV_JOBS_PER_GROUP); ++k) {
         uint job = group * uint(PTSV_JOBS_PER_GROUP) + k;
         if (job >= count) break; // the same for the whole workgroup
-        gIterations = 0u;
-#if PTSV_PASS == 1
-        if (ptsvStatus(job) != PTSV_CASTER_OK) continue;
-        loadTriangle(job);
-        traverse(0, 0u);
-#else
-        uvec2 pair = ptsvJobs[job];
-        loadTriangle(pair.x);
-        if (uSplitDepth == uLevels) testSamples(pair.y); // the job is a leaf cluster
-        else traverse(uSplitDepth, pair.y);
-#endif
-        finishJob(job);
+        runJob(job);
     }
+#endif
     // Totals (no barrier: one atomic per invocation that has something to add). Truncation is
     // an error, counted in both modes.
     if (gTruncated) atomicAdd(ptsvCounters[PTSV_C_TRUNCATED], 1u);
 #if SHADOWLAB_INSTRUMENTATION
     if (gTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_TESTS_LO, gTests)
     if (gNodeTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_NODE_TESTS_LO, gNodeTests)
-    if (lane == 0u) {
+    if (LEADER) {
         if (gAccepted != 0u) atomicAdd(ptsvCounters[PTSV_C_ACCEPTED], gAccepted);
         if (gLeafVisits != 0u) atomicAdd(ptsvCounters[PTSV_C_LEAF_VISITS], gLeafVisits);
         if (gJobs != 0u) { // the batch's per-job statistics, three atomics per workgroup
