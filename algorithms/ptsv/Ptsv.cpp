@@ -60,23 +60,30 @@ const ParamStruct<PtsvParams>& ptsvParams() {
               "triangle plane moved away from the light when front faces cast (paper 2), against self-shadowing",
               ParamChange::Update)
         .apply(rayOffsetRow(&P::rayOffset))
-        .integer("job_capacity", &P::jobCapacity, 1 << 20, 1, 1 << 24, "jobs",
+        // 4 Mi jobs (32 MiB): with one cluster per job (the invocation traversal's split) the peer engine
+        // scene queues up to 0.54 M at 1024², and without culling planes over 1.9 M at 512².
+        .integer("job_capacity", &P::jobCapacity, 1 << 22, 1, 1 << 24, "jobs",
                  "two-pass job list; jobs that find it full are finished by pass one (counted in overflow)",
                  ParamChange::Rebuild)
-        // 16 by default: on the peer engine scene (512², timing mode) 1240 / 1432 ms per frame
-        // against 1658 / 1592 with 1 and 1363 / 1683 with 64 (docs/algorithms/ptsv.md).
-        .integer("jobs_per_workgroup", &P::jobsPerWorkgroup, 16, 1, 64, "jobs",
-                 "consecutive jobs one traversal workgroup runs in turn (the paper's persistent threads run "
-                 "until the queue is empty; bounded here by llvmpipe's per-invocation loop cap)",
+        // 0 = 16 with two passes: on the peer engine scene (512², timing mode) 1240 / 1432 ms per
+        // frame against 1658 / 1592 with 1 and 1363 / 1683 with 64 (docs/algorithms/ptsv.md); 1 with
+        // one pass: a batch of 16 whole traversals in one invocation reached llvmpipe's loop cap on
+        // configs/ptsv/engine.json's implicit-bounds steps (up to 11,760 truncated jobs a frame).
+        .integer("jobs_per_workgroup", &P::jobsPerWorkgroup, 0, 0, 64, "jobs",
+                 "consecutive jobs one cooperative traversal workgroup runs in turn (the paper's persistent "
+                 "threads run until the queue is empty; bounded here by llvmpipe's per-invocation loop cap); "
+                 "0 = 16 with two passes, 1 with one",
                  ParamChange::Recompile)
         // auto: on llvmpipe's 8-lane subgroups a cooperative job takes 4 rounds per node for about 9
         // existing children; one job per invocation measured 2.5-3x faster on the peer engine scene
-        // (docs/algorithms/ptsv.md). Subgroups of 32 or more test a node in one round, the paper's case.
+        // (docs/algorithms/ptsv.md). Subgroups of 32 or more test a node in one round, the paper's
+        // case. One pass stays cooperative: a large triangle's whole traversal in one invocation can
+        // reach llvmpipe's loop cap (configs/ptsv/engine.json's implicit-bounds rows did).
         .choice("traversal", &P::traversal, "auto", {"auto", "cooperative", "invocation"},
                 "who walks a job: cooperative (paper: a subgroup per job, its lanes testing a node's 32 children "
                 "together, see vote and lanes), invocation (each invocation its own job, testing a node's "
-                "existing children in turn; no votes), auto (cooperative on ballot subgroups of 32 or more lanes, "
-                "else invocation)",
+                "existing children in turn; no votes), auto (invocation with two passes on subgroups narrower than 32 "
+                "lanes, else cooperative)",
                 ParamChange::Recompile)
         .choice("vote", &P::vote, "auto", {"auto", "ballot", "shared"},
                 "how a node's 32 children are tested together: ballot (ARB_shader_ballot: one subgroup, each "
@@ -187,7 +194,7 @@ public:
         f.timer.begin("traverse");
         if (n > 0) {
             // One workgroup per batch of triangles, as a 2D grid past 65535.
-            const size_t perGroup = perInvocation_ ? size_t(PTSV_INVOCATION_GROUP) : size_t(p_.jobsPerWorkgroup);
+            const size_t perGroup = perInvocation_ ? size_t(PTSV_INVOCATION_GROUP) : size_t(jobsPerWorkgroup());
             const size_t groups = (n + perGroup - 1) / perGroup;
             const GLuint gx = GLuint(std::min<size_t>(groups, kMaxGroups)), gy = GLuint((groups + gx - 1) / gx);
             pass1_.use();
@@ -300,6 +307,8 @@ private:
         p_.jobIterations = false;
     }
 
+    int jobsPerWorkgroup() const { return p_.jobsPerWorkgroup != 0 ? p_.jobsPerWorkgroup : p_.twoPass ? 16 : 1; }
+
     int splitDepth() const {
         const int l = p_.splitLevel;
         // 0: the parents of the clusters (paper), or the clusters themselves with one job per
@@ -321,7 +330,7 @@ private:
             throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width of 4, 8, 16, 32 or "
                                "64 (this context: " + std::to_string(subgroupSize_) + ")");
         perInvocation_ = p_.traversal == "invocation" ||
-                         (p_.traversal == "auto" && !(ballotUsable && subgroupSize_ >= 32));
+                         (p_.traversal == "auto" && p_.twoPass && !(ballotUsable && subgroupSize_ >= 32));
         vote_ = perInvocation_ ? kVoteNone : vote != "shared" && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
         lanes_ = perInvocation_ ? 1 : p_.lanes != 0 ? p_.lanes : vote_ == kVoteBallot ? subgroupSize_ : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
@@ -337,7 +346,7 @@ private:
                                  {"PTSV_PER_INVOCATION", flag(perInvocation_)},
                                  {"PTSV_BALLOT", flag(vote_ == kVoteBallot)},
                                  {"PTSV_LANES", std::to_string(lanes_)},
-                                 {"PTSV_JOBS_PER_GROUP", std::to_string(p_.jobsPerWorkgroup)}};
+                                 {"PTSV_JOBS_PER_GROUP", std::to_string(jobsPerWorkgroup())}};
         hierarchy_ = ShaderProgram::compute("ptsv/hierarchy.comp", defines);
         clusters_ = ShaderProgram::compute("ptsv/clusters.comp", defines);
         reduce_ = ShaderProgram::compute("ptsv/reduce.comp", defines);
