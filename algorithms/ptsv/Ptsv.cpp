@@ -389,7 +389,7 @@ private:
         // Zero-filled: a culled triangle (no workgroup writes its slot) counts 0 iterations.
         jobIterations_ = GlBuffer(p_.jobIterations ? std::max<size_t>(jobSlots, 1) * 4 : 4, nullptr, 0);
         boundsTexels_ = makeBufferTexture(bounds_, GL_RGB32F, 12, "ptsv bounds");
-        sampleTexels_ = makeBufferTexture(samples_, GL_RGBA32F, 16, "ptsv samples");
+        sampleTexels_ = makeBufferTexture(samples_, GL_RGBA32UI, 16, "ptsv samples");
         keyTexels_ = makeBufferTexture(keys_, GL_R32UI, 4, "ptsv keys");
         maskTexels_ = makeBufferTexture(masks_, GL_R32UI, 4, "ptsv masks");
         shadowTexels_ = makeBufferTexture(shadow_, GL_R32UI, 4, "ptsv shadow marks");

@@ -35,7 +35,7 @@ void main() {
         }
     }
     ptsvKeys[slot] = key;
-    ptsvSamples[slot] = vec4(q, 1.0);
+    ptsvSamples[slot] = uvec4(floatBitsToUint(q), key);
     ptsvShadow[slot] = 0u;
 #if PTSV_HEAT_MAP
     ptsvHeat[slot] = 0u;

@@ -5,7 +5,7 @@
 // SSBO binding points (0..2 are the scene buffers of shaders/common/scene.glsl).
 #define PTSV_MASK_BINDING 3    // child masks of every tree level, one 32-bit word per node
 #define PTSV_AABB_BINDING 4    // explicit bounds: 6 floats (min xyz, max xyz) per node below the root
-#define PTSV_SAMPLE_BINDING 5  // per view sample (tile-major): shadow-ray origin q, xyz
+#define PTSV_SAMPLE_BINDING 5  // per view sample (tile-major): shadow-ray origin q (float bits, xyz) and key (w)
 #define PTSV_KEY_BINDING 6     // per view sample (tile-major): cluster key or PTSV_KEY_*
 #define PTSV_SHADOW_BINDING 7  // per view sample (tile-major): 1 once a test-and-set found it shadowed
 #define PTSV_PLANE_BINDING 8   // per triangle: PTSV_PLANES_PER_TRIANGLE vec4

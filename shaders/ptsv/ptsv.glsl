@@ -6,7 +6,8 @@
 
 layout(std430, binding = PTSV_MASK_BINDING) coherent buffer PtsvMasks { uint ptsvMasks[]; };
 layout(std430, binding = PTSV_AABB_BINDING) buffer PtsvBounds { float ptsvBounds[]; };
-layout(std430, binding = PTSV_SAMPLE_BINDING) buffer PtsvSamples { vec4 ptsvSamples[]; };
+// A sample slot: q's bits in xyz and the cluster key in w, so a leaf test reads one texel per slot.
+layout(std430, binding = PTSV_SAMPLE_BINDING) buffer PtsvSamples { uvec4 ptsvSamples[]; };
 layout(std430, binding = PTSV_KEY_BINDING) buffer PtsvKeys { uint ptsvKeys[]; };
 layout(std430, binding = PTSV_SHADOW_BINDING) buffer PtsvShadow { uint ptsvShadow[]; };
 layout(std430, binding = PTSV_PLANE_BINDING) buffer PtsvPlanes { vec4 ptsvPlanes[]; };
@@ -77,7 +78,7 @@ float ptsvSigned(vec4 plane, vec3 x) {
 // the PTSV_*_UNIT units): a SIMD CPU back end (llvmpipe) gathers texel fetches for all its lanes at
 // once but loads storage buffers lane by lane; a GPU reads both through its caches.
 layout(binding = PTSV_BOUNDS_UNIT) uniform samplerBuffer uPtsvBoundsTexels;
-layout(binding = PTSV_SAMPLE_UNIT) uniform samplerBuffer uPtsvSampleTexels;
+layout(binding = PTSV_SAMPLE_UNIT) uniform usamplerBuffer uPtsvSampleTexels;
 layout(binding = PTSV_KEY_UNIT) uniform usamplerBuffer uPtsvKeyTexels;
 layout(binding = PTSV_PLANE_UNIT) uniform samplerBuffer uPtsvPlaneTexels;
 layout(binding = PTSV_MASK_UNIT) uniform usamplerBuffer uPtsvMaskTexels;
@@ -89,7 +90,7 @@ uint ptsvShadowAt(uint slot) { return texelFetch(uPtsvShadowTexels, int(slot)).x
 uint ptsvMaskAt(uint word) { return texelFetch(uPtsvMaskTexels, int(word)).x; }
 vec4 ptsvPlane(uint triangle, uint i) { return texelFetch(uPtsvPlaneTexels, int(PTSV_PLANES_PER_TRIANGLE * triangle + i)); }
 uint ptsvKeyAt(uint slot) { return texelFetch(uPtsvKeyTexels, int(slot)).x; }
-vec3 ptsvSampleAt(uint slot) { return texelFetch(uPtsvSampleTexels, int(slot)).xyz; }
+uvec4 ptsvSlotAt(uint slot) { return texelFetch(uPtsvSampleTexels, int(slot)); }
 void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
     bmin = texelFetch(uPtsvBoundsTexels, int(2u * node)).xyz;
     bmax = texelFetch(uPtsvBoundsTexels, int(2u * node + 1u)).xyz;
@@ -99,13 +100,15 @@ vec4 ptsvPlane(uint triangle, uint i) { return ptsvPlanes[PTSV_PLANES_PER_TRIANG
 uint ptsvMaskAt(uint word) { return ptsvMasks[word]; }
 uint ptsvShadowAt(uint slot) { return ptsvShadow[slot]; }
 uint ptsvKeyAt(uint slot) { return ptsvKeys[slot]; }
-vec3 ptsvSampleAt(uint slot) { return ptsvSamples[slot].xyz; }
+uvec4 ptsvSlotAt(uint slot) { return ptsvSamples[slot]; }
 void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
     uint b = 6u * node;
     bmin = vec3(ptsvBounds[b], ptsvBounds[b + 1u], ptsvBounds[b + 2u]);
     bmax = vec3(ptsvBounds[b + 3u], ptsvBounds[b + 4u], ptsvBounds[b + 5u]);
 }
 #endif
+vec3 ptsvSampleAt(uint slot) { return uintBitsToFloat(ptsvSlotAt(slot).xyz); }
+
 uint ptsvStatus(uint triangle) { return floatBitsToUint(ptsvPlane(triangle, 7u).x); }
 
 // The exact per-sample test (the test of test-and-set): inside the three edge planes (closed) and

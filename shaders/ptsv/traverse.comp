@@ -198,7 +198,8 @@ void testSamples(uint key) {
     uint first = (lo.y * uint(uTilesX) + lo.x) * ptsvTileSamples();
     uint s = lane;
     for (; s < ptsvTileSamples(); s += SAMPLE_STEP) {
-        uint k = ptsvKeyAt(first + s);
+        uvec4 slot = ptsvSlotAt(first + s); // q and key in one fetch
+        uint k = slot.w;
 #if PTSV_LEAF_CLUSTER_ONLY
         if (k != key) continue;
 #else
@@ -208,7 +209,7 @@ void testSamples(uint key) {
 #if PTSV_HEAT_MAP
         atomicAdd(ptsvHeat[first + s], 1u);
 #endif
-        if (ptsvInVolume(gPlane[0], gPlane[1], gPlane[2], gPlane[3], ptsvSampleAt(first + s)))
+        if (ptsvInVolume(gPlane[0], gPlane[1], gPlane[2], gPlane[3], uintBitsToFloat(slot.xyz)))
             ptsvShadow[first + s] = 1u;
     }
     if (s < ptsvTileSamples()) gTruncated = true;
@@ -303,7 +304,12 @@ void traverse(int depth, uint id) {
 
 void loadTriangle(uint t) {
     gTriangle = t;
-    for (uint i = 0u; i < 7u; ++i) {
+#if PTSV_PASS == 2
+    uint planes = uSplitDepth == uLevels ? 4u : 7u; // a cluster's samples need the volume's planes only
+#else
+    const uint planes = 7u;
+#endif
+    for (uint i = 0u; i < planes; ++i) {
         gPlane[i] = ptsvPlane(t, i);
 #if !PTSV_EXPLICIT_BOUNDS
         gView[i] = gPlane[i] * uInvView; // row vector: the plane's values carry over to view space
