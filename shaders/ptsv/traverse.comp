@@ -25,6 +25,12 @@
 //   the other planes 2-3 and culling planes 5-6; the halves' 64-bit ballots are combined, so every
 //   lane of the wave works.
 //
+// PTSV_PER_INVOCATION 1 (traversal = invocation): every invocation runs one job of its own, testing
+//   a node's existing children one after another with its own stack; no votes, no shared memory,
+//   no barrier, and nothing that depends on the subgroup width. On narrow subgroups (llvmpipe's 8
+//   lanes need 4 rounds per node, most of them on children that do not exist) it is the faster
+//   way; the images are the same.
+//
 // The paper runs persistent threads, each warp taking jobs from a queue until it is empty; llvmpipe
 // caps the loop iterations of one invocation at 65535 in total, so here a workgroup takes a fixed
 // batch of PTSV_JOBS_PER_GROUP consecutive jobs and the hardware scheduler hands out the batches;
