@@ -262,6 +262,21 @@ uint visit(int depth, uint id) {
         atomicAnd(ptsvMasks[maskIndex], ~v.y);
         gAccepted += uint(bitCount(v.y));
     }
+#if PTSV_PER_INVOCATION && PTSV_PASS == 1 && PTSV_TWO_PASS
+    // Children at the split depth become jobs here, with one atomic for all of them; those a full
+    // list leaves out are returned, and the walk visits them itself.
+    if (depth + 1 == uSplitDepth && v.x != 0u) {
+        uint slot = atomicAdd(ptsvCounters[PTSV_C_JOBS_PUSHED], uint(bitCount(v.x)));
+        uint kept = 0u;
+        for (uint m = v.x; m != 0u; m &= m - 1u, ++slot) {
+            uint c = uint(findLSB(m));
+            if (slot < uJobCapacity) ptsvJobs[slot] = uvec2(gTriangle, id * 32u + c);
+            else kept |= 1u << c;
+        }
+        if (kept != 0u) atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], uint(bitCount(kept)));
+        v.x = kept;
+    }
+#endif
     return v.x;
 }
 
@@ -282,7 +297,7 @@ void traverse(int depth, uint id) {
         stackMask[top] &= stackMask[top] - 1u;
         uint childId = node * 32u + uint(c);
         int childDepth = top + 1;
-#if PTSV_PASS == 1 && PTSV_TWO_PASS
+#if PTSV_PASS == 1 && PTSV_TWO_PASS && !PTSV_PER_INVOCATION
         if (childDepth == uSplitDepth) {
             uint slot = 0u;
             if (LEADER) {
