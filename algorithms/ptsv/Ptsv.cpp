@@ -75,8 +75,8 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  "0 = 16 with two passes, 1 with one",
                  ParamChange::Recompile)
         // auto: on llvmpipe's 8-lane subgroups a cooperative job takes 4 rounds per node for about 9
-        // existing children; one job per invocation measured 2.6x (512²) and 3.3x (1024²) less
-        // traversal time on the peer engine scene (docs/algorithms/ptsv.md). Subgroups of 32 or more test a node in one round, the paper's
+        // existing children; one job per invocation measured 3.1x less traversal time on the peer
+        // engine scene at 512² and 1024² (docs/algorithms/ptsv.md). Subgroups of 32 or more test a node in one round, the paper's
         // case. One pass stays cooperative: a large triangle's whole traversal in one invocation can
         // reach llvmpipe's loop cap (configs/ptsv/engine.json's implicit-bounds rows did).
         .choice("traversal", &P::traversal, "auto", {"auto", "cooperative", "invocation"},
