@@ -306,7 +306,7 @@ TEST_F(PtsvGLTest, HierarchyMatchesItsSamples) {
         s.scene.append(wall, translate({-2.0f + 0.8f * i, 0.8f, -1.0f - 2.5f * i}) * rotate(90, {1, 0, 0}));
     s.camera = lookAt({0.0f, 1.2f, 3.0f}, {0.0f, 0.6f, -10.0f});
     s.light = pointLight({0.5f, 2.0f, 8.0f});
-    std::vector<uint32_t> masks, keys;
+    std::vector<uint32_t> masks, slotWords; // a sample slot: q's float bits, then its key
     std::vector<float> bounds, samples;
     ptsv::KeyLayout layout = ptsv::makeKeyLayout({kRes, kRes}, 8, s.camera.fovYDeg, s.camera.nearPlane, s.camera.farPlane);
     auto fetch = [](GLuint binding, auto& out) {
@@ -319,9 +319,9 @@ TEST_F(PtsvGLTest, HierarchyMatchesItsSamples) {
     };
     Outcome o = run(s, {{"front_face_culling", true}}, false, [&]() {
         fetch(PTSV_MASK_BINDING, masks);
-        fetch(PTSV_KEY_BINDING, keys);
         fetch(PTSV_AABB_BINDING, bounds);
         fetch(PTSV_SAMPLE_BINDING, samples);
+        fetch(PTSV_SAMPLE_BINDING, slotWords);
     });
     ASSERT_EQ(o.counters["casters"], 0.0);
     ASSERT_EQ(masks.size(), layout.maskWords);
@@ -337,7 +337,7 @@ TEST_F(PtsvGLTest, HierarchyMatchesItsSamples) {
     for (int y = 0; y < kRes; ++y)
         for (int x = 0; x < kRes; ++x) {
             const size_t i = size_t(y) * kRes + x;
-            const uint32_t k = keys[slot(x, y)];
+            const uint32_t k = slotWords[4 * slot(x, y) + 3];
             if (!o.lit[i]) {
                 EXPECT_GE(k, uint32_t(PTSV_KEY_AWAY)) << x << "," << y;
                 continue;

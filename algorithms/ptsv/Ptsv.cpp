@@ -76,8 +76,8 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  ParamChange::Recompile)
         // auto: on llvmpipe's 8-lane subgroups a cooperative job takes 4 rounds per node for about 9
         // existing children; one job per invocation measured 3.1x less traversal time on the peer
-        // engine scene at 512² and 1024² (docs/algorithms/ptsv.md). Subgroups of 32 or more test a node in one round, the paper's
-        // case. One pass stays cooperative: a large triangle's whole traversal in one invocation can
+        // engine scene at 512² and 1024² (docs/algorithms/ptsv.md). Subgroups of 32 or more test a
+        // node in one round, the paper's case. One pass stays cooperative: a large triangle's whole traversal in one invocation can
         // reach llvmpipe's loop cap (configs/ptsv/engine.json's implicit-bounds rows did).
         .choice("traversal", &P::traversal, "auto", {"auto", "cooperative", "invocation"},
                 "who walks a job: cooperative (paper: a subgroup per job, its lanes testing a node's 32 children "
@@ -286,7 +286,7 @@ public:
     /// heat-map image, a debug aid).
     size_t memoryBytes() const override {
         size_t bytes = 0;
-        for (const GlBuffer* b : {&masks_, &bounds_, &samples_, &keys_, &shadow_, &heatCounts_, &planes_, &jobs_, &counters_.buffer(),
+        for (const GlBuffer* b : {&masks_, &bounds_, &samples_, &shadow_, &heatCounts_, &planes_, &jobs_, &counters_.buffer(),
                                   &jobIterations_})
             bytes += b->size();
         return bytes;
@@ -382,7 +382,6 @@ private:
         masks_ = GlBuffer(layout_.maskWords * 4, nullptr, 0);
         bounds_ = GlBuffer(boundsBytes, nullptr, 0);
         samples_ = GlBuffer(slots * 16, nullptr, 0);
-        keys_ = GlBuffer(slots * 4, nullptr, 0);
         shadow_ = GlBuffer(slots * 4, nullptr, 0);
         heatCounts_ = GlBuffer(p_.heatMap ? slots * 4 : 4, nullptr, 0);
         jobs_ = GlBuffer(p_.twoPass ? size_t(p_.jobCapacity) * 8 : 8, nullptr, 0);
@@ -391,7 +390,6 @@ private:
         jobIterations_ = GlBuffer(p_.jobIterations ? std::max<size_t>(jobSlots, 1) * 4 : 4, nullptr, 0);
         boundsTexels_ = makeBufferTexture(bounds_, GL_RGB32F, 12, "ptsv bounds");
         sampleTexels_ = makeBufferTexture(samples_, GL_RGBA32UI, 16, "ptsv samples");
-        keyTexels_ = makeBufferTexture(keys_, GL_R32UI, 4, "ptsv keys");
         maskTexels_ = makeBufferTexture(masks_, GL_R32UI, 4, "ptsv masks");
         shadowTexels_ = makeBufferTexture(shadow_, GL_R32UI, 4, "ptsv shadow marks");
         warnedSplit_ = false;
@@ -454,7 +452,6 @@ private:
         masks_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_MASK_BINDING);
         bounds_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_AABB_BINDING);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_SAMPLE_BINDING);
-        keys_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_KEY_BINDING);
         shadow_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_SHADOW_BINDING);
         planes_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_PLANE_BINDING);
         jobs_.bindBase(GL_SHADER_STORAGE_BUFFER, PTSV_JOB_BINDING);
@@ -465,7 +462,6 @@ private:
         // texture-fetch bit).
         glBindTextureUnit(PTSV_BOUNDS_UNIT, boundsTexels_.id());
         glBindTextureUnit(PTSV_SAMPLE_UNIT, sampleTexels_.id());
-        glBindTextureUnit(PTSV_KEY_UNIT, keyTexels_.id());
         glBindTextureUnit(PTSV_PLANE_UNIT, planeTexels_.id());
         glBindTextureUnit(PTSV_MASK_UNIT, maskTexels_.id());
         glBindTextureUnit(PTSV_SHADOW_UNIT, shadowTexels_.id());
@@ -487,8 +483,8 @@ private:
     std::array<float, 6> layoutKey_{};
     bool warnedSplit_ = false;
     ShaderProgram hierarchy_, clusters_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
-    GlBuffer masks_, bounds_, samples_, keys_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
-    GlTexture boundsTexels_, sampleTexels_, keyTexels_, planeTexels_, maskTexels_, shadowTexels_; ///< read-only views of those buffers
+    GlBuffer masks_, bounds_, samples_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
+    GlTexture boundsTexels_, sampleTexels_, planeTexels_, maskTexels_, shadowTexels_; ///< read-only views of those buffers
     GpuCounters<PTSV_COUNTER_WORDS> counters_;
     GlTexture heat_;
 };

@@ -34,7 +34,6 @@ void main() {
             }
         }
     }
-    ptsvKeys[slot] = key;
     ptsvSamples[slot] = uvec4(floatBitsToUint(q), key);
     ptsvShadow[slot] = 0u;
 #if PTSV_HEAT_MAP

@@ -5,8 +5,8 @@
 // SSBO binding points (0..2 are the scene buffers of shaders/common/scene.glsl).
 #define PTSV_MASK_BINDING 3    // child masks of every tree level, one 32-bit word per node
 #define PTSV_AABB_BINDING 4    // explicit bounds: 6 floats (min xyz, max xyz) per node below the root
-#define PTSV_SAMPLE_BINDING 5  // per view sample (tile-major): shadow-ray origin q (float bits, xyz) and key (w)
-#define PTSV_KEY_BINDING 6     // per view sample (tile-major): cluster key or PTSV_KEY_*
+#define PTSV_SAMPLE_BINDING 5  // per view sample (tile-major): shadow-ray origin q (float bits, xyz) and
+                               // cluster key or PTSV_KEY_* (w)
 #define PTSV_SHADOW_BINDING 7  // per view sample (tile-major): 1 once a test-and-set found it shadowed
 #define PTSV_PLANE_BINDING 8   // per triangle: PTSV_PLANES_PER_TRIANGLE vec4
 #define PTSV_JOB_BINDING 9     // two-pass job list: (triangle, node) pairs
@@ -14,11 +14,11 @@
 #define PTSV_HEAT_BINDING 11   // per view sample (tile-major): test-and-set operations (heat map)
 #define PTSV_JOB_ITER_BINDING 12 // per job: traversal iterations (pass one: triangle t at t; pass two: n + job)
 
-// Texture units of the traversal's buffer-texture views of what it reads but never writes: the
-// explicit bounds (RGB32F, 2 texels per node), samples (RGBA32F), keys (R32UI) and planes (RGBA32F).
+// Texture units of the buffer-texture views through which a pass reads what it does not write: the
+// explicit bounds (RGB32F, 2 texels per node), sample slots (RGBA32UI: q's bits and key) and planes
+// (RGBA32F).
 #define PTSV_BOUNDS_UNIT 2
 #define PTSV_SAMPLE_UNIT 3
-#define PTSV_KEY_UNIT 4
 #define PTSV_PLANE_UNIT 5
 #define PTSV_MASK_UNIT 6   // child masks (R32UI)
 #define PTSV_SHADOW_UNIT 7 // shadow marks (R32UI), read by the resolve pass

@@ -8,7 +8,6 @@ layout(std430, binding = PTSV_MASK_BINDING) coherent buffer PtsvMasks { uint pts
 layout(std430, binding = PTSV_AABB_BINDING) buffer PtsvBounds { float ptsvBounds[]; };
 // A sample slot: q's bits in xyz and the cluster key in w, so a leaf test reads one texel per slot.
 layout(std430, binding = PTSV_SAMPLE_BINDING) buffer PtsvSamples { uvec4 ptsvSamples[]; };
-layout(std430, binding = PTSV_KEY_BINDING) buffer PtsvKeys { uint ptsvKeys[]; };
 layout(std430, binding = PTSV_SHADOW_BINDING) buffer PtsvShadow { uint ptsvShadow[]; };
 layout(std430, binding = PTSV_PLANE_BINDING) buffer PtsvPlanes { vec4 ptsvPlanes[]; };
 layout(std430, binding = PTSV_JOB_BINDING) buffer PtsvJobs { uvec2 ptsvJobs[]; };
@@ -79,7 +78,6 @@ float ptsvSigned(vec4 plane, vec3 x) {
 // once but loads storage buffers lane by lane; a GPU reads both through its caches.
 layout(binding = PTSV_BOUNDS_UNIT) uniform samplerBuffer uPtsvBoundsTexels;
 layout(binding = PTSV_SAMPLE_UNIT) uniform usamplerBuffer uPtsvSampleTexels;
-layout(binding = PTSV_KEY_UNIT) uniform usamplerBuffer uPtsvKeyTexels;
 layout(binding = PTSV_PLANE_UNIT) uniform samplerBuffer uPtsvPlaneTexels;
 layout(binding = PTSV_MASK_UNIT) uniform usamplerBuffer uPtsvMaskTexels;
 layout(binding = PTSV_SHADOW_UNIT) uniform usamplerBuffer uPtsvShadowTexels; // resolve.comp only
@@ -89,7 +87,6 @@ uint ptsvShadowAt(uint slot) { return texelFetch(uPtsvShadowTexels, int(slot)).x
 // traversal into a subtree whose samples are already shadowed.
 uint ptsvMaskAt(uint word) { return texelFetch(uPtsvMaskTexels, int(word)).x; }
 vec4 ptsvPlane(uint triangle, uint i) { return texelFetch(uPtsvPlaneTexels, int(PTSV_PLANES_PER_TRIANGLE * triangle + i)); }
-uint ptsvKeyAt(uint slot) { return texelFetch(uPtsvKeyTexels, int(slot)).x; }
 uvec4 ptsvSlotAt(uint slot) { return texelFetch(uPtsvSampleTexels, int(slot)); }
 void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
     bmin = texelFetch(uPtsvBoundsTexels, int(2u * node)).xyz;
@@ -99,7 +96,6 @@ void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
 vec4 ptsvPlane(uint triangle, uint i) { return ptsvPlanes[PTSV_PLANES_PER_TRIANGLE * triangle + i]; }
 uint ptsvMaskAt(uint word) { return ptsvMasks[word]; }
 uint ptsvShadowAt(uint slot) { return ptsvShadow[slot]; }
-uint ptsvKeyAt(uint slot) { return ptsvKeys[slot]; }
 uvec4 ptsvSlotAt(uint slot) { return ptsvSamples[slot]; }
 void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
     uint b = 6u * node;
@@ -108,6 +104,7 @@ void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
 }
 #endif
 vec3 ptsvSampleAt(uint slot) { return uintBitsToFloat(ptsvSlotAt(slot).xyz); }
+uint ptsvKeyAt(uint slot) { return ptsvSlotAt(slot).w; }
 
 uint ptsvStatus(uint triangle) { return floatBitsToUint(ptsvPlane(triangle, 7u).x); }
 
