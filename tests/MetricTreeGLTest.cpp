@@ -126,6 +126,17 @@ const AccuracyCase kAccuracy[] = {
     // Closed meshes (and a ground facing the light, which shadows nothing): culling is exact.
     {"normal_cone_culling", thousandsOfTriangles, {{"normal_cone_culling", true}}, 1e-4},
     {"normal_cone_culling_directional", directionalObjects, {{"normal_cone_culling", true}}, 1e-4},
+    // The rows above run the default tile query (tile auto); the paper's per-pixel query and every
+    // tile size, on point and directional lights.
+    {"pixel_query_engine", engine, {{"query", std::string("pixel")}}, 1e-4},
+    {"pixel_query_omni_inside_shell", omniInsideShell, {{"query", std::string("pixel")}}, 1e-4},
+    {"pixel_query_fence_directional", fenceDirectional, {{"query", std::string("pixel")}}, 1e-4},
+    {"pixel_query_no_overlap_interval", thousandsOfTriangles, {{"query", std::string("pixel")}, {"overlap_interval", false}}, 1e-4},
+    {"tile_4x2_fence", fence, {{"tile", std::string("4x2")}}, 1e-4},
+    {"tile_8x2_camera_inside_shadow", cameraInsideShadow, {{"tile", std::string("8x2")}}, 1e-4},
+    {"tile_8x4_directional", directionalObjects, {{"tile", std::string("8x4")}}, 1e-4},
+    {"tile_8x8_engine", engine, {{"tile", std::string("8x8")}}, 1e-4},
+    {"tile_8x8_omni_inside_shell", omniInsideShell, {{"tile", std::string("8x8")}}, 1e-4},
 };
 
 class MetricTreeAccuracyGLTest : public MetricTreeGLTest, public ::testing::WithParamInterface<AccuracyCase> {};
@@ -240,6 +251,28 @@ TEST_F(MetricTreeGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
     expectOverflowedPixelsShadowed(o, pixels);
     for (size_t i = 0; i < o.visibility.size(); ++i)
         if (o.lit[i] && o.reference[i] < 0.5f) EXPECT_LT(o.visibility[i], 0.5f) << "pixel " << i << " lit by overflow";
+}
+
+// The tile query tests the clusters the per-pixel query would reach (and more), with the same cone
+// test, so the two give the same image; a tile whose list is full falls back to the per-pixel query.
+TEST_F(MetricTreeGLTest, TileQueryGivesThePixelQuerysImage) {
+    for (Shot (*make)() : {engine, fenceDirectional, omniInsideShell}) {
+        const Shot s = make();
+        Outcome pixel = run(s, {{"query", std::string("pixel")}}, false);
+        for (const char* tile : {"4x2", "8x8"}) {
+            Outcome full = run(s, {{"tile", std::string(tile)}}, false);
+            Outcome tiny = run(s, {{"tile", std::string(tile)}, {"tile_candidates", 16}}, false);
+            std::printf("[metric_tree] tile %s: %.0f fallbacks, with 16 candidates %.0f; nodes/px %.1f against %.1f per pixel\n",
+                        tile, full.counters["tile_fallbacks"], tiny.counters["tile_fallbacks"],
+                        full.counters["nodes_visited_mean"] + full.counters["tile_nodes_per_pixel"],
+                        pixel.counters["nodes_visited_mean"]);
+            EXPECT_EQ(full.counters["tile_pixels"], std::string(tile) == "4x2" ? 8.0 : 64.0);
+            EXPECT_GT(tiny.counters["tile_fallbacks"], full.counters["tile_fallbacks"]);
+            EXPECT_EQ(full.visibility, pixel.visibility) << tile;
+            EXPECT_EQ(tiny.visibility, pixel.visibility) << tile << ", 16 candidates";
+            EXPECT_EQ(full.overflow + tiny.overflow, 0u);
+        }
+    }
 }
 
 TEST_F(MetricTreeGLTest, ClusteringIsCachedOnDisk) {
@@ -371,7 +404,8 @@ INSTANTIATE_TEST_SUITE_P(Configs, MetricTreeConfigGLTest, ::testing::ValuesIn(kC
 TEST(MetricTreeTest, SchemaDeclaresEveryAblation) {
     const AlgorithmInfo info = metricTreeInfo();
     for (const char* key : {"cluster_size", "capsules", "slabs", "overlap_interval", "depth_skip", "normal_cone_culling",
-                            "random_order", "seed", "tree_builder", "stack_size", "cache", "ray_offset"})
+                            "random_order", "seed", "tree_builder", "stack_size", "cache", "ray_offset", "query", "tile",
+                            "tile_candidates"})
         EXPECT_NE(info.schema().find(key), nullptr) << key;
     EXPECT_TRUE(info.supports(LightType::Point));
     EXPECT_TRUE(info.supports(LightType::Directional));

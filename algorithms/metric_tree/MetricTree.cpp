@@ -31,6 +31,9 @@ struct MetricTreeParams {
     bool slabs, overlapInterval, depthSkip, normalConeCulling; ///< the query's tests (shader defines)
     std::string treeBuilder;                                   ///< "gpu" | "cpu"
     int stackSize;                                             ///< query stack, nodes
+    std::string query;                                         ///< "pixel" | "tile"
+    int tileCandidates;                                        ///< tile query: clusters per tile list
+    std::string tile;                                          ///< tile query: "4x2" ... "8x8" pixels
     float rayOffset;                                           ///< × scene radius
     std::string motion;                                        ///< "rigid" | "recluster"
 };
@@ -71,6 +74,19 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                 "with Yianilos pivots (the paper's Table 2 reference, slow)",
                 ParamChange::Update)
         .apply(stackSizeRow(&P::stackSize, 64))
+        .choice("query", &P::query, "tile", {"pixel", "tile"},
+                "pixel: every pixel walks the tree (paper 5.4); tile: an 8x8 tile walks it once as the cap enclosing "
+                "its points, and each pixel tests the cone of every cluster the cap reached (the same clusters pass, "
+                "the same image; no divergent walk)",
+                ParamChange::Recompile)
+        .choice("tile", &P::tile, "auto", {"auto", "4x2", "8x2", "8x4", "8x8"},
+                "tile query: the pixels that share one walk; auto = one SIMD group's (subgroup width 8: 4x2, 16: 8x2, "
+                "32: 8x4, else 8x8), so that all its lanes run one list",
+                ParamChange::Recompile)
+        .integer("tile_candidates", &P::tileCandidates, 512, 16, 512, "clusters",
+                 "tile query: most clusters one tile's list holds; a tile that reaches more falls back to the "
+                 "per-pixel query (counter tile_fallbacks)",
+                 ParamChange::Recompile)
         .apply(cacheRow(&P::cache, "metric_tree"))
         .apply(rayOffsetRow(&P::rayOffset))
         // The paper's answer to rigid motion: clusters never span two moving parts, and each moves
@@ -92,7 +108,10 @@ constexpr float kAngularEps = 1e-4f;
 
 class MetricTree final : public ShadowAlgorithm {
 public:
-    MetricTree(const ParamValues& p, const AlgorithmOptions& o) : p_(metricTreeParams().read(p)), options_(o) { compile(); }
+    MetricTree(const ParamValues& p, const AlgorithmOptions& o) : p_(metricTreeParams().read(p)), options_(o) {
+        subgroupSize_ = querySubgroupSize();
+        compile();
+    }
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
@@ -235,6 +254,8 @@ public:
             return {{"clusters", n},
                     {"build_errors", double(c[MT_C_BUILD_ERRORS])},
                     {"stack_overflow_pixels", double(c[MT_C_STACK_OVERFLOW])},
+                    {"tile_pixels", tileQueryPixels()},
+                    {"tile_fallbacks", double(c[MT_C_TILE_FALLBACKS])},
                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
                     {"clustering_ms", clusteringMs_}};
         return {{"clusters", n},
@@ -256,6 +277,9 @@ public:
                 {"cone_hits_mean", perPixel(MT_C_CONE_HITS_LO)},
                 {"slab_rejects_mean", perPixel(MT_C_SLAB_REJECTS_LO)},
                 {"depth_skips_mean", perPixel(MT_C_DEPTH_SKIPS_LO)},
+                {"tile_pixels", tileQueryPixels()},
+                {"tile_nodes_per_pixel", perPixel(MT_C_TILE_NODES_LO)},
+                {"tile_fallbacks", double(c[MT_C_TILE_FALLBACKS])},
                 {"stack_overflow_pixels", double(c[MT_C_STACK_OVERFLOW])},
                 {"cache_hit", cacheHit_ ? 1.0 : 0.0},
                 {"clustering_ms", clusteringMs_}};
@@ -288,12 +312,25 @@ private:
                                        {"MT_DEPTH_SKIP", flag(p_.depthSkip)},
                                        {"MT_NORMAL_CONE_CULLING", flag(p_.normalConeCulling)},
                                        {"MT_STACK_SIZE", std::to_string(p_.stackSize)},
+                                       {"MT_QUERY_TILE", flag(p_.query == "tile")},
+                                       {"MT_TILE_CANDIDATES", std::to_string(p_.tileCandidates)},
+                                       {"MT_TILE_PIXELS", std::to_string(tilePixels())},
                                        {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
                                        instrumentationDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
         insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
     }
+
+    /// Pixels per tile of the tile query: "WxH" -> W * H (the schema admits 4x2, 8x2, 8x4 and 8x8),
+    /// auto -> the subgroup width where it is one of those sizes (the tiles are consecutive invocations).
+    int tilePixels() const {
+        if (p_.tile != "auto") return (p_.tile[0] - '0') * (p_.tile[2] - '0');
+        return subgroupSize_ == 8 || subgroupSize_ == 16 || subgroupSize_ == 32 ? subgroupSize_ : 64;
+    }
+
+    /// The counter tile_pixels: pixels per tile, 0 with the per-pixel query.
+    double tileQueryPixels() const { return p_.query == "tile" ? double(tilePixels()) : 0.0; }
 
     mt::ClusteringOptions clusteringOptions() const {
         mt::ClusteringOptions o;
@@ -483,6 +520,7 @@ private:
     GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;
     size_t clusterCount_ = 0, capsuleCount_ = 0, geometryBytes_ = 0;
     int geometryUsed_ = 1; ///< geometry blocks holding triangles (MT_GEOMETRY_USED)
+    int subgroupSize_ = 0; ///< the context's subgroup width (0: unknown), for tile = auto
     float lsEps_ = kAngularEps;
     bool cacheHit_ = false;
     double clusteringMs_ = 0;

@@ -63,4 +63,7 @@
 #define MT_C_STACK_OVERFLOW 19     // pixels whose traversal stack overflowed (written shadowed)
 #define MT_C_DEPTH_SKIPS_LO 20     // subtrees skipped by the light-distance test
 #define MT_C_DEPTH_SKIPS_HI 21
-// Words 22..31 are reserved (the block size stays fixed).
+#define MT_C_TILE_NODES_LO 22      // nodes the tile query's caps visited (query: tile), low / high
+#define MT_C_TILE_NODES_HI 23
+#define MT_C_TILE_FALLBACKS 24     // tiles whose candidate list or stack was full: per-pixel query
+// Words 25..31 are reserved (the block size stays fixed).

@@ -203,6 +203,129 @@ void addWide(uint lo, uint value) {
 }
 #endif
 
+#if MT_QUERY_TILE
+// The tile query: a tile of MT_TILE_PIXELS pixels (consecutive invocations: 4 × 2, 8 × 2, 8 × 4 or
+// 8 × 8, see pixel_order.glsl) walks the tree once, as a cap (light
+// space: the centre c of their points and the radius rho enclosing them all), and each pixel then
+// tests only the clusters the cap reached. A pixel's distance to any element lies within rho of
+// c's (triangle inequality), so the cap visits every node any of its pixels would visit, and each
+// pixel applies the very cone test of the per-pixel query to those clusters: the same clusters
+// reach the triangle tests, hence the same image. Every lane of a SIMD group runs the same list,
+// so nothing diverges but the triangle tests. A tile whose list or stack would overflow falls back
+// to the per-pixel query (counted in tile_fallbacks): exact either way.
+shared vec3 sPoint[64]; // light-space point of each invocation's query
+shared float sDepth[64];
+shared bool sValid[64];
+#define MT_TILES (64 / MT_TILE_PIXELS)
+shared uint sCandidates[MT_TILES][MT_TILE_CANDIDATES];
+shared uint sCandidateCount[MT_TILES];
+shared bool sTileFallback[MT_TILES];
+
+// Invocation `tile`: the clusters whose cones the cap of the tile's pixels reaches, into its list.
+void collectCandidates(uint tile) {
+    sCandidateCount[tile] = 0u;
+    sTileFallback[tile] = false;
+    vec3 c = vec3(0.0);
+    float maxDepth = 0.0;
+    uint valid = 0u, first = tile * uint(MT_TILE_PIXELS), end = first + uint(MT_TILE_PIXELS);
+    for (uint i = first; i < end; ++i)
+        if (sValid[i]) { c += sPoint[i]; maxDepth = max(maxDepth, sDepth[i]); ++valid; }
+    if (valid == 0u) return;
+    c = lightIsDirectional() ? c / float(valid) : normalize(c);
+    float rho = 0.0;
+    for (uint i = first; i < end; ++i)
+        if (sValid[i]) rho = max(rho, lightIsDirectional() ? length(sPoint[i] - c) : mtAngle(c, sPoint[i]));
+    rho += uLsEps; // far above the rounding of rho, of c's distances and of each pixel's
+    uint stack[MT_STACK_SIZE];
+    int sp = 0;
+    uint next = mtCounters[MT_C_ROOT], count = 0u, visited = 0u;
+#define MT_TILE_PUSH(x) { if (sp == MT_STACK_SIZE) { sTileFallback[tile] = true; break; } stack[sp++] = (x); }
+    while (true) {
+        if (next == MT_NO_CHILD) {
+            if (sp == 0) break;
+            next = stack[--sp];
+        }
+        uint node = next - 1u;
+        ++visited;
+        MtNode n = mtNode(node);
+        next = MT_NO_CHILD;
+#if MT_DEPTH_SKIP
+        if (maxDepth <= uintBitsToFloat(n.minDist)) continue; // every point of the tile skips it
+#endif
+        float dc = mtPointDist(c, n.a.xyz, n.b.xyz), lo = dc - rho, hi = dc + rho;
+        if (lo <= n.a.w + uLsEps) {
+            if (count == uint(MT_TILE_CANDIDATES)) { sTileFallback[tile] = true; break; }
+            sCandidates[tile][count++] = node;
+        }
+        // A pixel goes near when its distance is <= delta, far otherwise: the tile, to each side
+        // some pixel may take.
+        uint nearChild = lo <= n.b.w ? n.child[MT_CHILD_NEAR] : MT_NO_CHILD;
+        uint farChild = hi > n.b.w ? n.child[MT_CHILD_FAR] : MT_NO_CHILD;
+        uint overlap = n.child[MT_CHILD_OVERLAP];
+#if MT_OVERLAP_INTERVAL
+        if (hi < uintBitsToFloat(n.overlapMin) || lo > uintBitsToFloat(n.overlapMax)) overlap = MT_NO_CHILD;
+#endif
+        if (overlap != MT_NO_CHILD) MT_TILE_PUSH(overlap);
+        if (farChild != MT_NO_CHILD) {
+            if (nearChild == MT_NO_CHILD) nearChild = farChild;
+            else MT_TILE_PUSH(farChild);
+        }
+        next = nearChild;
+    }
+#undef MT_TILE_PUSH
+    sCandidateCount[tile] = count;
+#if SHADOWLAB_INSTRUMENTATION
+    addWide(MT_C_TILE_NODES_LO, visited);
+#endif
+    if (sTileFallback[tile]) atomicAdd(mtCounters[MT_C_TILE_FALLBACKS], 1u);
+}
+
+// Every invocation of the group calls it (it holds barriers); `needs`: this one has a query at q.
+Result tileQuery(bool needs, vec3 q) {
+    uint i = gl_LocalInvocationIndex;
+    sValid[i] = needs;
+    sPoint[i] = needs ? mtToLightSpace(q) : vec3(0.0);
+    sDepth[i] = needs ? mtLightDepth(q) : 0.0;
+    barrier();
+    if (i < uint(MT_TILES)) collectCandidates(i);
+    barrier();
+    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
+    if (!needs) return r;
+    uint tile = i / uint(MT_TILE_PIXELS);
+    if (sTileFallback[tile]) return query(q);
+    vec3 dir = lightIsDirectional() ? -uLightDirection : uLightPosition - q;
+    float tMax = lightIsDirectional() ? kMtInf : 1.0;
+    vec3 p = sPoint[i];
+    uint count = sCandidateCount[tile];
+    bool hit = false;
+    for (uint k = 0u; k < count && !hit; ++k) {
+        uint node = sCandidates[tile][k];
+        ++r.visited;
+        int t = int(4u * node);
+        vec4 a = uintBitsToFloat(texelFetch(uNodeTexels, t)), b = uintBitsToFloat(texelFetch(uNodeTexels, t + 1));
+        if (mtPointDist(p, a.xyz, b.xyz) > a.w + uLsEps) continue; // outside this pixel's cone
+        ++r.coneHits;
+        MtCluster c = mtCluster(node);
+#if MT_SLABS
+        float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
+        float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
+        float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
+        float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
+        if (!(sFar >= lo && sNear <= hi)) { ++r.slabRejects; continue; }
+#endif
+        for (uint tri = c.first; tri < c.first + c.count && !hit; ++tri) {
+            ++r.triangles;
+            vec3 v0, v1, v2;
+            mtTriangle(tri, v0, v1, v2);
+            hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
+        }
+        if (!hit) ++r.fruitless;
+    }
+    if (hit) r.visibility = 0.0;
+    return r;
+}
+#endif
+
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
     if (gl_LocalInvocationIndex == 0u) {
@@ -212,35 +335,45 @@ void main() {
     barrier();
 #endif
     ivec2 px = pixelOfInvocation();
-    if (all(lessThan(px, imageSize(uVisibility)))) {
+    bool inside = all(lessThan(px, imageSize(uVisibility)));
+    float visibility = 1.0; // background: nothing to shadow (the reference's convention)
+    bool needs = false;     // covered and facing the light: a query at q
+    vec3 q = vec3(0.0);
+    if (inside) {
         vec4 pos = texelFetch(uPosition, px, 0);
-        float visibility = 1.0; // background: nothing to shadow (the reference's convention)
-        Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
         if (pos.w >= 0.5) {
             vec3 x = pos.xyz, nrm = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // facing away from the light
-            if (dot(nrm, toLight(x)) > 0.0) {
-                // The reference's ray origin: the same offset along the same (unnormalised) normal.
-                r = query(x + nrm * uRayOffset);
-                visibility = r.visibility;
-#if SHADOWLAB_INSTRUMENTATION
-                atomicAdd(sTraversed, 1u);
-                atomicAdd(sVisited, r.visited);
-                atomicAdd(sTriangles, r.triangles);
-                atomicAdd(sFruitless, r.fruitless);
-                atomicAdd(sConeHits, r.coneHits);
-                atomicAdd(sSlabRejects, r.slabRejects);
-                atomicAdd(sDepthSkips, r.depthSkips);
-                atomicMax(sVisitedMax, r.visited);
-                atomicMax(sTrianglesMax, r.triangles);
-                atomicMax(sFruitlessMax, r.fruitless);
-                if (r.overflow) atomicAdd(sOverflow, 1u);
-#else
-                // Timing mode still counts every overflowed pixel (never a silent wrong image).
-                if (r.overflow) atomicAdd(mtCounters[MT_C_STACK_OVERFLOW], 1u);
-#endif
-            }
+            // The reference's ray origin: the same offset along the same (unnormalised) normal.
+            if (dot(nrm, toLight(x)) > 0.0) { needs = true; q = x + nrm * uRayOffset; }
         }
+    }
+    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
+#if MT_QUERY_TILE
+    r = tileQuery(needs, q);
+#else
+    if (needs) r = query(q);
+#endif
+    if (needs) {
+        visibility = r.visibility;
+#if SHADOWLAB_INSTRUMENTATION
+        atomicAdd(sTraversed, 1u);
+        atomicAdd(sVisited, r.visited);
+        atomicAdd(sTriangles, r.triangles);
+        atomicAdd(sFruitless, r.fruitless);
+        atomicAdd(sConeHits, r.coneHits);
+        atomicAdd(sSlabRejects, r.slabRejects);
+        atomicAdd(sDepthSkips, r.depthSkips);
+        atomicMax(sVisitedMax, r.visited);
+        atomicMax(sTrianglesMax, r.triangles);
+        atomicMax(sFruitlessMax, r.fruitless);
+        if (r.overflow) atomicAdd(sOverflow, 1u);
+#else
+        // Timing mode still counts every overflowed pixel (never a silent wrong image).
+        if (r.overflow) atomicAdd(mtCounters[MT_C_STACK_OVERFLOW], 1u);
+#endif
+    }
+    if (inside) {
         imageStore(uVisibility, px, vec4(visibility));
 #if SHADOWLAB_INSTRUMENTATION
         imageStore(uNodesVisited, px, vec4(float(r.visited)));
