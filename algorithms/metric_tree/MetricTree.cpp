@@ -33,7 +33,7 @@ struct MetricTreeParams {
     int stackSize;                                             ///< query stack, nodes
     std::string query;                                         ///< "pixel" | "tile"
     int tileCandidates;                                        ///< tile query: clusters per tile list
-    std::string tile;                                          ///< tile query: "4x2" ... "8x8" pixels
+    std::string tile;                                          ///< tile query: "auto" | "4x2" ... "8x8"
     float rayOffset;                                           ///< × scene radius
     std::string motion;                                        ///< "rigid" | "recluster"
 };
@@ -74,19 +74,7 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                 "with Yianilos pivots (the paper's Table 2 reference, slow)",
                 ParamChange::Update)
         .apply(stackSizeRow(&P::stackSize, 64))
-        .choice("query", &P::query, "tile", {"pixel", "tile"},
-                "pixel: every pixel walks the tree (paper 5.4); tile: an 8x8 tile walks it once as the cap enclosing "
-                "its points, and each pixel tests the cone of every cluster the cap reached (the same clusters pass, "
-                "the same image; no divergent walk)",
-                ParamChange::Recompile)
-        .choice("tile", &P::tile, "auto", {"auto", "4x2", "8x2", "8x4", "8x8"},
-                "tile query: the pixels that share one walk; auto = one SIMD group's (subgroup width 8: 4x2, 16: 8x2, "
-                "32: 8x4, else 8x8), so that all its lanes run one list",
-                ParamChange::Recompile)
-        .integer("tile_candidates", &P::tileCandidates, 512, 16, 512, "clusters",
-                 "tile query: most clusters one tile's list holds; a tile that reaches more falls back to the "
-                 "per-pixel query (counter tile_fallbacks)",
-                 ParamChange::Recompile)
+        .apply(tileQueryRows(&P::query, &P::tile, &P::tileCandidates, "clusters"))
         .apply(cacheRow(&P::cache, "metric_tree"))
         .apply(rayOffsetRow(&P::rayOffset))
         // The paper's answer to rigid motion: clusters never span two moving parts, and each moves
@@ -314,7 +302,7 @@ private:
                                        {"MT_STACK_SIZE", std::to_string(p_.stackSize)},
                                        {"MT_QUERY_TILE", flag(p_.query == "tile")},
                                        {"MT_TILE_CANDIDATES", std::to_string(p_.tileCandidates)},
-                                       {"MT_TILE_PIXELS", std::to_string(tilePixels())},
+                                       {"MT_TILE_PIXELS", std::to_string(tilePixels(p_.tile, subgroupSize_))},
                                        {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
                                        instrumentationDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
@@ -322,15 +310,8 @@ private:
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
     }
 
-    /// Pixels per tile of the tile query: "WxH" -> W * H (the schema admits 4x2, 8x2, 8x4 and 8x8),
-    /// auto -> the subgroup width where it is one of those sizes (the tiles are consecutive invocations).
-    int tilePixels() const {
-        if (p_.tile != "auto") return (p_.tile[0] - '0') * (p_.tile[2] - '0');
-        return subgroupSize_ == 8 || subgroupSize_ == 16 || subgroupSize_ == 32 ? subgroupSize_ : 64;
-    }
-
     /// The counter tile_pixels: pixels per tile, 0 with the per-pixel query.
-    double tileQueryPixels() const { return p_.query == "tile" ? double(tilePixels()) : 0.0; }
+    double tileQueryPixels() const { return p_.query == "tile" ? double(tilePixels(p_.tile, subgroupSize_)) : 0.0; }
 
     mt::ClusteringOptions clusteringOptions() const {
         mt::ClusteringOptions o;
