@@ -204,6 +204,35 @@ void addWide(uint lo, uint value) {
 #endif
 
 #if MT_QUERY_TILE
+// A cluster the tile's walk reached, for one pixel: the per-pixel query's cone test, then slabs
+// and triangles; true on a hit.
+bool testCluster(uint node, vec3 q, vec3 p, vec3 dir, float tMax, inout Result r) {
+    ++r.visited;
+    int t = int(4u * node);
+    vec4 a = uintBitsToFloat(texelFetch(uNodeTexels, t)), b = uintBitsToFloat(texelFetch(uNodeTexels, t + 1));
+    if (mtPointDist(p, a.xyz, b.xyz) > a.w + uLsEps) return false; // outside this pixel's cone
+    ++r.coneHits;
+    MtCluster c = mtCluster(node);
+#if MT_SLABS
+    float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
+    float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
+    float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
+    float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
+    if (!(sFar >= lo && sNear <= hi)) { ++r.slabRejects; return false; }
+#endif
+    bool hit = false;
+    for (uint tri = c.first; tri < c.first + c.count && !hit; ++tri) {
+        ++r.triangles;
+        vec3 v0, v1, v2;
+        mtTriangle(tri, v0, v1, v2);
+        hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
+    }
+    if (!hit) ++r.fruitless;
+    return hit;
+}
+#endif
+
+#if MT_QUERY_TILE
 // The tile query: a tile of MT_TILE_PIXELS pixels (consecutive invocations: 4 × 2, 8 × 2, 8 × 4 or
 // 8 × 8, see pixel_order.glsl) walks the tree once, as a cap (light
 // space: the centre c of their points and the radius rho enclosing them all), and each pixel then
@@ -298,29 +327,7 @@ Result tileQuery(bool needs, vec3 q) {
     vec3 p = sPoint[i];
     uint count = sCandidateCount[tile];
     bool hit = false;
-    for (uint k = 0u; k < count && !hit; ++k) {
-        uint node = sCandidates[tile][k];
-        ++r.visited;
-        int t = int(4u * node);
-        vec4 a = uintBitsToFloat(texelFetch(uNodeTexels, t)), b = uintBitsToFloat(texelFetch(uNodeTexels, t + 1));
-        if (mtPointDist(p, a.xyz, b.xyz) > a.w + uLsEps) continue; // outside this pixel's cone
-        ++r.coneHits;
-        MtCluster c = mtCluster(node);
-#if MT_SLABS
-        float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
-        float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
-        float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
-        float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
-        if (!(sFar >= lo && sNear <= hi)) { ++r.slabRejects; continue; }
-#endif
-        for (uint tri = c.first; tri < c.first + c.count && !hit; ++tri) {
-            ++r.triangles;
-            vec3 v0, v1, v2;
-            mtTriangle(tri, v0, v1, v2);
-            hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
-        }
-        if (!hit) ++r.fruitless;
-    }
+    for (uint k = 0u; k < count && !hit; ++k) hit = testCluster(sCandidates[tile][k], q, p, dir, tMax, r);
     if (hit) r.visibility = 0.0;
     return r;
 }
