@@ -55,6 +55,7 @@ Shot engine() {
 // The two traversals (`traversal` = auto picks one per device), named so every row can say which.
 const std::pair<const std::string, ParamValue> kCooperative{"traversal", std::string("cooperative")};
 const std::pair<const std::string, ParamValue> kPerInvocation{"traversal", std::string("invocation")};
+const std::pair<const std::string, ParamValue> kPacket{"traversal", std::string("packet")};
 
 // ---- Running ptsv and the reference --------------------------------------------------------------
 
@@ -121,6 +122,12 @@ const AccuracyCase kAccuracy[] = {
     {"thousands_invocation", thousandsOfTriangles, {kPerInvocation}, 1e-4},
     {"engine_cooperative", engine, {kCooperative}, 1e-4},
     {"engine_invocation", engine, {kPerInvocation}, 1e-4},
+    {"directional_packet", directionalObjects, {kPacket}, 1e-4},
+    {"fence_packet", fenceDiscontinuity, {kPacket}, 1e-4},
+    {"fence_packet_implicit_one_pass", fenceDiscontinuity, {kPacket, {"bounds", std::string("implicit")}, {"two_pass", false}}, 1e-4},
+    {"fence_packet_split_1_cluster", fenceDiscontinuity, {kPacket, {"split_level", 1}, {"leaf_samples", std::string("cluster")}}, 1e-4},
+    {"thousands_packet", thousandsOfTriangles, {kPacket}, 1e-4},
+    {"engine_packet", engine, {kPacket}, 1e-4},
     {"thousands_no_planes", thousandsOfTriangles, {{"culling_planes", false}}, 1e-4},
     {"thousands_plane_bias", thousandsOfTriangles, {{"plane_bias", 1e-6}}, 1e-4}, // no caster touches a receiver
     {"engine", engine, {}, 1e-4},
@@ -172,7 +179,7 @@ TEST_F(PtsvGLTest, ExplicitBoundsNeedFewerTestAndSets) {
 // clusters' parents (paper) with cooperative jobs, the clusters themselves with one job per invocation.
 TEST_F(PtsvGLTest, TwoPassesSplitTheLargestJobs) {
     Shot s = fenceDiscontinuity();
-    for (const auto& traversal : {kCooperative, kPerInvocation}) {
+    for (const auto& traversal : {kCooperative, kPerInvocation, kPacket}) {
         SCOPED_TRACE(std::get<std::string>(traversal.second));
         const bool cooperative = std::get<std::string>(traversal.second) == "cooperative";
         Outcome one = run(s, {traversal, {"two_pass", false}, {"job_iterations", true}}, false);
@@ -196,7 +203,7 @@ TEST_F(PtsvGLTest, TwoPassesSplitTheLargestJobs) {
 // A job list of one entry overflows at once: every further job is finished by pass one, counted,
 // and the image stays exact.
 TEST_F(PtsvGLTest, TinyJobListOverflowsButStaysExact) {
-    for (const auto& traversal : {kCooperative, kPerInvocation}) {
+    for (const auto& traversal : {kCooperative, kPerInvocation, kPacket}) {
         SCOPED_TRACE(std::get<std::string>(traversal.second));
         Outcome o = run(thousandsOfTriangles(), {traversal, {"job_capacity", 1}});
         std::printf("[ptsv] job_capacity 1: %.0f jobs overflowed, overflowCount %llu, mismatch %.5f%%\n",
@@ -237,15 +244,22 @@ TEST_F(PtsvGLTest, VotePathsAgree) {
     EXPECT_EQ(perInvocation.counters["traversal_lanes"], 1.0);
     EXPECT_EQ(perInvocation.visibility, shared.visibility);
     EXPECT_EQ(perInvocation.counters["receivers"], shared.counters["receivers"]);
-    // auto: cooperative on ballot subgroups of 32 lanes or more, else one job per invocation.
+    // auto: cooperative on ballot subgroups of 32 lanes or more, else one job per invocation, whose
+    // pass one walks as packets where ARB_shader_ballot is there.
     Outcome autoTraversal = run(s, {}, false);
     EXPECT_EQ(autoTraversal.counters["vote_path"], ballotUsable && width >= 32 ? 1.0 : 2.0);
+    EXPECT_EQ(autoTraversal.counters["packet_traversal"], ballotUsable && width < 32 ? 1.0 : 0.0);
     Outcome autoVote = run(s, {kCooperative}, false);
     EXPECT_EQ(autoVote.counters["vote_path"], ballotUsable ? 1.0 : 0.0);
     EXPECT_EQ(autoVote.counters["subgroup_size"], double(width));
     // Only a driver without ARB_shader_ballot (or with an unusual width) has no ballot path to
     // compare; llvmpipe, NVIDIA and AMD all have one.
     if (!ballotUsable) GTEST_SKIP() << "no usable ARB_shader_ballot (subgroup " << width << ")";
+    Outcome packet = run(s, {kPacket}, false);
+    EXPECT_EQ(packet.counters["packet_traversal"], 1.0);
+    EXPECT_EQ(packet.counters["vote_path"], 2.0);
+    EXPECT_EQ(packet.visibility, shared.visibility);
+    EXPECT_EQ(packet.counters["receivers"], shared.counters["receivers"]);
     Outcome ballot = run(s, {kCooperative, {"vote", std::string("ballot")}}, false);
     EXPECT_EQ(ballot.counters["vote_path"], 1.0);
     EXPECT_EQ(ballot.counters["traversal_lanes"], double(width));

@@ -22,7 +22,7 @@ struct PtsvParams {
     float planeBias, rayOffset; ///< × scene radius
     std::string vote;        ///< "auto" | "ballot" | "shared"
     std::string leafSamples; ///< "tile" | "cluster"
-    std::string traversal;   ///< "auto" | "cooperative" | "invocation"
+    std::string traversal;   ///< "auto" | "cooperative" | "invocation" | "packet"
 };
 
 const ParamStruct<PtsvParams>& ptsvParams() {
@@ -79,11 +79,16 @@ const ParamStruct<PtsvParams>& ptsvParams() {
         // engine scene at 512² and 1024² (docs/algorithms/ptsv.md). Subgroups of 32 or more test a
         // node in one round, the paper's case. One pass stays cooperative: a large triangle's whole traversal in one invocation can
         // reach llvmpipe's loop cap (configs/ptsv/engine.json's implicit-bounds rows did).
-        .choice("traversal", &P::traversal, "auto", {"auto", "cooperative", "invocation"},
+        // packet: pass one's walks of neighbouring triangles share their nodes, so the lanes of a
+        // subgroup loop over one node's children together (traverse 10-12 % less than invocation at
+        // 512² on the peer engine scene, the same at 1024²).
+        .choice("traversal", &P::traversal, "auto", {"auto", "cooperative", "invocation", "packet"},
                 "who walks a job: cooperative (paper: a subgroup per job, its lanes testing a node's 32 children "
                 "together, see vote and lanes), invocation (each invocation its own job, testing a node's "
-                "existing children in turn; no votes), auto (invocation with two passes on subgroups narrower than 32 "
-                "lanes, else cooperative)",
+                "existing children in turn; no votes), packet (as invocation, but in pass one the lanes of a "
+                "subgroup, each with its own triangle, walk the union of their paths together; needs "
+                "ARB_shader_ballot), auto (with two passes on subgroups narrower than 32 lanes packet, or invocation "
+                "without ARB_shader_ballot; else cooperative)",
                 ParamChange::Recompile)
         .choice("vote", &P::vote, "auto", {"auto", "ballot", "shared"},
                 "how a node's 32 children are tested together: ballot (ARB_shader_ballot: one subgroup, each "
@@ -241,6 +246,7 @@ public:
                                     {"split_depth", p_.twoPass ? double(splitDepth()) : 0.0},
                                     {"vote_path", double(vote_)},
                                     {"traversal_lanes", double(lanes_)},
+                                    {"packet_traversal", packet_ ? 1.0 : 0.0},
                                     {"subgroup_size", double(subgroupSize_)},
                                     {"subgroup_mismatch_groups", double(c[PTSV_C_SUBGROUP_MISMATCH])},
                                     {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
@@ -330,8 +336,12 @@ private:
         if (vote == "ballot" && !ballotUsable)
             throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width of 4, 8, 16, 32 or "
                                "64 (this context: " + std::to_string(subgroupSize_) + ")");
-        perInvocation_ = p_.traversal == "invocation" ||
-                         (p_.traversal == "auto" && p_.twoPass && !(ballotUsable && subgroupSize_ >= 32));
+        if (p_.traversal == "packet" && !ballotUsable)
+            throw RuntimeError("ptsv: traversal = packet needs ARB_shader_ballot (this context: subgroup width " +
+                               std::to_string(subgroupSize_) + ")");
+        const bool narrow = p_.traversal == "auto" && p_.twoPass && !(ballotUsable && subgroupSize_ >= 32);
+        packet_ = p_.traversal == "packet" || (narrow && ballotUsable);
+        perInvocation_ = packet_ || p_.traversal == "invocation" || narrow;
         vote_ = perInvocation_ ? kVoteNone : vote != "shared" && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
         lanes_ = perInvocation_ ? 1 : p_.lanes != 0 ? p_.lanes : vote_ == kVoteBallot ? subgroupSize_ : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
@@ -345,6 +355,7 @@ private:
                                  {"PTSV_HEAT_MAP", flag(p_.heatMap)},
                                  {"PTSV_JOB_ITERATIONS", flag(p_.jobIterations)},
                                  {"PTSV_PER_INVOCATION", flag(perInvocation_)},
+                                 {"PTSV_PACKET", flag(packet_)},
                                  {"PTSV_BALLOT", flag(vote_ == kVoteBallot)},
                                  {"PTSV_LANES", std::to_string(lanes_)},
                                  {"PTSV_JOBS_PER_GROUP", std::to_string(jobsPerWorkgroup())}};
@@ -477,7 +488,8 @@ private:
     int subgroupSize_ = 0;
     Vote vote_ = kVoteShared;
     int lanes_ = 32; ///< invocations per traversal job (1 with traversal = invocation)
-    bool perInvocation_ = false; ///< traversal = invocation
+    bool perInvocation_ = false; ///< traversal = invocation (or packet, whose pass two is the same)
+    bool packet_ = false;        ///< traversal = packet: pass one walks a subgroup's triangles together
     bool fellBack_ = false; ///< ballots met subgroups of another width: shared votes from then on
     ptsv::KeyLayout layout_;
     std::array<float, 6> layoutKey_{};

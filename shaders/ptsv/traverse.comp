@@ -35,7 +35,7 @@
 // caps the loop iterations of one invocation at 65535 in total, so here a workgroup takes a fixed
 // batch of PTSV_JOBS_PER_GROUP consecutive jobs and the hardware scheduler hands out the batches;
 // a job cut short by such a cap is detected (a loop left without its exit condition) and reported.
-#if PTSV_BALLOT && !PTSV_PER_INVOCATION
+#if (PTSV_BALLOT && !PTSV_PER_INVOCATION) || PTSV_PACKET
 #extension GL_ARB_shader_ballot : require
 #extension GL_ARB_gpu_shader_int64 : require
 #endif
@@ -323,6 +323,88 @@ void traverse(int depth, uint id) {
     if (top >= depth) gTruncated = true;
 }
 
+#if PTSV_PACKET && PTSV_PASS == 1
+// Pass one as packets (traversal = packet): the invocations of a subgroup, each with a triangle of
+// its own (consecutive triangles: neighbours in the mesh, whose volumes take the same paths), walk
+// the hierarchy together. At a node every lane classifies the children for its own triangle, only
+// where its own volume reached the node; the packet then visits the union of the children its
+// lanes intersect. The lanes stay on one node, so the child loop has one length for all of them.
+
+// OR of x over the subgroup (every invocation must call it: its lanes read each other's x).
+uint orLanes(uint x) {
+    uint u = 0u;
+    for (uint l = 0u; l < gl_SubGroupSizeARB; ++l) u |= readInvocationARB(x, l);
+    return u;
+}
+
+// Tests the children of node (depth, id) for this lane's triangle where `live`; returns its
+// intersected ones (every invocation calls it: the child loop is the packet's).
+uint visitPacket(int depth, uint id, bool live) {
+    ++gIterations;
+    uint maskIndex = uMaskOffset[depth] + id;
+    uint mask = ptsvMaskAt(maskIndex);
+    uvec2 v = uvec2(0u);
+    for (uint m = mask; m != 0u; m &= m - 1u) {
+        uint c = uint(findLSB(m));
+        if (!live) continue;
+        bvec2 r = classify(id * 32u + c, depth + 1);
+        ++gNodeTests;
+        if (!r.x) v |= (r.y ? uvec2(0u, 1u) : uvec2(1u, 0u)) << c;
+    }
+    if (v.y != 0u) {
+        atomicAnd(ptsvMasks[maskIndex], ~v.y);
+        gAccepted += uint(bitCount(v.y));
+    }
+#if PTSV_TWO_PASS
+    // Children at the split depth become jobs, with one atomic per lane for all of its own; those a
+    // full list leaves out stay set, and the packet visits them itself.
+    if (depth + 1 == uSplitDepth && v.x != 0u) {
+        uint slot = atomicAdd(ptsvCounters[PTSV_C_JOBS_PUSHED], uint(bitCount(v.x)));
+        uint kept = 0u;
+        for (uint m = v.x; m != 0u; m &= m - 1u, ++slot) {
+            uint c = uint(findLSB(m));
+            if (slot < uJobCapacity) ptsvJobs[slot] = uvec2(gTriangle, id * 32u + c);
+            else kept |= 1u << c;
+        }
+        if (kept != 0u) atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], uint(bitCount(kept)));
+        v.x = kept;
+    }
+#endif
+    return v.x;
+}
+
+// The packet's depth-first walk from the root; `live`: this lane has a triangle.
+void traversePacket(bool live) {
+    uint own[PTSV_MAX_LEVELS], any[PTSV_MAX_LEVELS]; // this lane's children left; the packet's
+    int top = 0;
+    uint node = 0u;
+    own[0] = visitPacket(0, 0u, live);
+    any[0] = orLanes(own[0]);
+    while (true) {
+        while (top >= 0 && any[top] == 0u) {
+            --top;
+            node >>= 5u;
+        }
+        if (top < 0) break;
+        int c = findLSB(any[top]);
+        any[top] &= any[top] - 1u;
+        bool mine = ((own[top] >> uint(c)) & 1u) != 0u;
+        own[top] &= ~(1u << uint(c));
+        uint childId = node * 32u + uint(c);
+        int childDepth = top + 1;
+        if (childDepth == uLevels) {
+            if (mine) testSamples(childId);
+            continue;
+        }
+        top = childDepth;
+        node = childId;
+        own[top] = visitPacket(childDepth, childId, mine);
+        any[top] = orLanes(own[top]);
+    }
+    if (top >= 0) gTruncated = true;
+}
+#endif
+
 void loadTriangle(uint t) {
     gTriangle = t;
 #if PTSV_PASS == 2
@@ -375,7 +457,15 @@ void main() {
 #else
     uint count = min(ptsvCounters[PTSV_C_JOBS_PUSHED], uJobCapacity);
 #endif
-#if PTSV_PER_INVOCATION
+#if PTSV_PACKET && PTSV_PASS == 1
+    // Every invocation of a subgroup takes part in its packet's walk, with a triangle or without.
+    uint job = group * uint(PTSV_INVOCATION_GROUP) + gl_LocalInvocationIndex;
+    bool live = job < count && ptsvStatus(job) == PTSV_CASTER_OK;
+    if (live) loadTriangle(job);
+    gIterations = 0u;
+    traversePacket(live);
+    if (live) finishJob(job);
+#elif PTSV_PER_INVOCATION
     // One job per invocation (2D grid past 65535 groups).
     uint job = group * uint(PTSV_INVOCATION_GROUP) + gl_LocalInvocationIndex;
     if (job < count) runJob(job);
