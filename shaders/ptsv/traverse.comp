@@ -136,33 +136,28 @@ bool gTruncated = false; // a loop ended without its exit condition: the driver'
 
 // Classifies child `childId` at `depth` against the volume: x = rejected, y = trivially accepted.
 bvec2 classify(uint childId, int depth) {
-    vec2 r[4];
+    // Written out plane by plane, with no array and no loop: an indexed array or a loop with an
+    // early exit here made llvmpipe's code about 20 % slower on the peer scene (same work).
 #if PTSV_EXPLICIT_BOUNDS
     vec3 bmin, bmax;
     ptsvBoxAt(uNodeOffset[depth] + childId, bmin, bmax);
     float pad = uTolerance;
-    for (int i = 0; i < 4; ++i) r[i] = ptsvBoxRange(gPlane[i], bmin, bmax);
+#define PTSV_RANGE(i) ptsvBoxRange(gPlane[i], bmin, bmax)
 #else
     vec2 xr, yr, dr;
     ptsvImplicitExtent(childId, depth, xr, yr, dr);
     float pad = uTolerance + uImplicitPad;
-    for (int i = 0; i < 4; ++i) r[i] = ptsvFrustumRange(gView[i], xr, yr, dr);
+#define PTSV_RANGE(i) ptsvFrustumRange(gView[i], xr, yr, dr)
 #endif
-    bool rejected = false, accepted = true;
-    for (int i = 0; i < 4; ++i) {
-        rejected = rejected || r[i].x > pad;
-        accepted = accepted && r[i].y < -pad;
-    }
+    vec2 r0 = PTSV_RANGE(0), r1 = PTSV_RANGE(1), r2 = PTSV_RANGE(2), r3 = PTSV_RANGE(3);
+    bool rejected = max(max(r0.x, r1.x), max(r2.x, r3.x)) > pad;
+    bool accepted = max(max(r0.y, r1.y), max(r2.y, r3.y)) < -pad;
 #if PTSV_CULLING_PLANES
     // Only where the four planes decide nothing, as in the paper.
-    for (int i = 4; i < 7 && !rejected && !accepted; ++i) {
-#if PTSV_EXPLICIT_BOUNDS
-        rejected = ptsvBoxRange(gPlane[i], bmin, bmax).x > pad;
-#else
-        rejected = ptsvFrustumRange(gView[i], xr, yr, dr).x > pad;
+    if (!rejected && !accepted)
+        rejected = max(max(PTSV_RANGE(4).x, PTSV_RANGE(5).x), PTSV_RANGE(6).x) > pad;
 #endif
-    }
-#endif
+#undef PTSV_RANGE
     return bvec2(rejected, accepted && !rejected);
 }
 
