@@ -30,6 +30,8 @@
 //   no barrier, and nothing that depends on the subgroup width. On narrow subgroups (llvmpipe's 8
 //   lanes need 4 rounds per node, most of them on children that do not exist) it is the faster
 //   way; the images are the same.
+// PTSV_PACKET 1 (traversal = packet, with PTSV_PER_INVOCATION): in pass one the invocations of a
+//   subgroup, each with its own triangle, walk the union of their paths together (traversePacket).
 //
 // The paper runs persistent threads, each warp taking jobs from a queue until it is empty; llvmpipe
 // caps the loop iterations of one invocation at 65535 in total, so here a workgroup takes a fixed
