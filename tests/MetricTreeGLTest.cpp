@@ -7,6 +7,7 @@
 #include "algorithms/metric_tree/MetricTreeGpuLayout.h"
 #include "algorithms/metric_tree/MetricTreeMath.h"
 #include "framework/core/JsonNode.h"
+#include "framework/gl/Shader.h"
 #include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
 #include "tests/AlgorithmHarness.h"
@@ -256,6 +257,11 @@ TEST_F(MetricTreeGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
 // The tile query tests the clusters the per-pixel query would reach (and more), with the same cone
 // test, so the two give the same image; a tile whose list is full falls back to the per-pixel query.
 TEST_F(MetricTreeGLTest, TileQueryGivesThePixelQuerysImage) {
+    // tile = auto: one SIMD group's pixels, as wide as the context's subgroups (64 where unknown).
+    const int width = querySubgroupSize();
+    const double autoPixels = width == 8 || width == 16 || width == 32 ? width : 64;
+    EXPECT_EQ(run(engine(), {}, false).counters["tile_pixels"], autoPixels);
+    EXPECT_EQ(run(engine(), {{"query", std::string("pixel")}}, false).counters["tile_pixels"], 0.0);
     for (Shot (*make)() : {engine, fenceDirectional, omniInsideShell}) {
         const Shot s = make();
         Outcome pixel = run(s, {{"query", std::string("pixel")}}, false);
