@@ -74,7 +74,19 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                 "with Yianilos pivots (the paper's Table 2 reference, slow)",
                 ParamChange::Update)
         .apply(stackSizeRow(&P::stackSize, 64))
-        .apply(tileQueryRows(&P::query, &P::tile, &P::tileCandidates, "clusters"))
+        .choice("query", &P::query, "tile", {"pixel", "tile"},
+                "pixel: every pixel walks the tree (paper 5.4); tile: a tile of pixels walks it once with the cap "
+                "enclosing its points, and each pixel tests the clusters the walk gathered with the per-pixel "
+                "query's own tests (the same image; no divergent walk)",
+                ParamChange::Recompile)
+        .choice("tile", &P::tile, "auto", {"auto", "4x2", "8x2", "8x4", "8x8"},
+                "tile query: the pixels that share one walk; auto = one SIMD group's (subgroup width 8: 4x2, 16: 8x2, "
+                "32: 8x4, else 8x8), so that all its lanes run one list",
+                ParamChange::Recompile)
+        .integer("tile_candidates", &P::tileCandidates, 512, 16, 512, "clusters",
+                 "tile query: most clusters one tile's list holds; a tile that gathers more falls back to the "
+                 "per-pixel query (counter tile_fallbacks)",
+                 ParamChange::Recompile)
         .apply(cacheRow(&P::cache, "metric_tree"))
         .apply(rayOffsetRow(&P::rayOffset))
         // The paper's answer to rigid motion: clusters never span two moving parts, and each moves
@@ -302,7 +314,7 @@ private:
                                        {"MT_STACK_SIZE", std::to_string(p_.stackSize)},
                                        {"MT_QUERY_TILE", flag(p_.query == "tile")},
                                        {"MT_TILE_CANDIDATES", std::to_string(p_.tileCandidates)},
-                                       {"MT_TILE_PIXELS", std::to_string(tilePixels(p_.tile, subgroupSize_))},
+                                       {"MT_TILE_PIXELS", std::to_string(tilePixels())},
                                        {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
                                        instrumentationDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
@@ -310,8 +322,14 @@ private:
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
     }
 
+    /// Pixels per tile of the tile query: "WxH" -> W * H; auto -> the subgroup width where it is 8,
+    /// 16 or 32 (a tile is that many consecutive invocations, shaders/common/pixel_order.glsl), else 64.
+    int tilePixels() const {
+        if (p_.tile != "auto") return (p_.tile[0] - '0') * (p_.tile[2] - '0');
+        return subgroupSize_ == 8 || subgroupSize_ == 16 || subgroupSize_ == 32 ? subgroupSize_ : 64;
+    }
     /// The counter tile_pixels: pixels per tile, 0 with the per-pixel query.
-    double tileQueryPixels() const { return p_.query == "tile" ? double(tilePixels(p_.tile, subgroupSize_)) : 0.0; }
+    double tileQueryPixels() const { return p_.query == "tile" ? double(tilePixels()) : 0.0; }
 
     mt::ClusteringOptions clusteringOptions() const {
         mt::ClusteringOptions o;

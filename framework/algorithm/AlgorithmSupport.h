@@ -41,13 +41,6 @@ inline std::pair<std::string, std::string> instrumentationDefine(const Algorithm
     return {"SHADOWLAB_INSTRUMENTATION", o.instrumentation ? "1" : "0"};
 }
 
-/// Pixels per tile of a tile query (tileQueryRows): "WxH" -> W * H; "auto" -> the subgroup width
-/// where it is 8, 16 or 32 (a tile is that many consecutive invocations), else 64.
-inline int tilePixels(const std::string& tile, int subgroupSize) {
-    if (tile != "auto") return (tile[0] - '0') * (tile[2] - '0');
-    return subgroupSize == 8 || subgroupSize == 16 || subgroupSize == 32 ? subgroupSize : 64;
-}
-
 /// Per-pixel passes read the G-buffer's world position (texture unit 0) and camera-facing normal
 /// (unit 1) and write visibility to image unit 0 (R32F); units above are the algorithm's own.
 inline void bindPixelPassInputs(const FrameInputs& f) {

@@ -38,28 +38,6 @@ template <class T> auto stackSizeRow(int T::*member, int def) {
     };
 }
 
-/// `query`, `tile`, `tile_candidates`: the per-pixel query of a tree, or the tile query (a tile of
-/// pixels walks the tree once with a bound of all its points, then each pixel tests the list it
-/// gathered; shaders/common/pixel_order.glsl numbers the tiles). `unit`: what the list holds.
-template <class T>
-auto tileQueryRows(std::string T::*query, std::string T::*tile, int T::*candidates, const std::string& unit) {
-    return [=](ParamStruct<T>& s) {
-        s.choice("query", query, "tile", {"pixel", "tile"},
-                 "pixel: every pixel walks the tree (the paper's query); tile: a tile of pixels walks it once with a "
-                 "bound of all its points, and each pixel tests the " + unit + " the walk gathered with the per-pixel "
-                 "query's own tests (the same image; no divergent walk)",
-                 ParamChange::Recompile);
-        s.choice("tile", tile, "auto", {"auto", "4x2", "8x2", "8x4", "8x8"},
-                 "tile query: the pixels that share one walk; auto = one SIMD group's (subgroup width 8: 4x2, 16: 8x2, "
-                 "32: 8x4, else 8x8), so that all its lanes run one list",
-                 ParamChange::Recompile);
-        s.integer("tile_candidates", candidates, 512, 16, 512, unit,
-                  "tile query: most " + unit + " one tile's list holds; a tile that gathers more falls back to the "
-                  "per-pixel query (counter tile_fallbacks)",
-                  ParamChange::Recompile);
-    };
-}
-
 /// `cache`: reuse the algorithm's per-scene preprocessing from the disk cache
 /// ($XDG_CACHE_HOME or ~/.cache, /shadowlab/<folder>), keyed and checked by the scene's content.
 template <class T> auto cacheRow(bool T::*member, const std::string& folder) {

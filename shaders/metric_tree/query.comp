@@ -106,6 +106,20 @@ bool mtHitTriangle(vec3 o, vec3 d, float tMax, vec3 v0, vec3 v1, vec3 v2) {
     return t > 0.0 && t < tMax;
 }
 
+// Whether the shadow ray (q + t dir, t in (0, tMax)) crosses the slab between the cluster's two
+// planes (paper step 2); always with slabs off.
+bool mtCrossesSlabs(MtCluster c, vec3 q, vec3 dir, float tMax) {
+#if MT_SLABS
+    float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
+    float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
+    float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
+    float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
+    return sFar >= lo && sNear <= hi;
+#else
+    return true;
+#endif
+}
+
 struct Result {
     float visibility;
     uint visited, triangles, fruitless, coneHits, slabRejects, depthSkips;
@@ -150,16 +164,8 @@ Result query(vec3 q) {
             if (dq <= n.a.w + uLsEps) { // inside the cone or capsule-cone: the cluster may occlude q
                 ++r.coneHits;
                 MtCluster c = mtCluster(node);
-                bool test = true;
-#if MT_SLABS
-                // The shadow ray must cross the slab between the cluster's two planes (paper step 2).
-                float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
-                float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
-                float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
-                float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
-                test = sFar >= lo && sNear <= hi;
+                bool test = mtCrossesSlabs(c, q, dir, tMax);
                 if (!test) ++r.slabRejects;
-#endif
                 if (test) { triangle = c.first; trianglesEnd = c.first + c.count; }
             }
             uint follow = dq <= n.b.w ? n.child[MT_CHILD_NEAR] : n.child[MT_CHILD_FAR];
@@ -213,13 +219,7 @@ bool testCluster(uint node, vec3 q, vec3 p, vec3 dir, float tMax, inout Result r
     if (mtPointDist(p, a.xyz, b.xyz) > a.w + uLsEps) return false; // outside this pixel's cone
     ++r.coneHits;
     MtCluster c = mtCluster(node);
-#if MT_SLABS
-    float s0 = dot(c.axis.xyz, q), ds = dot(c.axis.xyz, dir);
-    float lo = c.axis.w - uSlabTolerance, hi = c.slabMax + uSlabTolerance;
-    float sNear = ds >= 0.0 ? s0 : (tMax == kMtInf ? -kMtInf : s0 + ds);
-    float sFar = ds >= 0.0 ? (tMax == kMtInf ? (ds > 0.0 ? kMtInf : s0) : s0 + ds) : s0;
-    if (!(sFar >= lo && sNear <= hi)) { ++r.slabRejects; return false; }
-#endif
+    if (!mtCrossesSlabs(c, q, dir, tMax)) { ++r.slabRejects; return false; }
     bool hit = false;
     for (uint tri = c.first; tri < c.first + c.count && !hit; ++tri) {
         ++r.triangles;

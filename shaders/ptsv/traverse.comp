@@ -220,7 +220,8 @@ void testSamples(uint key) {
 }
 
 // Tests the children of node (depth, id); returns the intersected ones, clears the accepted ones.
-uint visit(int depth, uint id) {
+// `live` false (a packet lane whose own volume missed the node, one job per invocation only): none.
+uint visit(int depth, uint id, bool live) {
     ++gIterations;
     uint maskIndex = uMaskOffset[depth] + id;
     uint mask = ptsvMaskAt(maskIndex);
@@ -229,6 +230,7 @@ uint visit(int depth, uint id) {
     // The existing children in turn (about 9 of 32 on the peer scene).
     for (uint m = mask; m != 0u; m &= m - 1u) {
         uint c = uint(findLSB(m));
+        if (!live) continue; // inside the loop: faster on llvmpipe than around the call (packets)
         bvec2 r = classify(id * 32u + c, depth + 1);
         ++gNodeTests;
         if (!r.x) v |= (r.y ? uvec2(0u, 1u) : uvec2(1u, 0u)) << c;
@@ -283,7 +285,7 @@ void traverse(int depth, uint id) {
     uint stackMask[PTSV_MAX_LEVELS];
     int top = depth;
     uint node = id; // visited at depth top; node ids are key prefixes, so its parent is node >> 5
-    stackMask[top] = visit(depth, id);
+    stackMask[top] = visit(depth, id, true);
     while (true) {
         while (top >= depth && stackMask[top] == 0u) { // deepest level with children left
             --top;
@@ -315,7 +317,7 @@ void traverse(int depth, uint id) {
         }
         top = childDepth;
         node = childId;
-        stackMask[top] = visit(childDepth, childId);
+        stackMask[top] = visit(childDepth, childId, true);
     }
     if (top >= depth) gTruncated = true;
 }
@@ -334,48 +336,13 @@ uint orLanes(uint x) {
     return u;
 }
 
-// Tests the children of node (depth, id) for this lane's triangle where `live`; returns its
-// intersected ones (every invocation calls it: the child loop is the packet's).
-uint visitPacket(int depth, uint id, bool live) {
-    ++gIterations;
-    uint maskIndex = uMaskOffset[depth] + id;
-    uint mask = ptsvMaskAt(maskIndex);
-    uvec2 v = uvec2(0u);
-    for (uint m = mask; m != 0u; m &= m - 1u) {
-        uint c = uint(findLSB(m));
-        if (!live) continue;
-        bvec2 r = classify(id * 32u + c, depth + 1);
-        ++gNodeTests;
-        if (!r.x) v |= (r.y ? uvec2(0u, 1u) : uvec2(1u, 0u)) << c;
-    }
-    if (v.y != 0u) {
-        atomicAnd(ptsvMasks[maskIndex], ~v.y);
-        gAccepted += uint(bitCount(v.y));
-    }
-#if PTSV_TWO_PASS
-    // Children at the split depth become jobs, with one atomic per lane for all of its own; those a
-    // full list leaves out stay set, and the packet visits them itself.
-    if (depth + 1 == uSplitDepth && v.x != 0u) {
-        uint slot = atomicAdd(ptsvCounters[PTSV_C_JOBS_PUSHED], uint(bitCount(v.x)));
-        uint kept = 0u;
-        for (uint m = v.x; m != 0u; m &= m - 1u, ++slot) {
-            uint c = uint(findLSB(m));
-            if (slot < uJobCapacity) ptsvJobs[slot] = uvec2(gTriangle, id * 32u + c);
-            else kept |= 1u << c;
-        }
-        if (kept != 0u) atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], uint(bitCount(kept)));
-        v.x = kept;
-    }
-#endif
-    return v.x;
-}
-
 // The packet's depth-first walk from the root; `live`: this lane has a triangle.
 void traversePacket(bool live) {
     uint own[PTSV_MAX_LEVELS], any[PTSV_MAX_LEVELS]; // this lane's children left; the packet's
     int top = 0;
     uint node = 0u;
-    own[0] = visitPacket(0, 0u, live);
+    // A lane classifies only where its own volume reached (visit()'s `live`).
+    own[0] = visit(0, 0u, live);
     any[0] = orLanes(own[0]);
     while (true) {
         while (top >= 0 && any[top] == 0u) {
@@ -395,7 +362,7 @@ void traversePacket(bool live) {
         }
         top = childDepth;
         node = childId;
-        own[top] = visitPacket(childDepth, childId, mine);
+        own[top] = visit(childDepth, childId, mine);
         any[top] = orLanes(own[top]);
     }
     if (top >= 0) gTruncated = true;
