@@ -1,5 +1,6 @@
 #include "framework/core/JsonNode.h"
 
+#include "framework/core/FileIO.h"
 #include "framework/core/JsonParse.h"
 
 #include <cmath>
@@ -39,16 +40,7 @@ Json parseJsonOrString(const std::string& text) {
     }
 }
 
-Json JsonNode::parseFile(const std::string& file) {
-    std::error_code ec;
-    if (fs::is_directory(file, ec)) throw InputError(file, "", "is a directory, not a JSON file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(file, "", "cannot open file");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    if (!in && !in.eof()) throw InputError(file, "", "cannot read file");
-    return parseJson(ss.str(), file);
-}
+Json JsonNode::parseFile(const std::string& file) { return parseJson(readInputFile(file), file); }
 
 bool JsonNode::has(const std::string& key) const { return value_->contains(key); }
 

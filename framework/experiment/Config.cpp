@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 namespace shadowlab {
@@ -108,22 +109,58 @@ static void followPath(const Path& path, int frame, int frames, glm::vec3& posit
     target = s.target;
 }
 
-/// Moving parts stay within the coordinates every other input is held to (±kMaxCoordinate) on every
-/// frame the experiment samples: paths and animations compose, so a part checked at rest can still
-/// leave float range (or reach infinity) at another time.
-void checkPoseBounds(const ExperimentConfig& c, int frame, const Bounds& b) {
+/// Whether a box lies within ±kMaxCoordinate. Written as !(|x| <= limit) so that a NaN, for which
+/// every comparison is false, fails it too.
+static bool withinCoordinates(const Bounds& b) {
     for (int a = 0; a < 3; ++a)
-        if (!(std::abs(double(b.min[a])) <= kMaxCoordinate && std::abs(double(b.max[a])) <= kMaxCoordinate))
-            throw InputError(c.file, "/scene", "moving objects reach beyond ±1e15 scene units at frame " + std::to_string(frame) +
-                                                   " (check the paths' translate and scale)");
+        if (!(std::abs(double(b.min[a])) <= kMaxCoordinate && std::abs(double(b.max[a])) <= kMaxCoordinate)) return false;
+    return true;
 }
 
+static std::string frameText(const ExperimentConfig& c, int frame) {
+    char time[32];
+    std::snprintf(time, sizeof time, "%.6g", c.sceneTimeAt(frame));
+    return "frame " + std::to_string(frame) + " (time " + time + " s)";
+}
+
+/// Moving parts stay within the coordinates every other input is held to (±kMaxCoordinate) on every
+/// frame the experiment samples: paths and animations compose, so a part checked at rest can still
+/// leave float range (or reach infinity or NaN) at another time.
+void checkPoseBounds(const ExperimentConfig& c, int frame, const Bounds& b) {
+    if (!withinCoordinates(b))
+        throw InputError(c.file, "/scene", "moving objects reach beyond ±1e15 scene units (or a non-finite position) at " +
+                                               frameText(c, frame) + " (check the paths' translate and scale)");
+}
+
+/// Every frame's pose, before anything is rendered: a pose that is not finite, or a part that leaves
+/// the coordinate range, is an error naming where its motion was given (the config's path, or the
+/// glTF file's node or animation channel) and the frame, instead of a part that silently vanishes.
 static void checkPoses(const ExperimentConfig& c) {
     // Every frame of any experiment one would run; a million-frame config is checked at 10,000
     // frames spread over it here, and the runner checks each frame's pose again as it goes.
     const int step = std::max(1, c.frames / 10000);
+    const Scene& scene = *c.scene;
     for (int f = 0;; f = std::min(f + step, c.frames - 1)) {
-        checkPoseBounds(c, f, c.scene->boundsAt(c.scene->poseAt(c.sceneTimeAt(f))));
+        std::vector<glm::mat4> pose;
+        try {
+            pose = scene.poseAt(c.sceneTimeAt(f));
+        } catch (const InputError& e) {
+            throw InputError(e.file(), e.jsonPath(), e.cause() + ", " + frameText(c, f));
+        }
+        for (size_t p = 0; p < scene.moving.size(); ++p) {
+            const MovingPart& part = scene.moving[p];
+            Bounds b;
+            for (int k = 0; k < 8; ++k) {
+                const glm::vec3 corner((k & 1) ? part.localMax.x : part.localMin.x, (k & 2) ? part.localMax.y : part.localMin.y,
+                                       (k & 4) ? part.localMax.z : part.localMin.z);
+                b.extend(glm::vec3(pose[p] * glm::vec4(corner, 1.0f)));
+            }
+            if (!withinCoordinates(b))
+                throw InputError(part.sourceFile.empty() ? c.file : part.sourceFile, part.sourcePath.empty() ? "/scene" : part.sourcePath,
+                                 "the moving object reaches beyond ±1e15 scene units (or a non-finite position) at " +
+                                     frameText(c, f) + " (check its translate and scale)");
+        }
+        checkPoseBounds(c, f, scene.boundsAt(pose));
         if (f == c.frames - 1) break;
     }
 }
@@ -144,6 +181,25 @@ double ExperimentConfig::sceneTimeAt(int frame) const {
     return range.x + (range.y - range.x) * double(frame) / double(frames - 1);
 }
 
+const char* toString(ExperimentConfig::Statistics s) {
+    switch (s) {
+    case ExperimentConfig::Statistics::All: return "all";
+    case ExperimentConfig::Statistics::None: return "none";
+    default: return "images";
+    }
+}
+
+std::vector<int> ExperimentConfig::statisticsFrames() const {
+    std::vector<int> out;
+    if (statistics == Statistics::All)
+        for (int f = 0; f < frames; ++f) out.push_back(f);
+    else if (statistics == Statistics::Images)
+        out = imagesAtFrames;
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
 Light ExperimentConfig::lightAt(int frame) const {
     Light l = light;
     followPath(lightPath, frame, frames, l.position, l.target);
@@ -159,7 +215,14 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     c.resolution = root.getIVec2("resolution", {256, 256}, 8, 8192);
     c.frames = root.getInt("frames", 30, 1, 1000000);
     c.warmupFrames = root.getInt("warmup_frames", 3, 0, 1000);
-    c.timingMode = root.getBool("timing_mode", false);
+    // Timing is honest by construction: the timed frames never carry instrumentation, so the
+    // former switch between instrumented and uninstrumented timing is gone, not ignored.
+    if (root.has("timing_mode"))
+        root.fail("timing_mode", "was removed: timed frames always run with statistics compiled out; counters and heat maps "
+                                 "come from an untimed pass chosen by \"statistics\": \"images\" (default), \"all\" or \"none\"");
+    const std::string stats = root.getEnum("statistics", "images", {"images", "all", "none"});
+    c.statistics = stats == "all" ? ExperimentConfig::Statistics::All
+                 : stats == "none" ? ExperimentConfig::Statistics::None : ExperimentConfig::Statistics::Images;
 
     if (!root.has("scene")) root.fail("scene", "required key is missing");
     JsonNode sceneNode = root.child("scene");

@@ -27,8 +27,10 @@ struct ExperimentConfig {
     glm::ivec2 resolution{256, 256};
     int frames = 30;
     int warmupFrames = 3;
-    /// Statistics compiled out of the timed shaders (AlgorithmOptions::instrumentation off).
-    bool timingMode = false;
+    /// Which frames the untimed statistics pass runs on (counters, heat maps). Timed frames always
+    /// run with the statistics compiled out (AlgorithmOptions::instrumentation off).
+    enum class Statistics { Images, All, None };
+    Statistics statistics = Statistics::Images;
 
     std::shared_ptr<Scene> scene;
     Camera camera;               ///< fov/near/far, and the static pose when there is no path
@@ -51,7 +53,10 @@ struct ExperimentConfig {
     /// camera path's times, else the light path's, else the span of the scene's own motion.
     double sceneTimeAt(int frame) const;
     Light lightAt(int frame) const;
+    /// The frames of the statistics pass, in order: images_at_frames, every frame, or none.
+    std::vector<int> statisticsFrames() const;
 };
+const char* toString(ExperimentConfig::Statistics s);
 
 /// InputError unless the scene posed for `frame` (its bounds `b`) lies within ±1e15 scene units.
 void checkPoseBounds(const ExperimentConfig& config, int frame, const Bounds& b);

@@ -24,16 +24,6 @@ Stats computeStats(std::vector<double> v) {
     return s;
 }
 
-void writeFileAtomic(const std::string& path, const std::string& text) {
-    std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        if (!out) throw RuntimeError("cannot write " + tmp);
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) throw RuntimeError("cannot rename " + tmp + " to " + path);
-}
-
 static std::string num(double v) {
     std::ostringstream os;
     os << std::setprecision(6) << v;
@@ -45,9 +35,9 @@ namespace {
 /// Every stage any frame ran, in the order they run ("total" last): stages that run only on some
 /// frames (a refit when parts moved) count as taking 0 ms on the others, so each stage's statistics
 /// are per frame, like the total they add up to.
-std::vector<std::string> stageOrder(const AlgorithmResults& a) {
+std::vector<std::string> stageOrder(const std::vector<FrameRecord>& frames) {
     std::vector<std::string> order;
-    for (const auto& f : a.frames)
+    for (const auto& f : frames)
         for (size_t i = 0; i < f.stages.size(); ++i) {
             const std::string& name = f.stages[i].name;
             if (std::find(order.begin(), order.end(), name) != order.end()) continue;
@@ -64,17 +54,18 @@ std::vector<std::string> stageOrder(const AlgorithmResults& a) {
 
 } // namespace
 
-void ExperimentResults::writeFramesCsv(const std::string& path) const {
+void ExperimentResults::writeFramesCsv(const std::string& path, bool statisticsPass) const {
+    auto framesOf = [&](const AlgorithmResults& a) -> const std::vector<FrameRecord>& { return statisticsPass ? a.statistics : a.frames; };
     std::set<std::string> counterNames;
     for (const auto& a : algorithms)
-        for (const auto& f : a.frames)
+        for (const auto& f : framesOf(a))
             for (const auto& [k, v] : f.counters) counterNames.insert(k);
     std::ostringstream os;
     os << "id,algorithm,frame,stage,gpu_ms,cpu_ms,mismatch_ratio,false_lit,false_shadowed,rmse,overflow";
     for (const auto& c : counterNames) os << "," << c;
     os << "\n";
     for (const auto& a : algorithms)
-        for (const auto& f : a.frames)
+        for (const auto& f : framesOf(a))
             for (const auto& s : f.stages) {
                 os << a.id << "," << a.algorithm << "," << f.frame << "," << s.name << ","
                    << (s.gpuMs >= 0 ? num(s.gpuMs) : "") << "," << num(s.cpuMs);
@@ -95,28 +86,53 @@ void ExperimentResults::writeFramesCsv(const std::string& path) const {
     writeFileAtomic(path, os.str());
 }
 
+namespace {
+
+/// time_ms and cpu_time_ms of a pass: GPU time where the stage has it (timer queries) and they can
+/// be trusted (`gpuTimes`), else the stage's CPU/wall time; "total" is the wall-clock time of the
+/// whole visibility computation, GPU finished.
+std::pair<Json, Json> stageTimes(const std::vector<FrameRecord>& frames, bool gpuTimes) {
+    const std::vector<std::string> order = stageOrder(frames);
+    std::map<std::string, std::vector<double>> gpu, cpu;
+    for (const auto& f : frames)
+        for (const auto& name : order) {
+            auto s = std::find_if(f.stages.begin(), f.stages.end(), [&](const StageTime& t) { return t.name == name; });
+            if (s == f.stages.end()) {  // did not run this frame: it cost nothing
+                cpu[name].push_back(0.0);
+                if (gpu.count(name)) gpu[name].push_back(0.0);
+                continue;
+            }
+            cpu[name].push_back(s->cpuMs);
+            if (s->gpuMs >= 0) gpu[name].push_back(s->gpuMs);
+        }
+    Json time = Json::object(), cpuTime = Json::object();
+    for (const auto& name : order) {
+        bool useGpu = gpuTimes && name != "total" && gpu.count(name) && gpu[name].size() == cpu[name].size();
+        time[name] = computeStats(useGpu ? gpu[name] : cpu[name]).toJson();
+        cpuTime[name] = computeStats(cpu[name]).toJson();
+    }
+    return {time, cpuTime};
+}
+
+Json counterStats(const std::vector<FrameRecord>& frames) {
+    std::map<std::string, std::vector<double>> counters;
+    for (const auto& f : frames)
+        for (const auto& [k, v] : f.counters) counters[k].push_back(v);
+    Json cj = Json::object();
+    for (const auto& [k, v] : counters) cj[k] = computeStats(v).toJson();
+    return cj;
+}
+
+} // namespace
+
 Json ExperimentResults::summary() const {
     Json out = meta;
     Json algs = Json::object();
+    const bool gpuTimes = meta.value("stage_time_source", std::string("gpu")) == "gpu";
     for (const auto& a : algorithms) {
-        std::map<std::string, std::vector<double>> gpu, cpu;
-        std::vector<std::string> order;
-        std::map<std::string, std::vector<double>> counters;
         std::vector<double> mismatch, falseLit, falseShadowed, rmse;
         uint64_t overflow = 0;
-        order = stageOrder(a);
         for (const auto& f : a.frames) {
-            for (const auto& name : order) {
-                auto s = std::find_if(f.stages.begin(), f.stages.end(), [&](const StageTime& t) { return t.name == name; });
-                if (s == f.stages.end()) {  // did not run this frame: it cost nothing
-                    cpu[name].push_back(0.0);
-                    if (gpu.count(name)) gpu[name].push_back(0.0);
-                    continue;
-                }
-                cpu[name].push_back(s->cpuMs);
-                if (s->gpuMs >= 0) gpu[name].push_back(s->gpuMs);
-            }
-            for (const auto& [k, v] : f.counters) counters[k].push_back(v);
             if (f.hasAccuracy) {
                 mismatch.push_back(f.accuracy.mismatchRatio);
                 falseLit.push_back(f.accuracy.falseLit);
@@ -129,16 +145,8 @@ Json ExperimentResults::summary() const {
         j["algorithm"] = a.algorithm;
         j["params"] = a.params;
         j["preprocess_ms"] = a.preprocessMs;
-        // time_ms: GPU time where the stage has it (timer queries) and they can be trusted
-        // (stage_time_source "gpu"), else the stage's CPU/wall time; "total" is the wall-clock time
-        // of the whole visibility computation, GPU finished.
-        const bool gpuTimes = meta.value("stage_time_source", std::string("gpu")) == "gpu";
-        Json time = Json::object(), cpuTime = Json::object();
-        for (const auto& name : order) {
-            bool useGpu = gpuTimes && name != "total" && gpu.count(name) && gpu[name].size() == cpu[name].size();
-            time[name] = computeStats(useGpu ? gpu[name] : cpu[name]).toJson();
-            cpuTime[name] = computeStats(cpu[name]).toJson();
-        }
+        // Times, accuracy and overflow come from the timed pass, in which no statistics are gathered.
+        auto [time, cpuTime] = stageTimes(a.frames, gpuTimes);
         j["time_ms"] = time;
         j["cpu_time_ms"] = cpuTime;
         if (!mismatch.empty()) {
@@ -153,9 +161,25 @@ Json ExperimentResults::summary() const {
         } else {
             j["accuracy"] = nullptr;  // no reference, or no frame with a lit pixel to compare
         }
-        Json cj = Json::object();
-        for (const auto& [k, v] : counters) cj[k] = computeStats(v).toJson();
-        j["counters"] = cj;
+        // Counters: the statistics pass's where it ran (they need the instrumented shaders); else the
+        // timed pass's, which hold only what stays measured there (overflow, errors, structure sizes).
+        const bool fromStatistics = !a.statistics.empty();
+        j["counters"] = counterStats(fromStatistics ? a.statistics : a.frames);
+        j["counters_source"] = fromStatistics ? "statistics_pass" : "timed_pass";
+        if (fromStatistics) {
+            Json frames = Json::array();
+            uint64_t statOverflow = 0;
+            for (const auto& f : a.statistics) {
+                frames.push_back(f.frame);
+                statOverflow += f.overflow;
+            }
+            auto [statTime, statCpu] = stageTimes(a.statistics, gpuTimes);
+            (void)statCpu;
+            j["statistics_pass"] = {{"frames", frames},
+                                    {"time_ms", statTime},
+                                    {"overflow", statOverflow},
+                                    {"visibility_differs_frames", a.visibilityDiffers}};
+        }
         j["memory_bytes"] = a.memoryBytes;
         j["overflow"] = overflow;
         algs[a.id] = j;
@@ -181,13 +205,15 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
         os << "## Time per frame (ms; GPU timer queries where the stage runs on the GPU, CPU time otherwise)\n\n";
     else
         os << "## Time per frame (ms; wall clock of each stage run to completion: this renderer's timer queries are unreliable)\n\n";
+    os << "Timed pass: every frame, statistics compiled out of the shaders (counters, heat maps and their atomics "
+          "are gathered in a separate, untimed pass below).\n\n";
     os << "| id | algorithm | stage | mean | min | max | median |\n|---|---|---|---:|---:|---:|---:|\n";
     for (const auto& a : algorithms) {
         const Json& j = s["algorithms"][a.id];
         os << "| " << a.id << " | " << a.algorithm << " | preprocess | " << std::setprecision(2) << j["preprocess_ms"].get<double>()
            << " | | | |\n";
         // Stages in the order the algorithm ran them (JSON objects sort their keys).
-        for (const auto& stage : stageOrder(a)) {
+        for (const auto& stage : stageOrder(a.frames)) {
             const Json& st = j["time_ms"][stage];
             os << "| " << a.id << " | " << a.algorithm << " | " << (stage == "total" ? "**total**" : stage) << " | "
                << std::setprecision(3) << st["mean"].get<double>() << " | " << st["min"].get<double>() << " | "
@@ -203,11 +229,23 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
            << 100.0 * acc["mismatch_ratio_max"].get<double>() << " % | " << 100.0 * acc["false_lit"].get<double>() << " % | "
            << 100.0 * acc["false_shadowed"].get<double>() << " % | " << std::setprecision(5) << acc["rmse"].get<double>() << " |\n";
     }
-    os << "\n## Memory and counters\n\n| id | memory (MiB) | overflow | counters (mean / max) |\n|---|---:|---:|---|\n";
+    os << "\n## Memory and counters\n\n";
+    const Json& statFrames = s.value("statistics_frames", Json::array());
+    if (statFrames.empty())
+        os << "No statistics pass (`statistics: none`): the counters are the timed pass's, which keep only what stays "
+              "measured without instrumentation (overflow, errors, structure sizes).\n\n";
+    else
+        os << "Counters from the untimed statistics pass (instrumented shaders) over frame" << (statFrames.size() > 1 ? "s " : " ")
+           << statFrames.dump() << "; *instrumented total* is that pass's mean frame time, shown only to tell what "
+              "instrumentation costs. Memory and overflow from the timed pass.\n\n";
+    os << "| id | memory (MiB) | overflow | timed total (ms) | instrumented total (ms) | counters (mean / max) |\n"
+          "|---|---:|---:|---:|---:|---|\n";
     for (const auto& a : algorithms) {
         const Json& j = s["algorithms"][a.id];
         os << "| " << a.id << " | " << std::setprecision(2) << double(j["memory_bytes"].get<size_t>()) / (1024.0 * 1024.0)
-           << " | " << j["overflow"] << " | ";
+           << " | " << j["overflow"] << " | " << std::setprecision(3) << j["time_ms"]["total"]["mean"].get<double>() << " | ";
+        if (j.contains("statistics_pass")) os << j["statistics_pass"]["time_ms"]["total"]["mean"].get<double>();
+        os << " | ";
         bool first = true;
         for (const auto& [k, v] : j["counters"].items()) {
             os << (first ? "" : "; ") << k << " " << std::setprecision(3) << v["mean"].get<double>() << " / " << v["max"].get<double>();

@@ -1,6 +1,7 @@
 #pragma once
 // Per-frame measurements of an experiment and the files made from them: frames.csv,
 // summary.json and report.md.
+#include "framework/core/FileIO.h"
 #include "framework/core/JsonNode.h"
 #include "framework/gl/StageTimer.h"
 #include "framework/metrics/Accuracy.h"
@@ -25,7 +26,13 @@ struct AlgorithmResults {
     Json params;
     double preprocessMs = 0;
     size_t memoryBytes = 0;
-    std::vector<FrameRecord> frames;
+    std::vector<FrameRecord> frames;      ///< the timed pass: statistics compiled out, every frame
+    /// The untimed statistics pass (instrumented shaders) over ExperimentConfig::statisticsFrames():
+    /// its counters are the ones reported; its times only show what instrumentation costs.
+    std::vector<FrameRecord> statistics;
+    /// Frames of the statistics pass whose visibility differed from the timed pass's (it must not:
+    /// instrumentation only counts), for the summary's warning.
+    std::vector<int> visibilityDiffers;
 };
 
 struct Stats {
@@ -38,12 +45,11 @@ struct ExperimentResults {
     Json meta; ///< name, renderer, resolution, triangles, ... (copied into summary.json)
     std::vector<AlgorithmResults> algorithms;
 
-    void writeFramesCsv(const std::string& path) const;
+    /// frames.csv (the timed pass) or, with `statisticsPass`, statistics.csv (the statistics pass).
+    void writeFramesCsv(const std::string& path, bool statisticsPass = false) const;
     Json summary() const;
     void writeReport(const std::string& path, const Json& summary) const;
 };
 
-/// Writes `text` to `path` through a temporary file and a rename, so a reader never sees half a file.
-void writeFileAtomic(const std::string& path, const std::string& text);
 
 } // namespace shadowlab

@@ -7,12 +7,14 @@
 #include "framework/experiment/Progress.h"
 #include "framework/gl/GlContext.h"
 #include "framework/gl/Shader.h"
-#include "framework/metrics/Images.h"
+#include "framework/experiment/FrameImages.h"
 #include "framework/render/ShadingPass.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
+#include <map>
 #include <filesystem>
 #include <optional>
 
@@ -29,21 +31,27 @@ struct Instance {
     const AlgorithmEntry* entry;
     std::unique_ptr<AlgorithmHost> host;
     AlgorithmResults results;
+    std::map<int, uint64_t> timedVisibility; ///< frame → visibilityHash, on the statistics frames
 };
 
-void writeImages(const std::string& dir, const std::string& id, int frame, glm::ivec2 res, ShadingPass& shading,
-                 const std::vector<float>& vis, const std::vector<float>* ref, const std::vector<uint8_t>& lit,
-                 const std::vector<uint8_t>& covered, const ShadowAlgorithm& algorithm) {
-    char tag[32];
-    std::snprintf(tag, sizeof tag, "_f%04d_", frame);
-    std::string base = dir + "/images/" + id + tag;
-    writePngRGBA(base + "shaded.png", res.x, res.y, readTextureRGBA8(shading.output(), res.x, res.y));
-    writePngRGBA(base + "visibility.png", res.x, res.y, visibilityImage(vis, covered));
-    if (ref) writePngRGBA(base + "diff.png", res.x, res.y, differenceImage(vis, *ref, lit));
-    for (const DebugView& view : algorithm.debugViews()) {
-        auto values = readTextureR32F(view.texture, res.x, res.y);
-        writePngRGBA(base + "heat_" + view.name + ".png", res.x, res.y, heatMapImage(values, view.maxValue));
+/// A host for `entry` on the scene: instrumented for the statistics pass, else with statistics
+/// compiled out (the timed pass).
+std::unique_ptr<AlgorithmHost> makeHost(const AlgorithmEntry& e, bool instrumented, const SceneGpu& scene, glm::ivec2 res) {
+    auto host = std::make_unique<AlgorithmHost>(*e.info, e.params, AlgorithmOptions{instrumented});
+    host->resize(res);
+    host->setScene(scene);
+    return host;
+}
+
+/// A fingerprint of a visibility image: the statistics pass must reproduce the timed pass's bits.
+uint64_t visibilityHash(const std::vector<float>& vis) {
+    uint64_t h = 1469598103934665603ull;  // FNV-1a over the raw words
+    for (float v : vis) {
+        uint32_t w;
+        std::memcpy(&w, &v, sizeof w);
+        h = (h ^ w) * 1099511628211ull;
     }
+    return h;
 }
 
 /// `timeSource` is summary.json's stage_time_source: which column of frames.csv the stage plot uses.
@@ -90,15 +98,15 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     sceneGpu.setTime(cfg.sceneTimeAt(0));
     std::vector<Instance> instances;
     for (const AlgorithmEntry* e : entries) {
-        Instance inst{e, std::make_unique<AlgorithmHost>(*e->info, e->params, AlgorithmOptions{!cfg.timingMode}), {}};
+        Instance inst{e, makeHost(*e, false, sceneGpu, res), {}, {}};
         inst.results.id = e->id;
         inst.results.algorithm = e->info->name;
         inst.results.params = e->params.toJson();
-        inst.host->resize(res);
-        inst.host->setScene(sceneGpu);
         inst.results.preprocessMs = inst.host->preprocessMs();
         instances.push_back(std::move(inst));
     }
+    const std::vector<int> statFrames = cfg.statisticsFrames();
+    auto isStatFrame = [&](int f) { return std::binary_search(statFrames.begin(), statFrames.end(), f); };
 
     ExperimentResults results;
     results.meta = {{"name", cfg.name},
@@ -113,9 +121,10 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"resolution", {res.x, res.y}},
                     {"frames", cfg.frames},
                     {"warmup_frames", cfg.warmupFrames},
-                    // true: the statistics were compiled out of the timed shaders (counters hold
-                    // only what stays measured: overflow, errors, structure sizes).
-                    {"timing_mode", cfg.timingMode},
+                    // The timed pass never carries instrumentation; counters and heat maps come
+                    // from an untimed statistics pass over these frames (Results.h).
+                    {"statistics", toString(cfg.statistics)},
+                    {"statistics_frames", statFrames},
                     {"triangles", cfg.scene->triangleCount()},
                     {"moving_parts", cfg.scene->moving.size()},
                     {"moving_triangles", cfg.scene->movingTriangleCount()},
@@ -123,7 +132,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"reference", cfg.reference}};
 
     std::vector<int> framesWithoutLit;  // accuracy is measured over lit pixels: none, nothing to measure
-    Progress progress(opt.progress, size_t(cfg.frames + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
+    Progress progress(opt.progress, size_t(cfg.frames + statFrames.size() + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
     std::optional<CpuGBuffer> cpuG;
     auto renderFrame = [&](const Camera& cam) {
         gbuffer.render(sceneGpu, cam);
@@ -183,12 +192,47 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                 rec.hasAccuracy = true;
                 rec.accuracy = compareVisibility(vis, reference, lit);
             }
+            if (isStatFrame(frame)) inst.timedVisibility[frame] = visibilityHash(vis);
             if (saveImages) {
                 shading.run(gbuffer, inst.host->visibility(), light);
-                writeImages(dir, inst.entry->id, frame, res, shading, vis, cfg.reference && !isReference ? &reference : nullptr,
-                            lit, covered, inst.host->algorithm());
+                writeFrameImages(dir, inst.entry->id, frame, res, shading, vis, cfg.reference && !isReference ? &reference : nullptr,
+                                 lit, covered);
             }
             inst.results.frames.push_back(std::move(rec));
+        }
+    }
+
+    // The statistics pass: the same frames again with instrumented shaders, untimed as far as any
+    // table goes. The timed hosts are released first, so the two passes never hold their GPU
+    // structures at once.
+    if (!statFrames.empty()) {
+        for (auto& inst : instances) inst.host.reset();
+        for (auto& inst : instances) inst.host = makeHost(*inst.entry, true, sceneGpu, res);
+    }
+    for (int frame : statFrames) {
+        Camera cam = cfg.cameraAt(frame);
+        Light light = cfg.lightAt(frame);
+        sceneGpu.setTime(cfg.sceneTimeAt(frame));
+        renderFrame(cam);
+        // Warmed up like the timed pass, so its times (shown only as the cost of instrumentation)
+        // leave shader compilation out too.
+        if (frame == statFrames.front())
+            for (auto& inst : instances)
+                for (int w = 0; w < cfg.warmupFrames; ++w) inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
+        const bool saveImages = opt.writeOutputs &&
+                                std::find(cfg.imagesAtFrames.begin(), cfg.imagesAtFrames.end(), frame) != cfg.imagesAtFrames.end();
+        for (auto& inst : instances) {
+            throwIfInterrupted();
+            progress.step(inst.entry->id + " statistics, frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
+            FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
+            FrameRecord rec;
+            rec.frame = frame;
+            rec.stages = m.stagesWithTotal();
+            for (const auto& c : m.counters) rec.counters[c.name] = c.value;
+            rec.overflow = m.overflow;
+            if (visibilityHash(inst.host->readVisibility()) != inst.timedVisibility[frame]) inst.results.visibilityDiffers.push_back(frame);
+            if (saveImages) writeHeatMaps(dir, inst.entry->id, frame, res, inst.host->algorithm().debugViews());
+            inst.results.statistics.push_back(std::move(rec));
         }
     }
     progress.finish();
@@ -205,6 +249,14 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         results.meta["warnings"].push_back(w);
         std::fprintf(stderr, "shadowlab: warning: %s\n", w.c_str());
     }
+    for (const auto& a : results.algorithms)
+        if (!a.visibilityDiffers.empty()) {
+            std::string w = a.id + ": the statistics pass's visibility differs from the timed pass's on " +
+                            std::to_string(a.visibilityDiffers.size()) + " of " + std::to_string(statFrames.size()) +
+                            " frames (instrumentation must only count; the timed pass's images and accuracy are reported)";
+            results.meta["warnings"].push_back(w);
+            std::fprintf(stderr, "shadowlab: warning: %s\n", w.c_str());
+        }
     if (!opt.writeOutputs) return results;
     throwIfInterrupted();
 
@@ -212,6 +264,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     // rename that follows makes the whole directory appear at once.
     writeFileAtomic(dir + "/config.resolved.json", cfg.resolved.dump(2) + "\n");
     results.writeFramesCsv(dir + "/frames.csv");
+    if (!statFrames.empty()) results.writeFramesCsv(dir + "/statistics.csv", true);
     Json summary = results.summary();
     results.writeReport(dir + "/report.md", summary);
     if (cfg.plots) runPlots(dir, finalDir, results.meta["stage_time_source"].get<std::string>());

@@ -1,5 +1,7 @@
 #include "framework/scene/GltfLoader.h"
 
+#include "framework/core/FileIO.h"
+
 #include "framework/core/JsonNode.h"
 #include "framework/core/JsonParse.h"
 
@@ -13,6 +15,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <tuple>
@@ -247,12 +250,12 @@ glm::mat4 trsMatrix(glm::vec3 t, glm::vec4 q, glm::vec3 s) {
     return m;
 }
 
-glm::vec4 slerp(glm::vec4 a, glm::vec4 b, float u) {
-    float d = glm::dot(a, b);
-    if (d < 0.0f) b = -b, d = -d;  // the shorter way round
-    if (d > 0.9995f) return glm::normalize(glm::mix(a, b, u));
-    float theta = std::acos(d);
-    return (std::sin((1.0f - u) * theta) * a + std::sin(u * theta) * b) / std::sin(theta);
+glm::dvec4 slerp(glm::dvec4 a, glm::dvec4 b, double u) {
+    double d = glm::dot(a, b);
+    if (d < 0.0) b = -b, d = -d;  // the shorter way round
+    if (d > 0.9995) return glm::normalize(glm::mix(a, b, u));
+    double theta = std::acos(std::min(d, 1.0));
+    return (std::sin((1.0 - u) * theta) * a + std::sin(u * theta) * b) / std::sin(theta);
 }
 
 /// One animation channel's keys (glTF 2.0 spec 3.11): values are vec3 (translation, scale) or
@@ -262,26 +265,34 @@ struct Track {
     std::vector<float> times;
     std::vector<glm::vec4> values;
     bool rotation = false;
+    std::string where;  ///< the channel's JSON path, for errors about its values
 
-    glm::vec4 key(size_t k) const { return mode == Cubic ? values[3 * k + 1] : values[k]; }
-    glm::vec4 at(double time) const {
-        if (times.size() == 1 || time <= times.front()) return key(0);
+    glm::dvec4 key(size_t k) const { return glm::dvec4(mode == Cubic ? values[3 * k + 1] : values[k]); }
+    /// Evaluated in double: keys and tangents near the float limit cannot overflow the weighted sums
+    /// (the caller checks that the value fits a float). A rotation comes out normalised, or zero
+    /// when a spline's tangents cancel it out.
+    glm::dvec4 at(double time) const {
+        if (times.size() == 1 || !(time > times.front())) return key(0);
         if (time >= times.back()) return key(times.size() - 1);
         size_t k = size_t(std::upper_bound(times.begin(), times.end(), float(time)) - times.begin()) - 1;
         if (k + 1 >= times.size()) return key(times.size() - 1);
         if (mode == Step) return key(k);
-        const float dt = times[k + 1] - times[k], u = float((time - times[k]) / dt);
+        const double dt = double(times[k + 1]) - double(times[k]), u = std::clamp((time - double(times[k])) / dt, 0.0, 1.0);
         if (mode == Linear) return rotation ? slerp(key(k), key(k + 1), u) : glm::mix(key(k), key(k + 1), u);
-        const float u2 = u * u, u3 = u2 * u;
-        glm::vec4 v = (2 * u3 - 3 * u2 + 1) * key(k) + (u3 - 2 * u2 + u) * dt * values[3 * k + 2] +
-                      (-2 * u3 + 3 * u2) * key(k + 1) + (u3 - u2) * dt * values[3 * (k + 1)];
-        return rotation ? glm::normalize(v) : v;
+        const double u2 = u * u, u3 = u2 * u;
+        glm::dvec4 v = (2 * u3 - 3 * u2 + 1) * key(k) + (u3 - 2 * u2 + u) * dt * glm::dvec4(values[3 * k + 2]) +
+                       (-2 * u3 + 3 * u2) * key(k + 1) + (u3 - u2) * dt * glm::dvec4(values[3 * (k + 1)]);
+        if (!rotation) return v;
+        const double len = glm::length(v);
+        return len > 0.0 && std::isfinite(len) ? v / len : glm::dvec4(0.0);
     }
 };
 
 /// The node hierarchy with one animation's tracks: every node's world matrix at any time. Shared
-/// (immutable) by the motion functions of the file's moving parts.
+/// (immutable) by the motion functions of the file's moving parts. Every value it computes is
+/// checked: a NaN or infinite pose would make the node's meshes vanish from every image.
 struct NodeAnimation {
+    std::string file;
     std::vector<int> parent;
     std::vector<glm::mat4> fixed;             ///< local matrix of nodes without tracks
     std::vector<glm::vec3> t, s;              ///< rest TRS of animated nodes
@@ -297,12 +308,29 @@ struct NodeAnimation {
     }
     glm::mat4 channels(size_t n, double time) const {
         if (track[0][n] < 0 && track[1][n] < 0 && track[2][n] < 0) return fixed[n];
-        auto value = [&](int slot, glm::vec4 rest) { return track[slot][n] >= 0 ? tracks[size_t(track[slot][n])].at(time) : rest; };
-        return trsMatrix(glm::vec3(value(0, glm::vec4(t[n], 0))), value(1, r[n]), glm::vec3(value(2, glm::vec4(s[n], 0))));
+        auto value = [&](int slot, glm::vec4 rest) {
+            if (track[slot][n] < 0) return rest;
+            const Track& tr = tracks[size_t(track[slot][n])];
+            const glm::dvec4 v = tr.at(time);
+            for (int c = 0; c < 4; ++c)
+                if (!(std::abs(v[c]) <= double(std::numeric_limits<float>::max())))
+                    throw InputError(file, tr.where, "the channel's interpolated value does not fit a float " + atTimeText(time) +
+                                                         (tr.mode == Track::Cubic ? " (check the CUBICSPLINE tangents)" : ""));
+            if (tr.rotation && v == glm::dvec4(0.0))
+                throw InputError(file, tr.where, "the channel's interpolated rotation is the zero quaternion " + atTimeText(time) +
+                                                     " (its CUBICSPLINE tangents cancel the keys out)");
+            return glm::vec4(v);
+        };
+        const glm::mat4 m = trsMatrix(glm::vec3(value(0, glm::vec4(t[n], 0))), value(1, r[n]), glm::vec3(value(2, glm::vec4(s[n], 0))));
+        if (!isFinite(m)) throw InputError(file, "/nodes/" + std::to_string(n), "the node's animated matrix is not finite " + atTimeText(time));
+        return m;
     }
     glm::mat4 world(size_t n, double time) const {
         glm::mat4 m = local(n, time);
         for (int p = parent[n]; p != -1; p = parent[size_t(p)]) m = local(size_t(p), time) * m;
+        if (!isFinite(m))
+            throw InputError(file, "/nodes/" + std::to_string(n),
+                             "the node's world matrix (its animation composed with its parents') overflows a float " + atTimeText(time));
         return m;
     }
 };
@@ -409,8 +437,15 @@ Track Loader::readTrack(const tinygltf::AnimationSampler& sampler, const std::st
                                    " keys (" + std::to_string(perKey) + " per key expected)");
     for (size_t i = 0; i < v.size(); i += size_t(width)) {
         glm::vec4 x(v[i], v[i + 1], v[i + 2], width == 4 ? v[i + 3] : 0.0f);
-        if (rotation && (perKey == 1 || i / 4 % 3 == 1) && !(glm::length(x) > 0.0f))
-            fail(path + "/output", "a rotation key is the zero quaternion");
+        const bool keyValue = perKey == 1 || i / 4 % 3 == 1;  // not a CUBICSPLINE tangent
+        if (rotation && keyValue) {
+            // The length in double: a float one overflows for components above ~1.8e19 and the key
+            // would turn into NaN. A quaternion means the rotation of its direction, so keys are
+            // made unit length, as slerp needs (glTF asks for unit keys; the tangents scale with them).
+            const double len = glm::length(glm::dvec4(x));
+            if (!(len > 0.0)) fail(path + "/output", "a rotation key is the zero quaternion (key " + std::to_string(i / 4 / perKey) + ")");
+            if (perKey == 1) x = glm::vec4(glm::dvec4(x) / len);
+        }
         tr.values.push_back(x);
     }
     return tr;
@@ -436,12 +471,15 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         if (m_.nodes[i].skin != -1 && m_.nodes[i].mesh != -1)
             fail(at("nodes", i) + "/skin", "skinned meshes are not supported: only node (rigid) animation is played");
     auto anim = std::make_shared<NodeAnimation>();
+    anim->file = file_;
     anim->extra.resize(m_.nodes.size());
     animStart_ = 1e300, animEnd_ = -1e300;
     for (const GltfNodeMotion& nm : nodeMotions_) {
         if (nm.node >= m_.nodes.size())
             fail("/nodes", "a node path names node " + std::to_string(nm.node) + ", but the file has " +
                                std::to_string(m_.nodes.size()) + " nodes");
+        if (anim->extra[nm.node])
+            fail("/nodes/" + std::to_string(nm.node), "two node paths move this node; give each node one path");
         if (nm.aboutCentre) {
             // Spin about the middle of what the node carries, not its frame's origin (which in
             // many files sits far from the part and would swing it round the scene).
@@ -465,7 +503,10 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         const auto& node = m_.nodes[i];
         anim->fixed[i] = localMatrix(node);
         anim->t[i] = node.translation.size() == 3 ? glm::vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])) : glm::vec3(0.0f);
-        anim->r[i] = node.rotation.size() == 4 ? glm::vec4(float(node.rotation[0]), float(node.rotation[1]), float(node.rotation[2]), float(node.rotation[3])) : glm::vec4(0, 0, 0, 1);
+        // Normalised in double, as localMatrix() does: a float length of large components overflows.
+        anim->r[i] = node.rotation.size() == 4
+                         ? glm::vec4(glm::normalize(glm::dvec4(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3])))
+                         : glm::vec4(0, 0, 0, 1);
         anim->s[i] = node.scale.size() == 3 ? glm::vec3(float(node.scale[0]), float(node.scale[1]), float(node.scale[2])) : glm::vec3(1.0f);
     }
     if (chosen == m_.animations.size()) return anim;  // node paths only
@@ -482,7 +523,12 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         if (slot < 0) fail(path + "/target/path", "unknown animated property \"" + what.substr(0, 40) + "\"");
         if (m_.nodes[size_t(ch.target_node)].matrix.size() == 16)
             fail(path + "/target/node", "node " + std::to_string(ch.target_node) + " has a matrix; glTF animates only nodes given by TRS");
+        // Two channels on one node's property (the spec forbids it) would leave one of them unplayed.
+        if (const int earlier = anim->track[slot][size_t(ch.target_node)]; earlier >= 0)
+            fail(path + "/target", "node " + std::to_string(ch.target_node) + "'s " + what + " is animated by " +
+                                       anim->tracks[size_t(earlier)].where + " already (glTF allows one channel per node and property)");
         Track tr = readTrack(a.samplers[size_t(ch.sampler)], base + "/samplers/" + std::to_string(ch.sampler), slot == 1);
+        tr.where = path;
         animStart_ = std::min(animStart_, double(tr.times.front()));
         animEnd_ = std::max(animEnd_, double(tr.times.back()));
         anim->track[slot][size_t(ch.target_node)] = int(anim->tracks.size());
@@ -828,6 +874,8 @@ Scene Loader::run(GltfStats* stats) {
                     part.triangleCount = scene.triangleCount() - first;
                     part.setLocal({scene.positions.begin() + ptrdiff_t(3 * first), scene.positions.end()});
                     part.worldFromLocal = [anim, node = size_t(node)](double time) { return anim->world(node, time); };
+                    part.sourceFile = file_;
+                    part.sourcePath = at("nodes", size_t(node));
                     part.startTime = animStart_;
                     part.endTime = animEnd_;
                     scene.moving.push_back(std::move(part));
@@ -855,10 +903,7 @@ Scene Loader::run(GltfStats* stats) {
 Scene loadGltf(const std::string& file) { return loadGltf(file, nullptr); }
 
 Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, const GltfMotion& motion) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw InputError(file, "", "cannot open file");
-    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (bytes.size() > 0xFFFFFFF0u) throw InputError(file, "", "file is larger than 4 GiB");
+    const std::vector<unsigned char> bytes = readInputFileBytes(file, 0xFFFFFFF0u);
 
     bool magic = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     std::string ext = file.size() >= 4 ? file.substr(file.size() - 4) : "";
@@ -878,6 +923,22 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
 
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(skipImage, nullptr);
+    // External buffers are read like every other input: regular files only, size-capped (a FIFO
+    // or /dev/zero named as a buffer's uri is bad input, not a hang or an out-of-memory abort).
+    tinygltf::FsCallbacks fs{};
+    fs.FileExists = tinygltf::FileExists;
+    fs.ExpandFilePath = tinygltf::ExpandFilePath;
+    fs.WriteWholeFile = tinygltf::WriteWholeFile;
+    fs.ReadWholeFile = [](std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+        try {
+            *out = readInputFileBytes(path, 0xFFFFFFF0u);
+            return true;
+        } catch (const InputError& e) {
+            if (err) *err += e.cause() + "\n";
+            return false;
+        }
+    };
+    loader.SetFsCallbacks(fs);
     tinygltf::Model model;
     std::string err, warn, baseDir = parentDir(file);
     bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir)

@@ -1,0 +1,69 @@
+#include "framework/experiment/FrameImages.h"
+
+#include "framework/gl/GlObjects.h"
+#include "framework/core/Error.h"
+#include "framework/metrics/Images.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+
+namespace shadowlab {
+
+std::string frameImagePrefix(const std::string& id, int frame) {
+    char tag[32];
+    std::snprintf(tag, sizeof tag, "_f%04d_", frame);
+    return id + tag;
+}
+
+void writeFrameImages(const std::string& dir, const std::string& id, int frame, glm::ivec2 res, ShadingPass& shading,
+                      const std::vector<float>& vis, const std::vector<float>* ref, const std::vector<uint8_t>& lit,
+                      const std::vector<uint8_t>& covered) {
+    const std::string base = dir + "/images/" + frameImagePrefix(id, frame);
+    writePngRGBA(base + "shaded.png", res.x, res.y, readTextureRGBA8(shading.output(), res.x, res.y));
+    writePngRGBA(base + "visibility.png", res.x, res.y, visibilityImage(vis, covered));
+    if (ref) writePngRGBA(base + "diff.png", res.x, res.y, differenceImage(vis, *ref, lit));
+}
+
+namespace {
+
+/// What one heat map's colours mean: the JSON written beside its PNG (less id and frame).
+nlohmann::json heatMapLegend(const DebugView& view, const HeatScale& scale, const std::string& image, glm::ivec2 res) {
+    nlohmann::json ramp = nlohmann::json::array();
+    for (const auto& c : heatRampStops()) ramp.push_back({c[0], c[1], c[2]});
+    return {{"name", view.name},
+            {"unit", view.unit},
+            {"image", image},
+            {"width", res.x},
+            {"height", res.y},
+            {"scale", heatScaleName(scale.kind)},
+            {"min", scale.min},
+            {"max", scale.max},
+            {"data_max", scale.dataMax},
+            {"nonzero_pixels", scale.nonZero},
+            {"clipped_pixels", scale.clipped},
+            {"ramp", ramp}};
+}
+
+} // namespace
+
+void writeHeatMaps(const std::string& dir, const std::string& id, int frame, glm::ivec2 res, const std::vector<DebugView>& views) {
+    const std::string prefix = frameImagePrefix(id, frame);
+    for (const DebugView& view : views) {
+        auto values = readTextureR32F(view.texture, res.x, res.y);
+        const HeatScale scale = heatMapScale(values, view.maxValue);
+        const std::string image = prefix + "heat_" + view.name + ".png";
+        writePngRGBA(dir + "/images/" + image, res.x, res.y, heatMapImage(values, scale));
+        // The PNG holds colours only: its legend (what the colours mean) is this file beside it.
+        nlohmann::json legend = heatMapLegend(view, scale, image, res);
+        legend["id"] = id;
+        legend["frame"] = frame;
+        const std::string path = dir + "/images/" + prefix + "heat_" + view.name + ".json";
+        std::ofstream out(path);
+        out << legend.dump(2) << "\n";
+        if (!out.flush()) throw RuntimeError("cannot write " + path);
+    }
+}
+
+} // namespace shadowlab
