@@ -69,7 +69,8 @@ const char* toString(MotionHandling m);
 /// How the host runs every algorithm, fixed at creation (one mechanism for all plugins).
 struct AlgorithmOptions {
     /// Statistics: counters, per-pixel debug images (heat maps) and the atomics that gather them.
-    /// Off (a config's `timing_mode`), they are compiled out of the timed shaders and counters()
+    /// Off (every timed frame of an experiment; the runner's untimed statistics pass turns them on),
+    /// they are compiled out of the shaders and counters()
     /// and debugViews() report only what is still measured; overflow and error detection stay
     /// (overflowCount() is exact in both modes) and the visibility is bit-identical.
     bool instrumentation = true;

@@ -1,4 +1,4 @@
-// Timing mode (AlgorithmOptions::instrumentation, a config's `timing_mode`): with
+// Timing mode (AlgorithmOptions::instrumentation off: every timed frame of an experiment): with
 // SHADOWLAB_INSTRUMENTATION 0 a shader gathers no statistics (counters, per-pixel debug images,
 // the atomics and barriers that sum them); overflow and error detection never depend on it, and
 // the visibility written is the same bit for bit. Every plugin passes the define
