@@ -52,6 +52,10 @@ void drawMeasurementsPanel(GuiState& s) {
     const Measurements& m = s.measurements;
     const Viewer& v = *s.viewer;
     ImGui::Text("%d x %d px, %s", v.resolution().x, v.resolution().y, v.active().label.c_str());
+    // The GUI runs instrumented so that counters and heat maps stay live; an experiment's tables
+    // time the same frames with statistics compiled out, so these times are higher.
+    ImGui::TextDisabled("times include statistics (counters, heat maps);");
+    ImGui::TextDisabled("shadowlab run times them compiled out");
     plot("##frame", m.frameMs(), "frame");
     const bool wall = v.wallClockStages();
     if (!wall) plot("##gpu", m.algorithmGpuMs(), "GPU");
