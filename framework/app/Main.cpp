@@ -6,7 +6,9 @@
 #include "framework/experiment/Runner.h"
 #include "framework/gl/GlContext.h"
 #include "framework/sweep/SweepCli.h"
+#include "framework/sweep/SweepText.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -17,25 +19,35 @@ using namespace shadowlab;
 
 namespace {
 
-const char* kUsage = R"(shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.
-
-Usage:
-  shadowlab run CONFIG.json [--out DIR] [--force] [--no-progress] [--set PATH=VALUE]...
+const char* kRunUsage = R"(  shadowlab run CONFIG.json [--out DIR] [--force] [--no-progress] [--set PATH=VALUE]...
       Runs the experiment and writes DIR (default: the config's output.dir): config.resolved.json,
       frames.csv, summary.json, report.md, images/ and plots. An existing DIR is kept unless --force;
       it is replaced only once the new run has completed.
       --set overrides one config value before validation, by dotted path (array elements by
       index), VALUE as JSON or a plain string: --set resolution=[128,128] --set frames=3
       --set algorithms.0.params.pcf=0 --set light.type=directional
-  shadowlab validate CONFIG.json [--set PATH=VALUE]...
+)";
+const char* kValidateUsage = R"(  shadowlab validate CONFIG.json [--set PATH=VALUE]...
       Checks the config (and loads its scene) without rendering; prints the resolved config.
-  shadowlab list [--json | --markdown [NAME]]
+)";
+const char* kListUsage = R"(  shadowlab list [--json | --markdown [NAME]]
       Lists the registered algorithms and their parameters; --markdown prints each parameter table
       as docs/algorithms/NAME.md holds it (scripts/update_param_docs.py rewrites the docs from it).
-%s  shadowlab --help | --version
-
-Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.
 )";
+
+std::string fullUsage() {
+    return std::string("shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.\n\nUsage:\n") +
+           kRunUsage + kValidateUsage + kListUsage + kSweepUsage + "  shadowlab --help | --version\n\n" +
+           "Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.\n";
+}
+
+/// `COMMAND --help`: that command's usage on stdout, exit code 0.
+int commandUsage(const char* text) {
+    std::fputs((std::string("Usage:\n") + text).c_str(), stdout);
+    return 0;
+}
+
+bool isHelp(const std::string& a) { return a == "--help" || a == "-h"; }
 
 void printList(bool json) {
     if (json) {
@@ -71,7 +83,7 @@ void printList(bool json) {
 int printMarkdown(const std::string& name) {
     if (!name.empty()) {
         const AlgorithmInfo* a = findAlgorithm(name);
-        if (!a) throw InputError("list", "", "unknown algorithm \"" + name + "\"");
+        if (!a) throw InputError("list", "", "unknown algorithm \"" + shortText(name, 60) + "\"");
         std::cout << a->schema().markdownTable();
         return 0;
     }
@@ -79,9 +91,18 @@ int printMarkdown(const std::string& name) {
     return 0;
 }
 
+/// `msg` echoes what was typed: it is cut to one short line.
 [[noreturn]] void usageError(const std::string& msg) {
-    std::fprintf(stderr, "shadowlab: %s (see shadowlab --help)\n", msg.c_str());
+    std::fprintf(stderr, "shadowlab: %s (see shadowlab --help)\n", shortText(msg, 300).c_str());
     std::exit(2);
+}
+
+/// A --set PATH=VALUE whose PATH the override walker could misread (an index past what it can
+/// count) is refused here, as bad input, before it gets there.
+void checkOverride(const std::string& assignment) {
+    const std::string path = assignment.substr(0, assignment.find('='));
+    if (const std::string why = dottedPathProblem(path); !why.empty() && !path.empty() && assignment.find('=') != std::string::npos)
+        usageError("--set " + shortText(path, 80) + ": the path " + why);
 }
 
 int run(const std::vector<std::string>& args) {
@@ -90,6 +111,7 @@ int run(const std::vector<std::string>& args) {
     RunOptions opt;
     for (size_t i = 1; i < args.size(); ++i) {
         const std::string& a = args[i];
+        if (isHelp(a)) return commandUsage(kRunUsage);
         if (a == "--out") {
             if (++i >= args.size()) usageError("--out needs a directory");
             opt.outputDir = args[i];
@@ -99,6 +121,7 @@ int run(const std::vector<std::string>& args) {
             opt.progress = false;
         } else if (a == "--set") {
             if (++i >= args.size()) usageError("--set needs PATH=VALUE");
+            checkOverride(args[i]);
             overrides.push_back(args[i]);
         } else if (!a.empty() && a[0] == '-') {
             usageError("unknown option " + a);
@@ -115,18 +138,19 @@ int run(const std::vector<std::string>& args) {
     ExperimentConfig cfg = loadConfig(config, false, overrides);
     std::vector<std::string> notes;
     OutputPlace place = OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes);
-    for (const auto& n : notes) std::fprintf(stderr, "shadowlab: %s\n", n.c_str());
+    for (const auto& n : notes) std::fprintf(stderr, "shadowlab: %s\n", shortText(n, 600).c_str());
     opt.place = &place;
     cfg = loadConfig(config, true, overrides);
     throwIfInterrupted();
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
-    std::fprintf(stderr, "shadowlab: %s, %zu triangles, %d×%d, %d frames on %s (%s)\n", cfg.name.c_str(),
+    // The name is the config's text: cut, so a huge or multi-line one stays one short line.
+    std::fprintf(stderr, "shadowlab: %s, %zu triangles, %d×%d, %d frames on %s (%s)\n", shortText(cfg.name, 100).c_str(),
                  cfg.scene->triangleCount(), cfg.resolution.x, cfg.resolution.y, cfg.frames, glRendererString().c_str(),
                  context->backend().c_str());
     ExperimentResults r = runExperiment(cfg, opt, context->backend());
     const std::string& dir = place.finalDir();
-    std::fprintf(stderr, "shadowlab: wrote %s (report.md, summary.json) in %.1f s\n", dir.c_str(),
+    std::fprintf(stderr, "shadowlab: wrote %s (report.md, summary.json) in %.1f s\n", shortText(dir, 300).c_str(),
                  r.meta["wall_time_s"].get<double>());
     if (glErrorCount() > 0) {
         std::fprintf(stderr, "shadowlab: %d OpenGL errors were reported during the run\n", glErrorCount());
@@ -140,10 +164,8 @@ int run(const std::vector<std::string>& args) {
 int main(int argc, char** argv) {
     std::vector<std::string> args(argv + 1, argv + argc);
     try {
-        if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-            std::string usage = kUsage;
-            usage.replace(usage.find("%s"), 2, kSweepUsage);
-            std::fputs(usage.c_str(), args.empty() ? stderr : stdout);
+        if (args.empty() || isHelp(args[0]) || args[0] == "help") {
+            std::fputs(fullUsage().c_str(), args.empty() ? stderr : stdout);
             return args.empty() ? 2 : 0;
         }
         if (args[0] == "--version") {
@@ -151,6 +173,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "list") {
+            if (std::any_of(args.begin() + 1, args.end(), isHelp)) return commandUsage(kListUsage);
             if (args.size() > 1 && args[1] == "--markdown") {
                 if (args.size() > 3) usageError("list --markdown takes at most one algorithm name");
                 return printMarkdown(args.size() == 3 ? args[2] : "");
@@ -161,15 +184,24 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "validate") {
+            std::string config;
             std::vector<std::string> overrides;
-            for (size_t i = 2; i < args.size(); ++i) {
-                if (args[i] != "--set" || ++i >= args.size()) usageError("validate takes one config file and --set PATH=VALUE");
-                overrides.push_back(args[i]);
+            for (size_t i = 1; i < args.size(); ++i) {
+                if (isHelp(args[i])) return commandUsage(kValidateUsage);
+                if (args[i] == "--set") {
+                    if (++i >= args.size()) usageError("--set needs PATH=VALUE");
+                    checkOverride(args[i]);
+                    overrides.push_back(args[i]);
+                } else if (config.empty() && !args[i].empty() && args[i][0] != '-') {
+                    config = args[i];
+                } else {
+                    usageError("validate takes one config file and --set PATH=VALUE");
+                }
             }
-            if (args.size() < 2) usageError("validate needs a config file");
-            ExperimentConfig cfg = loadConfig(args[1], true, overrides);
+            if (config.empty()) usageError("validate needs a config file");
+            ExperimentConfig cfg = loadConfig(config, true, overrides);
             std::cout << cfg.resolved.dump(2) << "\n";
-            std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", args[1].c_str(), cfg.scene->triangleCount(),
+            std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", shortText(config, 300).c_str(), cfg.scene->triangleCount(),
                          cfg.algorithms.size(), cfg.reference ? " + reference" : "");
             return 0;
         }
@@ -177,13 +209,13 @@ int main(int argc, char** argv) {
         if (args[0] == "sweep") return sweepCommand(args);
         usageError("unknown command " + args[0]);
     } catch (const InputError& e) {
-        std::fprintf(stderr, "shadowlab: error: %s\n", e.what());
+        std::fprintf(stderr, "shadowlab: error: %s\n", shortText(e.what(), 1000).c_str());
         return 2;
     } catch (const Interrupted& e) {
         std::fprintf(stderr, "shadowlab: %s; no results written, any previous ones kept\n", e.what());
         return 128 + e.signal();
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "shadowlab: failed: %s\n", e.what());
+        std::fprintf(stderr, "shadowlab: failed: %s\n", shortText(e.what(), 1000).c_str());
         return 1;
     }
 }

@@ -2,9 +2,11 @@
 
 #include "framework/experiment/Config.h"
 #include "framework/scene/SceneConfig.h"
+#include "framework/sweep/SweepText.h"
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -18,8 +20,10 @@ namespace {
 // expanding it would validate millions of configs before saying so.
 constexpr size_t kMaxRuns = 100000;
 
-// Column names of sweep.csv that an axis must not shadow.
-const std::set<std::string> kReservedNames = {"run", "index", "triangles", "pixels", "id", "algorithm", "measure", "value"};
+// Column names of sweep.csv that an axis must not shadow (sweep_report.py reads rows by column name).
+const std::set<std::string> kReservedNames = {"run", "index", "triangles", "pixels", "id", "algorithm", "measure", "kind", "value"};
+// An axis name is a column header and a plot file name (sweep_AXIS.png).
+constexpr size_t kMaxAxisNameChars = 64;
 
 const std::vector<std::string> kScales = {"category", "value", "triangles", "pixels"};
 
@@ -33,7 +37,7 @@ std::string defaultName(const std::string& file) {
 }
 
 bool isIdentifier(const std::string& s) {
-    if (s.empty()) return false;
+    if (s.empty() || s.size() > kMaxAxisNameChars) return false;
     for (char c : s)
         if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
     return true;
@@ -56,10 +60,58 @@ bool overlaps(const std::string& a, const std::string& b) {
 
 std::string axisWhere(size_t a, const SweepAxis& axis) { return "/axes/" + std::to_string(a) + " (axis \"" + axis.name + "\")"; }
 
-SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names, std::set<std::string>& allPaths) {
+/// Where a value set at the dotted `path` sits in the scene description, for absolutiseAxisValue.
+enum class SceneSlot { None, Object, Objects, Gltf };
+
+/// The slot of `path`, following absolutiseScenePaths's walk: the scene and every object may hold
+/// `gltf`, an `object` and `objects`.
+SceneSlot slotOf(const std::string& path) {
+    SceneSlot slot = SceneSlot::None;
+    size_t start = 0;
+    for (bool first = true;; first = false) {
+        const size_t dot = path.find('.', start);
+        const std::string key = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+        if (first) slot = key == "scene" ? SceneSlot::Object : SceneSlot::None;
+        else if (slot == SceneSlot::Objects) slot = SceneSlot::Object;
+        else if (slot == SceneSlot::Object)
+            slot = key == "objects" ? SceneSlot::Objects : key == "object" ? SceneSlot::Object : key == "gltf" ? SceneSlot::Gltf : SceneSlot::None;
+        else slot = SceneSlot::None;
+        if (slot == SceneSlot::None || dot == std::string::npos) return slot;
+        start = dot + 1;
+    }
+}
+
+/// An axis value's relative glTF paths resolved against the sweep file's folder, as the base's are
+/// against theirs: a run's config is written under the output folder, where a relative path would
+/// name another file.
+void absolutiseAxisValue(Json& value, const std::string& path, const std::string& dir) {
+    switch (slotOf(path)) {
+    case SceneSlot::Object: absolutiseScenePaths(value, dir); break;
+    case SceneSlot::Objects:
+        if (value.is_array())
+            for (Json& o : value) absolutiseScenePaths(o, dir);
+        break;
+    case SceneSlot::Gltf:
+        if (value.is_string()) value = resolvePath(dir, value.get<std::string>());
+        break;
+    case SceneSlot::None: break;
+    }
+}
+
+/// A label of a "value" axis is x of a plot: a positive number (JSON syntax, which every reader of
+/// sweep.csv parses the same way).
+bool isPositiveNumber(const std::string& label) {
+    const Json j = Json::parse(label, nullptr, false);
+    return !j.is_discarded() && j.is_number() && std::isfinite(j.get<double>()) && j.get<double>() > 0;
+}
+
+SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names, std::set<std::string>& allPaths,
+                    const std::string& sweepDir) {
     SweepAxis axis;
     axis.name = node.requireString("name");
-    if (!isIdentifier(axis.name)) node.fail("name", "\"" + axis.name + "\" is not a name of letters, digits and _ (it becomes a column name)");
+    if (!isIdentifier(axis.name))
+        node.fail("name", "\"" + shortText(axis.name, 80) + "\" is not a name of 1 to " + std::to_string(kMaxAxisNameChars) +
+                              " letters, digits and _ (it becomes a column name)");
     if (kReservedNames.count(axis.name)) node.fail("name", "\"" + axis.name + "\" is a column of sweep.csv already; choose another name");
     if (names.count(axis.name)) node.fail("name", "two axes are named \"" + axis.name + "\"");
     const std::string where = axisWhere(a, axis);
@@ -71,9 +123,10 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
         throw InputError(node.file(), where + "/values", "expected an object of one or more dotted paths, each with a list of values");
     size_t count = 0;
     for (const auto& [path, list] : values.items()) {
-        const std::string at = where + ", path " + path;
+        const std::string at = where + ", path " + shortText(path);
         if (path.empty() || path.front() == '.' || path.back() == '.' || path.find("..") != std::string::npos)
             throw InputError(node.file(), at, "not a dotted path like scene.objects.1.object.triangles");
+        if (const std::string why = dottedPathProblem(path); !why.empty()) throw InputError(node.file(), at, "the path " + why);
         if (!list.is_array() || list.empty()) throw InputError(node.file(), at, "expected a non-empty list of values");
         if (!allPaths.insert(path).second) throw InputError(node.file(), at, "another axis sets this path already");
         for (const std::string& other : allPaths)
@@ -85,6 +138,7 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
         count = list.size();
         axis.paths.push_back(path);
         axis.values.push_back(std::vector<Json>(list.begin(), list.end()));
+        for (Json& v : axis.values.back()) absolutiseAxisValue(v, path, sweepDir);
     }
 
     if (node.has("labels")) {
@@ -92,18 +146,33 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
         node.markRead("labels");
         if (!labels.is_array() || labels.size() != count)
             node.fail("labels", "expected a list of " + std::to_string(count) + " strings, one per value");
-        for (const Json& l : labels) {
-            if (!l.is_string() || l.get<std::string>().empty()) node.fail("labels", "expected non-empty strings, got " + l.dump());
+        for (size_t k = 0; k < labels.size(); ++k) {
+            const Json& l = labels[k];
+            if (!l.is_string() || l.get<std::string>().empty())
+                node.fail("labels", "expected non-empty strings, got " + shortText(l.dump(), 80));
+            // A label is a cell of the plan's TSV, of sweep.csv and of the report's tables, and part
+            // of every progress line: one short line of text.
+            if (const std::string why = textProblem(l.get<std::string>(), kMaxLabelChars); !why.empty())
+                throw InputError(node.file(), node.childPath("labels") + "/" + std::to_string(k),
+                                 "the label \"" + shortText(l.get<std::string>(), 60) + "\" " + why);
             axis.labels.push_back(l.get<std::string>());
         }
     } else if (axis.paths.size() > 1) {
         node.fail("labels", "required when an axis sets several paths (name each of its " + std::to_string(count) + " points)");
     } else {
-        for (const Json& v : axis.values.front()) axis.labels.push_back(v.is_string() ? v.get<std::string>() : v.dump());
+        for (size_t k = 0; k < axis.values.front().size(); ++k) {
+            const Json& v = axis.values.front()[k];
+            // A string with a newline or tab is shown as JSON text (escaped): the label stays one cell.
+            std::string label = v.is_string() && textProblem(v.get<std::string>(), 0).empty() ? v.get<std::string>() : v.dump();
+            if (label.size() > kMaxLabelChars)
+                node.fail("labels", "value " + std::to_string(k) + " (" + shortText(label, 60) + ") is longer than " +
+                                        std::to_string(kMaxLabelChars) + " characters as a label: give the axis labels");
+            axis.labels.push_back(std::move(label));
+        }
     }
     std::set<std::string> seen;
     for (const auto& l : axis.labels)
-        if (!seen.insert(l).second) throw InputError(node.file(), where, "the label \"" + l + "\" appears twice");
+        if (!seen.insert(l).second) throw InputError(node.file(), where, "the label \"" + shortText(l, 60) + "\" appears twice");
 
     const std::string scale = node.getEnum("scale", "category", kScales);
     axis.scale = AxisScale(std::find(kScales.begin(), kScales.end(), scale) - kScales.begin());
@@ -111,7 +180,13 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
         for (size_t p = 0; p < axis.paths.size(); ++p)
             for (const Json& v : axis.values[p])
                 if (!v.is_number() || v.get<double>() <= 0)
-                    node.fail("scale", "\"value\" needs positive numbers (x of a log-log plot), but " + axis.paths[p] + " has " + v.dump());
+                    node.fail("scale", "\"value\" needs positive numbers (x of a log-log plot), but " + shortText(axis.paths[p], 80) +
+                                           " has " + shortText(v.dump(), 60));
+    if (axis.scale == AxisScale::Value)
+        for (const auto& l : axis.labels)
+            if (!isPositiveNumber(l))
+                node.fail("scale", "\"value\" plots each point at its label, which must be a positive number, but one is \"" +
+                                       shortText(l, 60) + "\" (leave labels out, or use scale \"category\")");
     node.finish();
     return axis;
 }
@@ -134,7 +209,7 @@ Json resolveRun(const Json& config, const std::string& file) {
         const SweepAxis& axis = s.axes[a];
         for (size_t p = 0; p < axis.paths.size(); ++p)
             if (overlaps(e.jsonPath(), slashPath(axis.paths[p])))
-                throw InputError(s.file, axisWhere(a, axis) + ", path " + axis.paths[p] + " = " + axis.values[p][run.point[a]].dump(),
+                throw InputError(s.file, axisWhere(a, axis) + ", path " + axis.paths[p] + " = " + shortText(axis.values[p][run.point[a]].dump(), 80),
                                  "at " + e.jsonPath() + ": " + e.cause());
     }
     // Not an axis path: the base config itself is wrong (in the sweep file at /base, or in its own file).
@@ -159,9 +234,35 @@ std::string runId(const Json& resolvedConfig) {
 
 std::string runLabel(const Sweep& sweep, const SweepRun& run) {
     std::string s;
-    for (size_t a = 0; a < sweep.axes.size(); ++a)
+    for (size_t a = 0; a < sweep.axes.size() && s.size() <= 2 * kMaxEchoChars; ++a)
         s += (a ? " " : "") + sweep.axes[a].name + "=" + sweep.axes[a].labels[run.point[a]];
-    return s.empty() ? "(base)" : s;
+    return s.empty() ? "(base)" : shortText(s, 2 * kMaxEchoChars);
+}
+
+std::string absoluteFolder(const std::string& dir) {
+    std::string s = std::filesystem::absolute(dir).lexically_normal().string();
+    while (s.size() > 1 && s.back() == '/') s.pop_back();
+    return s;
+}
+
+Json Sweep::runConfig(size_t k) const {
+    const SweepRun& run = runs.at(k);
+    Json config = base;
+    for (size_t a = 0; a < axes.size(); ++a) {
+        const SweepAxis& axis = axes[a];
+        for (size_t p = 0; p < axis.paths.size(); ++p) {
+            const Json& v = axis.values[p][run.point[a]];
+            try {
+                // The --set walker, so an axis path means exactly what --set PATH means.
+                applyOverride(config, axis.paths[p] + "=" + v.dump());
+            } catch (const InputError& e) {
+                throw InputError(file, axisWhere(a, axis) + ", path " + axis.paths[p], e.cause() + " (at " + e.jsonPath() + ")");
+            } catch (const std::exception& e) {
+                throw InputError(file, axisWhere(a, axis) + ", path " + axis.paths[p], e.what());
+            }
+        }
+    }
+    return config;
 }
 
 Json planJson(const Sweep& sweep) {
@@ -176,7 +277,7 @@ Json planJson(const Sweep& sweep) {
 }
 
 Json Sweep::snapshot(const std::string& dir) const {
-    Json j = {{"name", name}, {"base", base}, {"axes", axesJson}, {"output", {{"dir", std::filesystem::absolute(dir).string()}}}};
+    Json j = {{"name", name}, {"base", base}, {"axes", axesJson}, {"output", {{"dir", absoluteFolder(dir)}}}};
     if (!merge.empty()) j["merge"] = merge;
     return j;
 }
@@ -184,18 +285,30 @@ Json Sweep::snapshot(const std::string& dir) const {
 Sweep parseSweep(const Json& json, const std::string& file) {
     Sweep s;
     s.file = file;
+    // The file's name reaches plan.json and messages; its folder anchors every relative path.
+    if (const std::string why = textProblem(file, 0); !why.empty()) throw InputError(shortText(file), "", "the file's path " + why);
+    const std::string sweepDir = absoluteFolder(parentDir(file));
+    if (!isValidUtf8(sweepDir)) throw InputError(file, "", "the absolute path of its folder is not valid UTF-8");
     JsonNode root(file, &json, "", nullptr);
+    const bool named = root.has("name");
     s.name = root.getString("name", defaultName(file));
+    // The name titles the report, names the Slurm job and the default output folder.
+    if (const std::string why = textProblem(s.name, kMaxLabelChars); !why.empty()) {
+        if (named) root.fail("name", "the name \"" + shortText(s.name, 60) + "\" " + why);
+        throw InputError(file, "", "the file name, the sweep's default name, " + why + ": give the sweep a \"name\"");
+    }
+    if (s.name.empty()) root.fail("name", "must not be empty");
 
     // The base: a config inline, or the name of a config file (relative to the sweep file).
     if (!root.has("base")) root.fail("base", "required key is missing (an experiment config, inline or a file name)");
     const Json& base = root.raw()["base"];
     root.markRead("base");
-    std::string baseFile = file, baseDir = parentDir(file), baseWhere = "/base";
+    std::string baseFile = file, baseDir = sweepDir, baseWhere = "/base";
     if (base.is_string()) {
-        baseFile = resolvePath(baseDir, base.get<std::string>());
+        baseFile = resolvePath(sweepDir, base.get<std::string>());
+        if (const std::string why = textProblem(baseFile, 0); !why.empty()) root.fail("base", "the file name " + why);
         s.base = JsonNode::parseFile(baseFile);
-        baseDir = parentDir(baseFile);
+        baseDir = absoluteFolder(parentDir(baseFile));
         baseWhere = "";
     } else if (base.is_object()) {
         s.base = base;
@@ -209,8 +322,12 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     s.axesJson = root.has("axes") ? root.raw()["axes"] : Json::array();
     std::vector<JsonNode> axisNodes = root.objectArray("axes");
     for (size_t a = 0; a < axisNodes.size(); ++a) {
-        s.axes.push_back(parseAxis(axisNodes[a], a, names, paths));
+        s.axes.push_back(parseAxis(axisNodes[a], a, names, paths, sweepDir));
         names.insert(s.axes.back().name);
+        // The snapshot carries the values as the runs use them (glTF paths absolute), so that
+        // DIR/sweep.json, read from DIR, gives the same runs.
+        Json& values = s.axesJson[a]["values"];
+        for (size_t p = 0; p < s.axes.back().paths.size(); ++p) values[s.axes.back().paths[p]] = s.axes.back().values[p];
     }
 
     JsonNode merge = root.child("merge");
@@ -219,8 +336,8 @@ Sweep parseSweep(const Json& json, const std::string& file) {
         const Json& list = merge.raw()[key];
         merge.markRead(key);
         bool ok = list.is_array();
-        for (const Json& v : list) ok = ok && v.is_string();
-        if (!ok) merge.fail(key, "expected a list of strings");
+        for (const Json& v : list) ok = ok && v.is_string() && textProblem(v.get<std::string>(), kMaxLabelChars).empty();
+        if (!ok) merge.fail(key, "expected a list of strings (one line each, at most " + std::to_string(kMaxLabelChars) + " characters)");
         if (std::string(key) == "ratios")
             for (const Json& v : list)
                 if (v.get<std::string>().find('/') == std::string::npos)
@@ -229,7 +346,10 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     merge.finish();
     s.merge = root.has("merge") ? root.raw()["merge"] : Json::object();
     JsonNode out = root.child("output");
+    if (out.has("dir") && out.raw()["dir"].is_string() && out.raw()["dir"].get<std::string>().empty())
+        out.fail("dir", "must not be empty (the sweep's folder: DIR/sweep.json, DIR/runs/)");
     s.outputDir = out.getPath("dir", "results/" + s.name);
+    if (const std::string why = textProblem(s.outputDir, 0); !why.empty()) out.fail("dir", "the folder's name " + why);
     out.finish();
     root.finish();
 
@@ -239,7 +359,10 @@ Sweep parseSweep(const Json& json, const std::string& file) {
         if (total > kMaxRuns) root.fail("axes", "more than " + std::to_string(kMaxRuns) + " runs");
     }
 
+    // One run at a time: its config is made, validated and dropped before the next, so memory is
+    // the base's a few times over, whatever the number of runs.
     std::map<std::string, size_t> ids;
+    s.runs.reserve(total);
     for (size_t index = 0; index < total; ++index) {
         SweepRun run;
         run.index = index;
@@ -248,32 +371,28 @@ Sweep parseSweep(const Json& json, const std::string& file) {
             run.point[a] = rest % s.axes[a].size();
             rest /= s.axes[a].size();
         }
-        run.config = s.base;
-        for (size_t a = 0; a < s.axes.size(); ++a) {
-            const SweepAxis& axis = s.axes[a];
-            for (size_t p = 0; p < axis.paths.size(); ++p) {
-                const Json& v = axis.values[p][run.point[a]];
+        s.runs.push_back(run);
+        try {
+            Json resolved;
+            {
+                const Json config = s.runConfig(index);
                 try {
-                    // The --set walker, so an axis path means exactly what --set PATH means.
-                    applyOverride(run.config, axis.paths[p] + "=" + v.dump());
+                    resolved = resolveRun(config, baseFile);
                 } catch (const InputError& e) {
-                    throw InputError(file, axisWhere(a, axis) + ", path " + axis.paths[p], e.cause() + " (at " + e.jsonPath() + ")");
+                    if (e.file() != baseFile) throw; // a glTF file's own error names that file
+                    rethrowRunError(e, s, run, baseFile, baseWhere);
                 }
             }
+            s.runs.back().id = runId(resolved);
+        } catch (const Json::exception& e) {
+            // Text that JSON cannot hold (a path that is not UTF-8) or a value of the wrong type
+            // deep in a config: bad input, not a crash.
+            throw InputError(file, "", "run " + std::to_string(index) + " (" + runLabel(s, run) + "): " + e.what());
         }
-        Json resolved;
-        try {
-            resolved = resolveRun(run.config, baseFile);
-        } catch (const InputError& e) {
-            if (e.file() != baseFile) throw; // a glTF file's own error names that file
-            rethrowRunError(e, s, run, baseFile, baseWhere);
-        }
-        run.id = runId(resolved);
-        if (auto [it, fresh] = ids.emplace(run.id, index); !fresh)
+        if (auto [it, fresh] = ids.emplace(s.runs.back().id, index); !fresh)
             root.fail("axes", "runs " + std::to_string(it->second) + " (" + runLabel(s, s.runs[it->second]) + ") and " +
                                   std::to_string(index) + " (" + runLabel(s, run) +
                                   ") resolve to the same config (an axis repeats a value, or sets one to its default)");
-        s.runs.push_back(std::move(run));
     }
     return s;
 }

@@ -1,11 +1,13 @@
 #include "framework/sweep/SweepMerge.h"
 
 #include "framework/core/Error.h"
-#include "framework/experiment/Results.h"
+#include "framework/core/FileIO.h"
+#include "framework/core/Interrupt.h"
 #include "framework/sweep/SweepFile.h"
 #include "framework/sweep/SweepRunner.h"
+#include "framework/sweep/SweepText.h"
 
-#include <cstdlib>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -16,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string csvField(const std::string& s) {
-    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
     std::string out = "\"";
     for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
     return out + "\"";
@@ -26,18 +28,38 @@ std::string csvField(const std::string& s) {
 /// results give equal rows wherever they were computed.
 std::string number(const Json& v) { return v.is_null() ? std::string() : v.dump(); }
 
+/// A summary.json that lacks what the table needs: the run is reported, not merged.
+struct BadSummary {
+    std::string path, cause;
+};
+
+/// summary.json's `key` of `parent` (at JSON path `where`), of the kind `want` says: "object",
+/// "number" (or null: a measure not taken), "count" (a number, never null), "string".
+const Json& field(const Json& parent, const std::string& key, const std::string& where, const char* want) {
+    const std::string at = where + "/" + key;
+    if (!parent.is_object() || !parent.contains(key)) throw BadSummary{at, "missing"};
+    const Json& v = parent[key];
+    const std::string w = want;
+    const bool number = v.is_number() && std::isfinite(v.get<double>());
+    const bool ok = w == "object" ? v.is_object() : w == "string" ? v.is_string() : w == "count" ? number : (v.is_null() || number);
+    if (!ok) throw BadSummary{at, "expected " + w + ", got " + shortText(v.dump(), 40)};
+    return v;
+}
+
 /// measure → value of one algorithm entry of summary.json. Times are means over the measured
 /// frames; the spread stays in each run's own summary.json and frames.csv.
-std::vector<std::pair<std::string, Json>> measures(const Json& a) {
+std::vector<std::pair<std::string, Json>> measures(const Json& a, const std::string& where) {
     std::vector<std::pair<std::string, Json>> m;
-    for (const auto& [stage, t] : a.at("time_ms").items()) m.emplace_back("time_ms." + stage, t.at("mean"));
-    m.emplace_back("preprocess_ms", a.at("preprocess_ms"));
-    if (a.contains("accuracy") && a["accuracy"].is_object())
+    for (const auto& [stage, t] : field(a, "time_ms", where, "object").items())
+        m.emplace_back("time_ms." + stage, field(t, "mean", where + "/time_ms/" + stage, "number"));
+    m.emplace_back("preprocess_ms", field(a, "preprocess_ms", where, "number"));
+    if (a.contains("accuracy") && !a["accuracy"].is_null())
         for (const char* k : {"mismatch_ratio", "mismatch_ratio_max", "false_lit", "false_shadowed", "rmse"})
-            m.emplace_back(std::string("accuracy.") + k, a["accuracy"].at(k));
-    for (const auto& [name, c] : a.at("counters").items()) m.emplace_back("counters." + name, c.at("mean"));
-    m.emplace_back("memory_bytes", a.at("memory_bytes"));
-    m.emplace_back("overflow", a.at("overflow"));
+            m.emplace_back(std::string("accuracy.") + k, field(field(a, "accuracy", where, "object"), k, where + "/accuracy", "number"));
+    for (const auto& [name, c] : field(a, "counters", where, "object").items())
+        m.emplace_back("counters." + name, field(c, "mean", where + "/counters/" + name, "number"));
+    m.emplace_back("memory_bytes", field(a, "memory_bytes", where, "count"));
+    m.emplace_back("overflow", field(a, "overflow", where, "count"));
     return m;
 }
 
@@ -60,11 +82,35 @@ const char* measureKind(const std::string& m) {
     return "counter";
 }
 
+/// sweep.csv's rows of one complete run (BadSummary when its summary.json lacks what they need).
+std::string runRows(const Sweep& sweep, const SweepRun& run, const Json& s) {
+    std::ostringstream prefix, rows;
+    prefix << run.id << "," << run.index;
+    for (size_t a = 0; a < sweep.axes.size(); ++a) prefix << "," << csvField(sweep.axes[a].labels[run.point[a]]);
+    const Json& res = s.is_object() && s.contains("resolution") ? s["resolution"] : Json();
+    if (!res.is_array() || res.size() != 2 || !res[0].is_number_unsigned() || !res[1].is_number_unsigned())
+        throw BadSummary{"/resolution", "expected [width, height]"};
+    const Json& triangles = field(s, "triangles", "", "count");
+    if (!triangles.is_number_unsigned()) throw BadSummary{"/triangles", "expected a count"};
+    prefix << "," << triangles.dump() << "," << res[0].get<uint64_t>() * res[1].get<uint64_t>();
+    for (const auto& [id, a] : field(s, "algorithms", "", "object").items()) {
+        const std::string where = "/algorithms/" + id;
+        const std::string algorithm = field(a, "algorithm", where, "string").get<std::string>();
+        for (const auto& [measure, value] : measures(a, where))
+            rows << prefix.str() << "," << csvField(id) << "," << csvField(algorithm) << "," << csvField(measure) << ","
+                 << measureKind(measure) << "," << number(value) << "\n";
+    }
+    return rows.str();
+}
+
 } // namespace
 
 MergeResult mergeSweep(const std::string& dir, bool plots) {
+    if (dir.empty()) throw InputError("sweep merge", "", "the output folder must not be empty");
     const std::string snapshot = dir + "/sweep.json";
-    if (!fs::exists(snapshot)) throw InputError(snapshot, "", "not found: is " + dir + " the output folder of `sweep run` or `sweep slurm`?");
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(snapshot, ec)))
+        throw InputError(shortText(snapshot, 300), "", "not found: is " + shortText(dir, 200) + " the output folder of `sweep run` or `sweep slurm`?");
     const Sweep sweep = loadSweep(snapshot);
     MergeResult r;
     r.runs = sweep.runs.size();
@@ -78,36 +124,67 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
         const SweepRun& run = sweep.runs[i];
         RunPaths p(dir, run.id);
         Json& entry = plan["runs"][i];
-        if (!p.complete()) {
-            const bool failed = fs::exists(p.error);
-            r.failed += failed;
-            entry["status"] = failed ? "failed" : "missing";
+        auto fail = [&](const std::string& status, const std::string& detail) {
+            entry["status"] = status;
+            if (status == "failed") {
+                ++r.failed;
+                entry["error"] = detail;
+            }
             std::fprintf(stderr, "sweep merge: run %zu %s (%s): %s\n", run.index, run.id.c_str(), runLabel(sweep, run).c_str(),
-                         failed ? ("failed, see " + p.error).c_str() : "no results yet");
+                         shortText(detail, 400).c_str());
+        };
+        std::string why;
+        if (!p.complete(&why)) {
+            // A broken summary.json is a failed run (its folder is there, its results are not); an
+            // error record beside no folder is one too.
+            if (!why.empty()) fail("failed", "results unreadable: " + shortText(p.dir, 200) + ": " + why);
+            else if (fs::exists(fs::symlink_status(p.error, ec))) fail("failed", "failed, see " + shortText(p.error, 300));
+            else fail("missing", "no results yet");
             continue;
         }
+        // complete() read it already; read again here (a run written meanwhile is read whole or not at all).
+        Json s;
+        std::string rows;
+        try {
+            s = JsonNode::parseFile(p.dir + "/summary.json");
+            rows = runRows(sweep, run, s);
+        } catch (const InputError& e) {
+            fail("failed", "results unreadable: " + e.cause());
+            continue;
+        } catch (const BadSummary& b) {
+            fail("failed", shortText(p.dir, 200) + "/summary.json: at " + shortText(b.path, 120) + ": " + b.cause);
+            continue;
+        }
+        // A complete run's error record is stale (an earlier attempt's): the run counts as complete.
         entry["status"] = "complete";
-        const Json s = JsonNode::parseFile(p.dir + "/summary.json");
-        entry["renderer"] = s.value("renderer", "");
-        entry["stage_time_source"] = s.value("stage_time_source", "");
-        std::ostringstream prefix;
-        prefix << run.id << "," << run.index;
-        for (size_t a = 0; a < sweep.axes.size(); ++a) prefix << "," << csvField(sweep.axes[a].labels[run.point[a]]);
-        const Json& res = s.at("resolution");
-        prefix << "," << s.at("triangles").dump() << "," << res[0].get<long>() * res[1].get<long>();
-        for (const auto& [id, a] : s.at("algorithms").items())
-            for (const auto& [measure, value] : measures(a))
-                csv << prefix.str() << "," << csvField(id) << "," << csvField(a.at("algorithm").get<std::string>()) << "," << measure
-                    << "," << measureKind(measure) << "," << number(value) << "\n";
+        for (const char* key : {"renderer", "stage_time_source"})
+            entry[key] = s.contains(key) && s[key].is_string() ? s[key] : Json("");
+        csv << rows;
         ++r.merged;
     }
-    writeFileAtomic(dir + "/plan.json", plan.dump(2) + "\n");
+    writeFileAtomic(dir + "/plan.json", plan.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
     writeFileAtomic(dir + "/sweep.csv", csv.str());
 
+    // An argv, never a shell command line: the folder's name is passed as it is, whatever it holds.
     const std::string script = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/sweep_report.py";
-    const std::string cmd = std::string(SHADOWLAB_PLOT_PYTHON) + " '" + script + "' '" + dir + "'" + (plots ? "" : " --no-plots");
-    r.reportWritten = std::system(cmd.c_str()) == 0;
-    if (!r.reportWritten) std::fprintf(stderr, "sweep merge: the report script failed (%s); sweep.csv is complete\n", cmd.c_str());
+    const std::string log = dir + "/sweep_report.log";
+    std::vector<std::string> argv = {SHADOWLAB_PLOT_PYTHON, script, absoluteFolder(dir)};
+    if (!plots) argv.push_back("--no-plots");
+    writeFileAtomic(log, ""); // runChildProcess appends: this merge's output only
+    const int rc = runChildProcess(argv, log);
+    r.reportWritten = rc == 0;
+    if (!r.reportWritten) {
+        std::string tail;
+        try {
+            tail = readInputFile(log, size_t(1) << 20);
+        } catch (const InputError&) {
+        }
+        while (!tail.empty() && tail.back() == '\n') tail.pop_back();
+        const size_t nl = tail.find_last_of('\n');
+        std::fprintf(stderr, "sweep merge: the report script failed (%s): %s; sweep.csv is complete (log: %s)\n",
+                     rc < 0 ? "it could not start, or died of a signal" : ("exit code " + std::to_string(rc)).c_str(),
+                     shortText(nl == std::string::npos ? tail : tail.substr(nl + 1), 300).c_str(), shortText(log, 300).c_str());
+    }
     return r;
 }
 

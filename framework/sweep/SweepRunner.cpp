@@ -1,17 +1,16 @@
 #include "framework/sweep/SweepRunner.h"
 
 #include "framework/core/Error.h"
+#include "framework/core/FileIO.h"
 #include "framework/core/Interrupt.h"
-#include "framework/experiment/Results.h"
+#include "framework/sweep/SweepProcess.h"
+#include "framework/sweep/SweepText.h"
 
 #include <chrono>
 #include <csignal>
 #include <cstring>
-#include <fcntl.h>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -24,12 +23,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string readFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+/// A run's log is read only for the end of it, into its error record; a larger one is named instead.
+constexpr size_t kMaxLogBytes = size_t(8) << 20;
 
 std::string lastLines(const std::string& text, size_t n) {
     size_t pos = text.size();
@@ -45,26 +40,20 @@ std::string lastLines(const std::string& text, size_t n) {
     return text.substr(pos == 0 ? 0 : pos + 1, end - (pos == 0 ? 0 : pos + 1));
 }
 
-/// Starts `binary run CONFIG --out DIR --force --no-progress` with its output in the run's log.
-pid_t startRun(const std::string& binary, const RunPaths& p) {
-    std::vector<std::string> args = {binary, "run", p.config, "--out", p.dir, "--force", "--no-progress"};
-    pid_t pid = fork();
-    if (pid < 0) throw RuntimeError(std::string("fork failed: ") + std::strerror(errno));
-    if (pid == 0) {
-        int fd = open(p.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd >= 0) {
-            dup2(fd, 1);
-            dup2(fd, 2);
-            close(fd);
+std::string logTail(const std::string& log) {
+    try {
+        // Each line cut, so a run that printed one huge line does not make a huge record.
+        std::string tail, lines = lastLines(readInputFile(log, kMaxLogBytes), 8);
+        for (size_t start = 0; start <= lines.size();) {
+            size_t nl = lines.find('\n', start);
+            if (nl == std::string::npos) nl = lines.size();
+            tail += (tail.empty() ? "" : "\n") + validUtf8(lines.substr(start, std::min<size_t>(nl - start, 1000)));
+            start = nl + 1;
         }
-        std::vector<char*> argv;
-        for (auto& a : args) argv.push_back(a.data());
-        argv.push_back(nullptr);
-        execv(binary.c_str(), argv.data());
-        std::fprintf(stderr, "cannot run %s: %s\n", binary.c_str(), std::strerror(errno));
-        _exit(127);
+        return tail;
+    } catch (const InputError& e) {
+        return "(" + e.cause() + ")";
     }
-    return pid;
 }
 
 std::string describeStatus(int status) {
@@ -73,32 +62,91 @@ std::string describeStatus(int status) {
     return "status " + std::to_string(status);
 }
 
+/// DIR and DIR/runs, made where absent; InputError where something else than a folder is there.
+void makeFolders(const std::string& outputDir) {
+    if (outputDir.empty()) throw InputError("--out", "", "the output folder must not be empty");
+    for (const std::string& d : {outputDir, outputDir + "/runs"}) {
+        std::error_code ec;
+        const fs::file_status st = fs::status(d, ec);
+        if (fs::exists(st) && !fs::is_directory(st)) throw InputError(shortText(d, 300), "", "is not a folder (the sweep's output folder goes there)");
+        fs::create_directories(d, ec);
+        if (ec) throw InputError(shortText(d, 300), "", "cannot create the folder: " + ec.message());
+    }
+}
+
 } // namespace
 
 RunPaths::RunPaths(const std::string& outputDir, const std::string& id)
-    : dir(outputDir + "/runs/" + id), config(dir + ".config.json"), log(dir + ".log"), error(dir + ".error.json") {}
+    : dir(outputDir + "/runs/" + id), config(dir + ".config.json"), log(dir + ".log"), error(dir + ".error.json"), lock(dir + ".lock") {}
 
-bool RunPaths::complete() const { return fs::exists(dir + "/summary.json"); }
+bool RunPaths::complete(std::string* why) const {
+    if (why) why->clear();
+    const std::string summary = dir + "/summary.json";
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(dir, ec))) return false;
+    if (!fs::exists(fs::symlink_status(summary, ec))) {
+        if (why) *why = "the run's folder has no summary.json";
+        return false;
+    }
+    try {
+        const Json s = JsonNode::parseFile(summary);
+        if (s.is_object() && s.contains("complete") && s["complete"] == true) return true;
+        if (why) *why = "summary.json does not say \"complete\": true";
+    } catch (const InputError& e) {
+        if (why) *why = "summary.json " + e.cause();
+    }
+    return false;
+}
 
 std::string selfBinary() { return fs::read_symlink("/proc/self/exe").string(); }
 
 void writeSweepSnapshot(const Sweep& sweep, const std::string& outputDir) {
-    fs::create_directories(outputDir + "/runs");
-    const std::string path = outputDir + "/sweep.json", text = sweep.snapshot(outputDir).dump(2) + "\n";
-    if (fs::exists(path) && readFile(path) == text) return;
+    makeFolders(outputDir);
+    const std::string path = outputDir + "/sweep.json";
+    const Json snapshot = sweep.snapshot(outputDir);
+    const std::string text = snapshot.dump(2) + "\n";
+    std::error_code ec;
+    if (fs::exists(fs::symlink_status(path, ec))) {
+        Json old;
+        try {
+            old = JsonNode::parseFile(path);
+        } catch (const InputError& e) {
+            throw InputError(shortText(path, 300), "", e.cause() + " (not a sweep's snapshot: remove it, or choose another --out)");
+        }
+        // The same sweep, whatever folder it was written from: resume. Another one: refuse, since
+        // replacing sweep.json would make the runs already there belong to a sweep they are not of.
+        Json a = old, b = snapshot;
+        if (a.is_object()) a.erase("output");
+        b.erase("output");
+        if (a != b) {
+            const std::string oldName = old.is_object() && old.contains("name") && old["name"].is_string() ? old["name"].get<std::string>() : "?";
+            throw InputError(shortText(path, 300), "",
+                             "holds another sweep (\"" + shortText(oldName, 60) + "\") than " + shortText(sweep.file, 200) + " (\"" +
+                                 shortText(sweep.name, 60) + "\"): choose another --out, or remove " + shortText(path, 200) +
+                                 " to give the folder to the new sweep (its complete runs with equal ids are kept)");
+        }
+        if (readInputFile(path) == text) return;
+    }
     writeFileAtomic(path, text);
 }
 
 int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
+    makeFolders(opt.outputDir);
+    const std::string where = shortText(opt.outputDir, 300);
+    FileLock folderLock;
+    if (!folderLock.tryLock(opt.outputDir + "/sweep.lock", opt.part ? FileLock::Mode::Shared : FileLock::Mode::Exclusive))
+        throw InputError(where, "", opt.part ? "a `sweep run` of the whole sweep is running in this folder (sweep.lock is held): wait for it"
+                                             : "another `sweep run` is running in this folder (sweep.lock is held): wait for it, or stop it");
     writeSweepSnapshot(sweep, opt.outputDir);
     // SIGINT/SIGTERM (a Slurm cancel, Ctrl-C) only set the flag: the runs in flight are stopped first.
     installInterruptHandlers();
     const size_t n = opt.indices.size();
     const int width = int(std::to_string(n).size());
-    size_t reported = 0, failed = 0, next = 0;
+    size_t reported = 0, failed = 0, busy = 0, next = 0;
     struct Running {
         size_t index;
         Clock::time_point start;
+        FileLock lock;
     };
     std::map<pid_t, Running> running;
 
@@ -114,12 +162,26 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
         while (!pendingInterrupt() && next < n && running.size() < std::max<size_t>(1, opt.jobs)) {
             const SweepRun& run = sweep.runs.at(opt.indices[next++]);
             RunPaths p(opt.outputDir, run.id);
-            if (p.complete()) {
-                report(run, "skip", "  (complete already)");
+            FileLock runLock;
+            if (!runLock.tryLock(p.lock, FileLock::Mode::Exclusive)) {
+                ++busy;
+                report(run, "BUSY", "  (another sweep process is running it)");
                 continue;
             }
-            writeFileAtomic(p.config, run.config.dump(2) + "\n");
-            running[startRun(opt.binary, p)] = {run.index, Clock::now()};
+            std::string why;
+            std::error_code ec;
+            if (p.complete(&why)) {
+                // An error record of an earlier failed attempt says nothing about a complete run.
+                const bool stale = fs::remove(p.error, ec);
+                report(run, "skip", stale ? "  (complete already; removed its stale error record)" : "  (complete already)");
+                continue;
+            }
+            if (!why.empty())
+                std::fprintf(stderr, "sweep: run %zu %s is not complete: %s; running it again\n", run.index, run.id.c_str(),
+                             shortText(why, 300).c_str());
+            writeFileAtomic(p.config, sweep.runConfig(run.index).dump(2) + "\n");
+            const pid_t pid = startLoggedChild({opt.binary, "run", p.config, "--out", p.dir, "--force", "--no-progress"}, p.log);
+            running.emplace(pid, Running{run.index, Clock::now(), std::move(runLock)});
         }
         if (running.empty()) continue;
         int status = 0;
@@ -134,25 +196,30 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
         if (it == running.end()) continue;
         const SweepRun& run = sweep.runs[it->second.index];
         const double seconds = std::chrono::duration<double>(Clock::now() - it->second.start).count();
-        running.erase(it);
         RunPaths p(opt.outputDir, run.id);
         char took[64];
         std::snprintf(took, sizeof took, "  (%.1f s)", seconds);
-        if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && p.complete()) {
-            fs::remove(p.error);
+        std::string why;
+        if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && p.complete(&why)) {
+            std::error_code ec;
+            fs::remove(p.error, ec);
             report(run, "done", took);
+            running.erase(it);
             continue;
         }
         ++failed;
+        const std::string cause = describeStatus(status) + (WIFEXITED(status) && WEXITSTATUS(status) == 0 ? "; " + why : "");
         Json error = {{"id", run.id},
                       {"index", run.index},
                       {"axes", runLabel(sweep, run)},
-                      {"status", describeStatus(status)},
+                      {"status", cause},
                       {"seconds", seconds},
                       {"log", p.log},
-                      {"log_tail", lastLines(readFile(p.log), 8)}};
-        writeFileAtomic(p.error, error.dump(2) + "\n");
-        report(run, "FAILED", std::string(took) + ": " + describeStatus(status) + "; see " + p.log);
+                      {"log_tail", logTail(p.log)}};
+        // replace: a byte of the log that is not UTF-8 must not lose the record.
+        writeFileAtomic(p.error, error.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
+        report(run, "FAILED", std::string(took) + ": " + shortText(cause, 300) + "; see " + shortText(p.log, 300));
+        running.erase(it);
     }
 
     if (pendingInterrupt()) {
@@ -168,8 +235,9 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
                      int(pendingInterrupt()), reported, n);
         return 128 + int(pendingInterrupt());
     }
-    std::fprintf(stderr, "sweep: %zu runs: %zu complete, %zu failed (%s)\n", n, n - failed, failed, opt.outputDir.c_str());
-    return failed ? 1 : 0;
+    std::fprintf(stderr, "sweep: %zu runs: %zu complete, %zu failed%s (%s)\n", n, n - failed - busy, failed,
+                 busy ? (", " + std::to_string(busy) + " run by another sweep process").c_str() : "", where.c_str());
+    return failed ? 1 : busy ? 2 : 0;
 }
 
 } // namespace shadowlab
