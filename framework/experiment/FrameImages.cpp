@@ -50,7 +50,8 @@ nlohmann::json heatMapLegend(const DebugView& view, const HeatScale& scale, cons
 
 void writeHeatMaps(const std::string& dir, const std::string& id, int frame, glm::ivec2 res, const std::vector<DebugView>& views) {
     const std::string prefix = frameImagePrefix(id, frame);
-    for (const DebugView& view : views) {
+    for (size_t k = 0; k < views.size(); ++k) {
+        const DebugView& view = views[k];
         auto values = readTextureR32F(view.texture, res.x, res.y);
         const HeatScale scale = heatMapScale(values, view.maxValue);
         const std::string image = prefix + "heat_" + view.name + ".png";
@@ -59,6 +60,7 @@ void writeHeatMaps(const std::string& dir, const std::string& id, int frame, glm
         nlohmann::json legend = heatMapLegend(view, scale, image, res);
         legend["id"] = id;
         legend["frame"] = frame;
+        legend["view_index"] = k; // the algorithm's order of its views, which readers keep
         const std::string path = dir + "/images/" + prefix + "heat_" + view.name + ".json";
         std::ofstream out(path);
         out << legend.dump(2) << "\n";

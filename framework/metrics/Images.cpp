@@ -47,24 +47,54 @@ std::vector<unsigned char> differenceImage(const std::vector<float>& vis, const 
     return out;
 }
 
-std::vector<unsigned char> heatMapImage(const std::vector<float>& values, float maxValue, float* usedMax) {
-    if (maxValue <= 0) {
-        maxValue = 0;
-        for (float v : values) maxValue = std::max(maxValue, v);
-        if (maxValue <= 0) maxValue = 1;
+const char* heatScaleName(HeatScale::Kind kind) { return kind == HeatScale::Kind::Fixed ? "fixed" : "p99"; }
+
+HeatScale heatMapScale(const std::vector<float>& values, float fixedMax) {
+    HeatScale s;
+    std::vector<float> nonZero;
+    for (float v : values) {
+        s.dataMax = std::max(s.dataMax, v);
+        if (v > 0) nonZero.push_back(v);
     }
-    if (usedMax) *usedMax = maxValue;
+    s.nonZero = nonZero.size();
+    if (fixedMax > 0) {
+        s.kind = HeatScale::Kind::Fixed;
+        s.max = fixedMax;
+    } else if (!nonZero.empty()) {
+        // Nearest rank: the smallest value that at least 99 % of the non-zero pixels do not exceed.
+        size_t rank = size_t(std::ceil(0.99 * double(nonZero.size()))) - 1;
+        std::nth_element(nonZero.begin(), nonZero.begin() + std::ptrdiff_t(rank), nonZero.end());
+        s.max = nonZero[rank];
+    }
+    for (float v : values) s.clipped += v > s.max;
+    return s;
+}
+
+const std::array<std::array<float, 3>, 5>& heatRampStops() {
     // Piecewise-linear approximation of a black → purple → orange → yellow ramp.
-    static const float stops[5][3] = {{0, 0, 0.02f}, {0.34f, 0.06f, 0.43f}, {0.73f, 0.21f, 0.33f}, {0.98f, 0.55f, 0.04f}, {0.99f, 1.0f, 0.64f}};
+    static const std::array<std::array<float, 3>, 5> stops{
+        {{0, 0, 0.02f}, {0.34f, 0.06f, 0.43f}, {0.73f, 0.21f, 0.33f}, {0.98f, 0.55f, 0.04f}, {0.99f, 1.0f, 0.64f}}};
+    return stops;
+}
+
+std::vector<unsigned char> heatMapImage(const std::vector<float>& values, const HeatScale& scale) {
+    const auto& stops = heatRampStops();
+    const float range = scale.max > scale.min ? scale.max - scale.min : 1.0f;
     std::vector<unsigned char> out(values.size() * 4);
     for (size_t i = 0; i < values.size(); ++i) {
-        float t = std::clamp(values[i] / maxValue, 0.0f, 1.0f) * 4.0f;
+        float t = std::clamp((values[i] - scale.min) / range, 0.0f, 1.0f) * 4.0f;
         int k = std::min(int(t), 3);
         float u = t - float(k);
         put(out, i, stops[k][0] + u * (stops[k + 1][0] - stops[k][0]), stops[k][1] + u * (stops[k + 1][1] - stops[k][1]),
             stops[k][2] + u * (stops[k + 1][2] - stops[k][2]));
     }
     return out;
+}
+
+std::vector<unsigned char> heatMapImage(const std::vector<float>& values, float maxValue, float* usedMax) {
+    HeatScale scale = heatMapScale(values, maxValue);
+    if (usedMax) *usedMax = scale.max;
+    return heatMapImage(values, scale);
 }
 
 } // namespace shadowlab
