@@ -1,5 +1,6 @@
 // Config parsing and validation: defaults fill in, and every bad input is one InputError naming
 // the file, the JSON path and the cause.
+#include "framework/core/Error.h"
 #include "framework/experiment/Config.h"
 
 #include <gtest/gtest.h>
@@ -98,6 +99,30 @@ TEST(ConfigTest, InvalidJsonFileNamesTheFile) {
             }
         },
         InputError);
+}
+
+} // namespace
+} // namespace shadowlab
+
+namespace shadowlab {
+namespace {
+
+TEST(ConfigOverrideTest, ArrayIndicesAreDigitsWithinTheArray) {
+    // Each is bad input naming the path walked, never a number parser's exception (exit 1).
+    for (const char* bad : {"algorithms.-1.id=x", "algorithms.+0.id=x", "algorithms.100000000000000000000.id=x",
+                            "algorithms.1e3.id=x", "algorithms.2.id=x", "algorithms.0x1.id=x"}) {
+        Json cfg = {{"algorithms", Json::array({{{"algorithm", "psv"}}, {{"algorithm", "ptsv"}}})}};
+        try {
+            applyOverride(cfg, bad);
+            ADD_FAILURE() << bad << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.file(), "--set") << bad;
+            EXPECT_NE(e.cause().find("no element"), std::string::npos) << bad << ": " << e.what();
+        }
+    }
+    Json cfg = {{"algorithms", Json::array({{{"algorithm", "psv"}}, {{"algorithm", "ptsv"}}})}};
+    applyOverride(cfg, "algorithms.1.id=second");
+    EXPECT_EQ(cfg["algorithms"][1]["id"], "second");
 }
 
 } // namespace

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <set>
 
@@ -292,10 +293,13 @@ void applyOverride(Json& config, const std::string& assignment) {
         if (key.empty()) throw InputError("--set", path, "empty path component");
         Json* next = nullptr;
         if (node->is_array()) {
-            const bool numeric = key.find_first_not_of("0123456789") == std::string::npos;
-            if (!numeric || std::stoul(key) >= node->size())
+            // Digits only, and no more of them than an index into this array can have: "-1", "1e3"
+            // and 10^20 are a bad path, not an exception from the number parser.
+            const bool numeric = !key.empty() && key.size() <= 18 && key.find_first_not_of("0123456789") == std::string::npos;
+            const size_t index = numeric ? size_t(std::strtoull(key.c_str(), nullptr, 10)) : 0;
+            if (!numeric || index >= node->size())
                 throw InputError("--set", walked, "no element " + key + " in an array of " + std::to_string(node->size()));
-            next = &(*node)[std::stoul(key)];
+            next = &(*node)[index];
         } else if (node->is_object() || node->is_null()) {
             next = &(*node)[key];
         } else {

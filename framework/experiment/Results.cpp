@@ -256,4 +256,24 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
     writeFileAtomic(path, os.str());
 }
 
+std::string summaryTable(const Json& s) {
+    std::ostringstream os;
+    char line[256];
+    std::snprintf(line, sizeof line, "%-22s %12s %14s %12s %9s\n", "id", "frame (ms)", "preprocess", "mismatch", "overflow");
+    os << line;
+    for (const auto& [id, a] : s.at("algorithms").items()) {
+        const Json& acc = a.at("accuracy");
+        char mismatch[32] = "-";
+        if (!acc.is_null()) std::snprintf(mismatch, sizeof mismatch, "%.4f %%", 100.0 * acc.at("mismatch_ratio_max").get<double>());
+        // Ids are config text: cut so that one long id cannot push the table out of shape.
+        const std::string shown = id.size() > 22 ? id.substr(0, 19) + "..." : id;
+        std::snprintf(line, sizeof line, "%-22s %12.2f %11.1f ms %12s %9llu\n", shown.c_str(),
+                      a.at("time_ms").at("total").at("mean").get<double>(), a.at("preprocess_ms").get<double>(), mismatch,
+                      (unsigned long long)a.at("overflow").get<uint64_t>());
+        os << line;
+    }
+    os << "frame: mean of the timed pass (statistics compiled out); mismatch: worst frame, of lit pixels\n";
+    return os.str();
+}
+
 } // namespace shadowlab

@@ -51,5 +51,9 @@ struct ExperimentResults {
     void writeReport(const std::string& path, const Json& summary) const;
 };
 
+/// The few lines `shadowlab run` prints at the end: per algorithm its timed mean frame time (the
+/// timed pass: statistics compiled out), preprocessing, worst-frame mismatch and overflow.
+std::string summaryTable(const Json& summary);
+
 
 } // namespace shadowlab
