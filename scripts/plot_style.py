@@ -1,14 +1,23 @@
 """One visual style for every plot of shadowlab (run plots and sweep plots): each algorithm id
-keeps one colour everywhere, and each stage (or second grouping) one hatch, line style and marker,
-so every (algorithm, stage) pair reads distinctly even when printed in grey.
+keeps one colour everywhere, and each second grouping (the other axes of a sweep) one line style
+and marker. Stacked stage bars colour by stage instead (stage_styles): one colour and hatch per
+stage name, the same in every algorithm's bar, and no two stages alike.
 """
+import matplotlib
 import matplotlib.colors as mcolors
 
 # Matplotlib's tab10 (colour-blind friendly, distinct in grey) then tab20's lighter set.
 COLOURS = list(mcolors.TABLEAU_COLORS.values()) + ["#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5", "#c49c94"]
 LINESTYLES = ["-", "--", ":", "-."]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
-HATCHES = ["", "//", "..", "xx", "\\\\", "++", "oo", "--"]
+
+# Stage colours: tab20's dark half, then its light half, so that the first ten stages differ
+# strongly and the next ten still differ from every other in hue or lightness.
+_TAB20 = list(matplotlib.colormaps["tab20"].colors)
+STAGE_COLOURS = _TAB20[0::2] + _TAB20[1::2]
+# A second cue for grey print. 7 hatches against 20 colours: a (colour, hatch) pair repeats only
+# after 140 stages.
+STAGE_HATCHES = ["", "//", "..", "xx", "\\\\", "++", "oo"]
 
 
 def colours(ids):
@@ -17,17 +26,18 @@ def colours(ids):
 
 
 def variants(keys):
-    """Line style, marker and hatch per stage (or other grouping), in first-seen order; the first
-    gets a solid line and no hatch."""
-    out = {}
-    for k, key in enumerate(dict.fromkeys(keys)):
-        out[key] = {"linestyle": LINESTYLES[k % len(LINESTYLES)], "marker": MARKERS[k % len(MARKERS)],
-                    "hatch": HATCHES[k % len(HATCHES)]}
-    return out
+    """Line style and marker per grouping, in first-seen order; the first gets a solid line."""
+    return {key: {"linestyle": LINESTYLES[k % len(LINESTYLES)], "marker": MARKERS[k % len(MARKERS)]}
+            for k, key in enumerate(dict.fromkeys(keys))}
 
 
-def shade(colour, k):
-    """The colour lightened a little per step k (stacked segments of one bar stay one hue)."""
-    r, g, b = mcolors.to_rgb(colour)
-    t = min(0.12 * k, 0.5)
-    return (r + (1 - r) * t, g + (1 - g) * t, b + (1 - b) * t)
+def stage_styles(stages):
+    """Face colour and hatch per stage name, in first-seen order: one look per stage."""
+    return {st: {"color": STAGE_COLOURS[k % len(STAGE_COLOURS)], "hatch": STAGE_HATCHES[k % len(STAGE_HATCHES)]}
+            for k, st in enumerate(dict.fromkeys(stages))}
+
+
+def text_colour(face):
+    """Black or white, whichever reads better on a face colour (labels drawn on bar segments)."""
+    r, g, b = mcolors.to_rgb(face)
+    return "black" if 0.299 * r + 0.587 * g + 0.114 * b > 0.5 else "white"

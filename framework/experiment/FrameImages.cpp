@@ -1,13 +1,13 @@
 #include "framework/experiment/FrameImages.h"
 
+#include "framework/core/FileIO.h"
 #include "framework/gl/GlObjects.h"
-#include "framework/core/Error.h"
 #include "framework/metrics/Images.h"
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
-#include <fstream>
 
 namespace shadowlab {
 
@@ -31,7 +31,9 @@ namespace {
 /// What one heat map's colours mean: the JSON written beside its PNG (less id and frame).
 nlohmann::json heatMapLegend(const DebugView& view, const HeatScale& scale, const std::string& image, glm::ivec2 res) {
     nlohmann::json ramp = nlohmann::json::array();
-    for (const auto& c : heatRampStops()) ramp.push_back({c[0], c[1], c[2]});
+    // As the decimals they were written with (a float's 0.02 would print as 0.0199999995…).
+    auto decimal = [](float v) { return std::round(double(v) * 1e4) / 1e4; };
+    for (const auto& c : heatRampStops()) ramp.push_back({decimal(c[0]), decimal(c[1]), decimal(c[2])});
     return {{"name", view.name},
             {"unit", view.unit},
             {"image", image},
@@ -62,9 +64,7 @@ void writeHeatMaps(const std::string& dir, const std::string& id, int frame, glm
         legend["frame"] = frame;
         legend["view_index"] = k; // the algorithm's order of its views, which readers keep
         const std::string path = dir + "/images/" + prefix + "heat_" + view.name + ".json";
-        std::ofstream out(path);
-        out << legend.dump(2) << "\n";
-        if (!out.flush()) throw RuntimeError("cannot write " + path);
+        writeFileAtomic(path, legend.dump(2) + "\n");
     }
 }
 
