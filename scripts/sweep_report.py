@@ -6,6 +6,9 @@
                        power-law fits  time = c * n^k  per (algorithm id, stage) along size axes
   DIR/sweep_AXIS.png   mean time per frame of each stage against the axis, one line per algorithm
                        id (and per value of the other axes); log-log where the axis is a size
+  DIR/sweep_stages.png the stages of each run stacked, a panel per algorithm id, a colour per stage
+  DIR/sweep.html       sweep.md with its figures (a "## Figures" section added to it), as one
+                       self-contained page (report_html.py)
 
 Usage: sweep_report.py DIR [--no-plots]
 """
@@ -204,15 +207,21 @@ def plots(s, directory):
         stages = [st for st in s.stages if any(f"time_ms.{st}" in v for r in s.runs.values() for v in r["values"].values())]
         if not stages:
             continue
-        fig, axes = plt.subplots(1, len(stages), figsize=(4.4 * len(stages), 3.9), squeeze=False)
-        for ax, st in zip(axes[0], stages):
+        # At most four panels a row: a sweep with many stages stays readable at page width.
+        ncols = min(4, len(stages))
+        nrows = -(-len(stages) // ncols)
+        fig, axes = plt.subplots(nrows, ncols, figsize=(4.4 * ncols, 3.9 * nrows), squeeze=False)
+        for ax in axes.flat[len(stages):]:
+            ax.set_axis_off()
+        for ax, st in zip(axes.flat, stages):
             for aid in s.algorithms:
                 for key, runs in groups.items():
                     pts = sorted((s.x(axis, r), r["values"][aid][f"time_ms.{st}"]) for r in runs
                                  if aid in r["values"] and r["values"][aid].get(f"time_ms.{st}"))
                     if not pts:
                         continue
-                    label = aid + (" (" + ", ".join(key) + ")" if key else "")
+                    # The other axes' values by name ("pcf=1"), not as bare labels.
+                    label = aid + (" (" + ", ".join(f"{a['name']}={v}" for a, v in zip(s.others(axis), key)) + ")" if key else "")
                     if size:
                         fit = power_fit([p[0] for p in pts], [p[1] for p in pts])
                         label += f" k={fit[0]:.2f}" if fit else ""
@@ -235,6 +244,72 @@ def plots(s, directory):
         plt.close(fig)
 
 
+def stage_plot(s, directory):
+    """Stacked bars of each run's stages, one panel per algorithm id: the run-level breakdown that
+    the per-axis lines do not show. A stage has one colour and hatch in every panel (plot_style)."""
+    import matplotlib
+    matplotlib.use("Agg")  # headless: no display on CI or servers
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plot_style
+
+    runs = sorted(s.runs.values(), key=lambda r: r["index"])
+    stages = list(dict.fromkeys(m[len("time_ms."):] for r in runs for v in r["values"].values() for m in v
+                                if m.startswith("time_ms.") and m != "time_ms.total" and m != "time_ms.preprocess"))
+    ids = [aid for aid in s.algorithms if any(aid in r["values"] for r in runs)]
+    if not stages or not ids or not runs:
+        return None
+    style = plot_style.stage_styles(stages)
+    labels = [", ".join(f"{k}={v}" for k, v in r["axes"].items()) or f"run {r['index']}" for r in runs]
+    fig, axes = plt.subplots(len(ids), 1, squeeze=False, layout="constrained", figsize=(max(7, 0.55 * len(runs) + 3), 2.6 * len(ids) + 1.2))
+    for ax, aid in zip(axes[:, 0], ids):
+        for x, r in enumerate(runs):
+            bottom = 0.0
+            for st in stages:
+                ms = r["values"].get(aid, {}).get(f"time_ms.{st}")
+                if ms:
+                    ax.bar(x, ms, bottom=bottom, width=0.7, color=style[st]["color"], hatch=style[st]["hatch"],
+                           edgecolor="black", linewidth=0.5)
+                    bottom += ms
+        ax.set_title(aid, fontsize=9)
+        ax.set_ylabel("ms per frame")
+        ax.set_xticks(range(len(runs)))
+        ax.set_xticklabels(labels if ax is axes[-1, 0] else [""] * len(runs), rotation=30, ha="right", fontsize=7)
+        ax.grid(True, axis="y", alpha=0.3)
+    axes[0, 0].legend(handles=[Patch(facecolor=st["color"], hatch=st["hatch"], edgecolor="black", label=name)
+                               for name, st in style.items()], title="stage", loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+    fig.suptitle(f"{s.plan['name']}: mean time per frame of each stage, run by run")
+    path = os.path.join(directory, "sweep_stages.png")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def figures(s, directory):
+    """Appends a "## Figures" section to sweep.md showing every plot drawn (replacing an earlier one)."""
+    names = [(f"sweep_{a['name']}.png", f"Time per frame of each stage against {a['name']}") for a in s.axes]
+    names.append(("sweep_stages.png", "The stages of each run, per algorithm id"))
+    shown = [(n, title) for n, title in names if os.path.exists(os.path.join(directory, n))]
+    path = os.path.join(directory, "sweep.md")
+    with open(path) as f:
+        text = f.read()
+    cut = text.find("\n## Figures\n")
+    if cut >= 0:
+        text = text[:cut + 1]
+    if shown:
+        text = text.rstrip("\n") + "\n\n## Figures\n\n" + "\n\n".join(
+            f"![{title}]({n})" for n, title in shown) + "\n"
+        with open(path, "w") as f:
+            f.write(text)
+
+
+def html_report(directory):
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import report_html
+    report_html.convert(os.path.join(directory, "sweep.md"), os.path.join(directory, "sweep.html"))
+
+
 def main():
     args = sys.argv[1:]
     if not args or len(args) > 2 or (len(args) == 2 and args[1] != "--no-plots"):
@@ -243,6 +318,9 @@ def main():
     report(s, args[0])
     if len(args) == 1:
         plots(s, args[0])
+        stage_plot(s, args[0])
+        figures(s, args[0])
+    html_report(args[0])
 
 
 if __name__ == "__main__":
