@@ -24,6 +24,7 @@ struct BadCase {
     std::string text;                    ///< its content
     std::vector<std::string> fragments;  ///< each must appear in the error line
     std::string objectKeys = {};         ///< a scene file: more keys of the config object loading it
+    test::Fields configFields = {};      ///< a scene file: more top-level keys of the config loading it
 };
 
 std::vector<BadCase> badCases() {
@@ -87,6 +88,42 @@ std::vector<BadCase> badCases() {
          {"/extensionsRequired/0", "EXT_imaginary"}},
         {"AccessorCountBeyondBuffer", "m.gltf", test::triangleGltf({}, 1'000'000'000),
          {"/accessors/0", "exceed bufferView"}},
+        // Moving objects whose pose leaves float range (or turns NaN) on some frame: a config error
+        // naming the path (or the glTF channel or node) and the frame, never an object that vanishes.
+        {"PathCatmullRomScaleOvershoots", "c.json",
+         configWith({{"scene", R"({"time_range": [0, 1.5], "objects": [{"procedural": "plane"},
+                       {"procedural": "sphere", "path": {"interpolation": "catmull_rom", "keyframes": [
+                         {"time": 0, "scale": 1}, {"time": 1, "scale": 1}, {"time": 2, "scale": 3e38}]}}]})"}}),
+         {"c.json", "/scene/objects/1/path", "beyond ±1e15", "frame 1 (time 1.5 s)"}},
+        {"PathScaleSplineLeavesFloatRange", "c.json",
+         configWith({{"scene", R"({"time_range": [0, 1.5], "objects": [{"procedural": "plane"},
+                       {"procedural": "sphere", "path": {"keyframes": [{"time": 0, "scale": 1}, {"time": 1, "scale": 3.4e38},
+                         {"time": 2, "scale": 3.4e38}, {"time": 3, "scale": 1}]}}]})"}}),
+         {"c.json", "/scene/objects/1/path", "interpolated scale is not finite", "time 1.5 s", "frame 1"}},
+        {"GridPathOverAnObjectPathOverflows", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "grid", "count": [1, 1, 1],
+                       "path": {"keyframes": [{"time": 0}, {"time": 1, "scale": 3e38}]},
+                       "object": {"procedural": "sphere", "path": {"keyframes": [{"time": 0}, {"time": 1, "scale": 3e38}]}}}]})"}}),
+         {"c.json", "/scene/objects/0/path", "overflows a float", "frame 1"}},
+        {"TwoNodePathsOnOneNode", "m.gltf", test::triangleGltf({}), {"c.json", "/scene/objects/0/node_paths/1/node", "already has a path"},
+         R"(, "node_paths": [{"node": 0, "path": {"keyframes": [{"time": 0}]}}, {"node": 0, "path": {"keyframes": [{"time": 1}]}}])"},
+        {"GltfTwoChannelsOnOneNodeAndProperty", "m.gltf",
+         test::animatedTriangleGltf({{"translation", "LINEAR", {0, 1}, {0, 0, 0, 1, 0, 0}},
+                                     {"translation", "LINEAR", {0, 1}, {0, 0, 0, 0, 1, 0}}}),
+         {"m.gltf", "/animations/0/channels/1/target", "/animations/0/channels/0 already"}, R"(, "animation": 0)"},
+        {"GltfCubicTranslationLeavesFloatRange", "m.gltf",
+         test::animatedTriangleGltf({{"translation", "CUBICSPLINE", {0, 30},
+                                      {0, 0, 0, 0, 0, 0, 3.4e38f, 0, 0, -3.4e38f, 0, 0, 0, 0, 0, 0, 0, 0}}}),
+         {"m.gltf", "/animations/0/channels/0", "does not fit a float", "time 15 s", "CUBICSPLINE tangents", "frame 1"},
+         R"(, "animation": 0)", {{"frames", "3"}}},
+        {"GltfCubicRotationCancelsOut", "m.gltf",
+         test::animatedTriangleGltf({{"rotation", "CUBICSPLINE", {0, 1},
+                                      {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, 0}}}),
+         {"m.gltf", "/animations/0/channels/0", "zero quaternion", "time 0.5 s", "frame 1"},
+         R"(, "animation": 0)", {{"frames", "3"}}},
+        {"GltfTranslationKeyBeyondCoordinates", "m.gltf",
+         test::animatedTriangleGltf({{"translation", "LINEAR", {0, 1}, {0, 0, 0, 3e38f, 0, 0}}}),
+         {"m.gltf", "/nodes/0", "beyond ±1e15", "frame 1"}, R"(, "animation": 0)"},
         {"UnbackedAccessorOfGigabytes", "m.gltf", test::triangleGltf({{"accessors", R"([{"componentType": 5126, "type": "MAT4", "count": 120000000}])"}}), {"/accessors/0/count", "too large"}},
     };
 }
@@ -104,7 +141,9 @@ TEST_P(HostileInputTest, ExitsTwoWithOneShortLine) {
     std::string config = dir + "/" + c.file;
     if (c.file != "c.json") {  // a scene file: a config that loads it
         config = dir + "/c.json";
-        std::ofstream(config) << test::configWith({{"scene", R"({"objects": [{"gltf": ")" + c.file + "\"" + c.objectKeys + "}]}"}});
+        test::Fields fields = {{"scene", R"({"objects": [{"gltf": ")" + c.file + "\"" + c.objectKeys + "}]}"}};
+        fields.insert(fields.end(), c.configFields.begin(), c.configFields.end());
+        std::ofstream(config) << test::configWith(fields);
     }
     std::string out;
     // ulimit -v: a case that allocates before it checks fails here instead of passing slowly
@@ -123,6 +162,20 @@ TEST_P(HostileInputTest, ExitsTwoWithOneShortLine) {
 
 INSTANTIATE_TEST_SUITE_P(Table, HostileInputTest, ::testing::ValuesIn(badCases()),
                          [](const auto& info) { return std::string(info.param.name); });
+
+TEST(HostileInputTest, AMovingObjectWithANonFinitePoseFailsTheRunBeforeAnythingIsWritten) {
+    // Formerly the object vanished from frame 1 on, every algorithm agreed with the reference on
+    // the emptier scene (0 % mismatch) and the run exited 0.
+    std::string dir = test::makeTempDir("hostile-run-pose");
+    std::ofstream(dir + "/c.json") << test::configWith(
+        {{"scene", R"({"time_range": [0, 1.5], "objects": [{"procedural": "plane"},
+           {"procedural": "sphere", "path": {"interpolation": "catmull_rom", "keyframes": [
+             {"time": 0, "scale": 1}, {"time": 1, "scale": 1}, {"time": 2, "scale": 3e38}]}}]})"}});
+    std::string out;
+    EXPECT_EQ(test::runCommand(bin() + " run " + dir + "/c.json --no-progress --out " + dir + "/out", out), 2) << out;
+    EXPECT_NE(out.find("/scene/objects/1/path"), std::string::npos) << out;
+    EXPECT_FALSE(fs::exists(dir + "/out")) << out;
+}
 
 TEST(HostileInputTest, ParserNamesThePathOfEveryFault) {
     EXPECT_THROW(parseJson(R"({"a": {"b": [1, {"c": 1, "c": 2}]}})", "f"), InputError);

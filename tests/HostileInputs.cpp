@@ -69,6 +69,39 @@ std::string triangleGltf(const Fields& fields, long long positionCount) {
         fields);
 }
 
+std::string animatedTriangleGltf(const std::vector<ChannelSpec>& channels) {
+    std::vector<float> floats = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::string views = R"({"buffer": 0, "byteLength": 36})";
+    std::string accessors = R"({"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3, "min": [0, 0, 0], "max": [1, 1, 0]})";
+    std::string samplers, targets;
+    int next = 1;  // accessor and view index
+    auto add = [&](const std::vector<float>& v, const char* type, size_t count) {
+        views += R"(, {"buffer": 0, "byteOffset": )" + std::to_string(floats.size() * 4) + R"(, "byteLength": )" +
+                 std::to_string(v.size() * 4) + "}";
+        accessors += R"(, {"bufferView": )" + std::to_string(next) + R"(, "componentType": 5126, "type": ")" + type +
+                     R"(", "count": )" + std::to_string(count) + "}";
+        floats.insert(floats.end(), v.begin(), v.end());
+        return next++;
+    };
+    for (size_t c = 0; c < channels.size(); ++c) {
+        const ChannelSpec& ch = channels[c];
+        const int width = ch.path == "rotation" ? 4 : 3;
+        const int input = add(ch.times, "SCALAR", ch.times.size());
+        const int output = add(ch.values, width == 4 ? "VEC4" : "VEC3", ch.values.size() / size_t(width));
+        samplers += std::string(c ? ", " : "") + R"({"input": )" + std::to_string(input) + R"(, "output": )" +
+                    std::to_string(output) + R"(, "interpolation": ")" + ch.interpolation + "\"}";
+        targets += std::string(c ? ", " : "") + R"({"sampler": )" + std::to_string(c) + R"(, "target": {"node": )" +
+                   std::to_string(ch.node) + R"(, "path": ")" + ch.path + "\"}}";
+    }
+    std::vector<unsigned char> bytes(floats.size() * 4);
+    std::memcpy(bytes.data(), floats.data(), bytes.size());
+    return triangleGltf({{"accessors", "[" + accessors + "]"},
+                         {"bufferViews", "[" + views + "]"},
+                         {"buffers", R"([{"byteLength": )" + std::to_string(bytes.size()) +
+                                         R"(, "uri": "data:application/octet-stream;base64,)" + base64(bytes.data(), bytes.size()) + "\"}]"},
+                         {"animations", R"([{"name": "a", "samplers": [)" + samplers + "], \"channels\": [" + targets + "]}]"}});
+}
+
 std::string glbOf(const std::string& json) {
     std::string chunk = json;
     while (chunk.size() % 4) chunk += ' ';

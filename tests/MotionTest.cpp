@@ -6,11 +6,13 @@
 #include "framework/scene/Motion.h"
 #include "framework/scene/SceneConfig.h"
 #include "tests/AnimatedGltf.h"
+#include "tests/HostileInputs.h"
 #include "tests/TestSupport.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
+#include <fstream>
 
 namespace shadowlab {
 namespace {
@@ -213,6 +215,85 @@ TEST(GltfAnimationTest, RefusesSkinsMorphTargetsAndUnknownAnimationsClearly) {
     EXPECT_NE(gltfError(test::kAssimpGltf + "/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", "0")
                   .find("morph target animation (weights) is not supported"),
               std::string::npos);
+}
+
+TEST(MovingSceneTest, BoundsKeepANaNThatGlmMinAndMaxWouldDrop) {
+    Bounds b;
+    b.extend(glm::vec3(1, 2, 3));
+    EXPECT_TRUE(b.finite());
+    b.extend(glm::vec3(std::nanf(""), 0, 0));
+    EXPECT_FALSE(b.finite());
+    EXPECT_TRUE(std::isnan(b.min.x) && std::isnan(b.max.x));
+    b.extend(glm::vec3(5, 5, 5));  // a later finite point does not wash it out
+    EXPECT_TRUE(std::isnan(b.min.x));
+    Bounds c;
+    c.extend(glm::vec3(0));
+    c.extend(b);
+    EXPECT_FALSE(c.finite());
+    Bounds inf;
+    inf.extend(glm::vec3(0, INFINITY, 0));
+    EXPECT_FALSE(inf.finite());
+}
+
+TEST(RigidPathTest, APoseBeyondFloatRangeIsAnErrorNamingThePathAndTheTime) {
+    // Catmull-Rom through 1, 3.4e38, 3.4e38, 1 overshoots to 3.8e38 half way between the middle keys.
+    RigidPath p = parsePath({{"keyframes", {{{"time", 0}, {"scale", 1}}, {{"time", 1}, {"scale", 3.4e38}},
+                                            {{"time", 2}, {"scale", 3.4e38}}, {{"time", 3}, {"scale", 1}}}}});
+    try {
+        p.at(1.5);
+        ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.file(), "p.json");
+        EXPECT_EQ(e.jsonPath(), "/path");
+        EXPECT_NE(e.cause().find("interpolated scale is not finite"), std::string::npos) << e.cause();
+        EXPECT_NE(e.cause().find("at time 1.5 s"), std::string::npos) << e.cause();
+    }
+    // Keys of 1, 1, 3e38 overflowed a float spline into NaN; in double it is a finite, huge scale,
+    // which the experiment's coordinate check refuses (HostileInputTest.PathCatmullRomScaleOvershoots).
+    RigidPath q = parsePath({{"keyframes", {{{"time", 0}, {"scale", 1}}, {{"time", 1}, {"scale", 1}}, {{"time", 2}, {"scale", 3e38}}}}});
+    const glm::mat4 m = q.at(1.5);
+    EXPECT_TRUE(isFinite(m));
+    EXPECT_GT(m[0][0], 1e37f);
+}
+
+TEST(MovingSceneTest, ANonFinitePoseOfAnyPartIsAnErrorNamingWhereItsMotionWasGiven) {
+    Scene s = sceneOf({{{"procedural", "sphere"}, {"path", {{"keyframes", {{{"time", 0}}, {{"time", 1}, {"translate", {1, 0, 0}}}}}}}}});
+    ASSERT_EQ(s.moving.size(), 1u);
+    EXPECT_EQ(s.moving[0].sourceFile, "s.json");
+    EXPECT_EQ(s.moving[0].sourcePath, "/scene/objects/0/path");
+    // A motion function without its own checks: poseAt() is the last guard.
+    s.moving[0].worldFromLocal = [](double t) { return t > 0.5 ? glm::mat4(std::nanf("")) : glm::mat4(1.0f); };
+    EXPECT_NO_THROW(s.poseAt(0.0));
+    try {
+        s.poseAt(0.75);
+        ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.jsonPath(), "/scene/objects/0/path");
+        EXPECT_NE(e.cause().find("not finite at time 0.75 s"), std::string::npos) << e.cause();
+    }
+}
+
+TEST(GltfAnimationTest, ARotationKeyOfHugeComponentsIsTheRotationItPointsAt) {
+    // (1e38, 0, 0, 1): its float length overflows (and the pose became NaN); as a direction it is a
+    // half turn about X, which is what the node plays.
+    const std::string file = test::makeTempDir("anim") + "/big.gltf";
+    std::ofstream(file) << test::animatedTriangleGltf({{"rotation", "LINEAR", {0, 1}, {0, 0, 0, 1, 1e38f, 0, 0, 1}}});
+    Scene s = loadGltf(file, nullptr, 1000, {"0"});
+    ASSERT_EQ(s.moving.size(), 1u);
+    EXPECT_EQ(s.moving[0].sourcePath, "/nodes/0");
+    for (double t : {0.0, 0.25, 0.5, 1.0}) EXPECT_TRUE(isFinite(s.moving[0].worldFromLocal(t))) << t;
+    expectNear(apply(s.moving[0].worldFromLocal(1.0), {0, 1, 0}), {0, -1, 0});
+    expectNear(apply(s.moving[0].worldFromLocal(0.5), {0, 1, 0}), {0, 0, 1});
+}
+
+TEST(GltfAnimationTest, TwoChannelsOnOneNodesPropertyAreRefused) {
+    const std::string file = test::makeTempDir("anim") + "/two.gltf";
+    // Two rotations of node 0: one of them would never play.
+    std::ofstream(file) << test::animatedTriangleGltf({{"rotation", "LINEAR", {0, 1}, {0, 0, 0, 1, 0, 1, 0, 1}},
+                                                       {"scale", "LINEAR", {0, 1}, {1, 1, 1, 2, 2, 2}},
+                                                       {"rotation", "STEP", {0, 1}, {0, 0, 0, 1, 1, 0, 0, 1}}});
+    EXPECT_EQ(gltfError(file, "a"), "/animations/0/channels/2/target: node 0's rotation is animated by /animations/0/channels/0 "
+                                    "already (glTF allows one channel per node and property)");
 }
 
 } // namespace

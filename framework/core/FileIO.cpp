@@ -2,6 +2,7 @@
 
 #include "framework/core/Error.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -26,7 +27,9 @@ const char* kindOf(mode_t m) {
 
 std::string sizeText(size_t bytes) {
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.0f MiB", double(bytes) / double(1 << 20));
+    // Whole MiB from 1 MiB up; below, bytes (a small cap would read "0 MiB").
+    if (bytes < (size_t(1) << 20)) std::snprintf(buf, sizeof buf, "%zu bytes", bytes);
+    else std::snprintf(buf, sizeof buf, "%.0f MiB", double(bytes) / double(1 << 20));
     return buf;
 }
 
@@ -95,7 +98,7 @@ void writeFileAtomic(const std::string& path, const std::string& text) {
     if (!kind.empty()) throw InputError(path, "", "is " + kind + ": refusing to replace it with a file");
     const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-    if (fd < 0) throw RuntimeError("cannot create " + tmp + ": " + std::strerror(errno));
+    if (fd < 0) throw RuntimeError("cannot write " + path + " (creating " + tmp + "): " + std::strerror(errno));
     auto fail = [&](const char* what, int err) {
         ::unlink(tmp.c_str());
         throw RuntimeError(std::string("cannot ") + what + " " + path + ": " + std::strerror(err));

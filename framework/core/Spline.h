@@ -5,10 +5,14 @@
 
 namespace shadowlab {
 
-inline glm::vec3 catmullRom(glm::vec3 p0, glm::vec3 p1, glm::vec3 p2, glm::vec3 p3, float u) {
-    const float u2 = u * u, u3 = u2 * u;
-    return 0.5f * ((2.0f * p1) + (-p0 + p2) * u + (2.0f * p0 - 5.0f * p1 + 4.0f * p2 - p3) * u2 +
-                   (-p0 + 3.0f * p1 - 3.0f * p2 + p3) * u3);
+/// For any glm vector type: object paths evaluate it in double, where keys near the float limit
+/// (a scale of 3e38) cannot overflow in the weighted sums; the caller checks the result fits a float.
+template <class V>
+V catmullRom(V p0, V p1, V p2, V p3, typename V::value_type u) {
+    using S = typename V::value_type;
+    const S u2 = u * u, u3 = u2 * u;
+    return S(0.5) * ((S(2) * p1) + (-p0 + p2) * u + (S(2) * p0 - S(5) * p1 + S(4) * p2 - p3) * u2 +
+                     (-p0 + S(3) * p1 - S(3) * p2 + p3) * u3);
 }
 
 } // namespace shadowlab

@@ -18,6 +18,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <sys/stat.h>
 #include <tuple>
 #include <sstream>
 #include <utility>
@@ -926,7 +927,12 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
     // External buffers are read like every other input: regular files only, size-capped (a FIFO
     // or /dev/zero named as a buffer's uri is bad input, not a hang or an out-of-memory abort).
     tinygltf::FsCallbacks fs{};
-    fs.FileExists = tinygltf::FileExists;
+    // tinygltf's own FileExists fopen()s the file, which blocks on a FIFO until a writer comes:
+    // whether something is there is a stat(); what it is, readInputFileBytes() says.
+    fs.FileExists = [](const std::string& path, void*) {
+        struct stat st {};
+        return ::stat(path.c_str(), &st) == 0;
+    };
     fs.ExpandFilePath = tinygltf::ExpandFilePath;
     fs.WriteWholeFile = tinygltf::WriteWholeFile;
     fs.ReadWholeFile = [](std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {

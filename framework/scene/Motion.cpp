@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <utility>
 
 namespace shadowlab {
@@ -26,31 +28,75 @@ glm::vec3 readScale(JsonNode& node) {
     return node.getVec3("scale", glm::vec3(1.0f));
 }
 
+bool isFinite(const glm::mat4& m) {
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+            if (!std::isfinite(m[c][r])) return false;
+    return true;
+}
+
+bool isFinite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string atTimeText(double time) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "at time %.6g s", time);
+    return buf;
+}
+
 RigidPath::RigidPath(std::vector<RigidKey> keys, Interpolation interpolation)
     : keys_(std::move(keys)), interpolation_(interpolation) {}
 
 glm::mat4 RigidPath::at(double time) const {
     if (keys_.empty()) return glm::mat4(1.0f);
-    auto pose = [](const RigidKey& k) { return composeTransform(k.translate, k.rotateDeg, k.scale); };
-    if (keys_.size() == 1 || time <= keys_.front().time) return pose(keys_.front());
+    auto fail = [&](const std::string& what) {
+        throw InputError(file, jsonPath, what + " " + atTimeText(time));
+    };
+    auto pose = [&](const RigidKey& k) {
+        const glm::mat4 m = composeTransform(k.translate, k.rotateDeg, k.scale);
+        if (!isFinite(m)) fail("the path's pose matrix is not finite");
+        return m;
+    };
+    if (keys_.size() == 1 || !(time > keys_.front().time)) return pose(keys_.front());
     if (time >= keys_.back().time) return pose(keys_.back());
     auto it = std::upper_bound(keys_.begin(), keys_.end(), time, [](double t, const RigidKey& k) { return t < k.time; });
     size_t i1 = size_t(it - keys_.begin()) - 1, i2 = i1 + 1;
     if (interpolation_ == Interpolation::Step) return pose(keys_[i1]);
-    float u = float((time - keys_[i1].time) / (keys_[i2].time - keys_[i1].time));
+    // In double: keys near the float limit (a scale of 3e38) overflow a float spline's weighted sums
+    // into inf - inf = NaN. What does not fit a float afterwards is bad input, never a NaN pose.
+    const double u = (time - keys_[i1].time) / (keys_[i2].time - keys_[i1].time);
+    auto toFloat = [&](glm::dvec3 v, const char* what) {
+        for (int a = 0; a < 3; ++a)
+            if (!(std::abs(v[a]) <= double(std::numeric_limits<float>::max())))
+                fail(std::string("the path's interpolated ") + what + " is not finite in float range (" +
+                     (interpolation_ == Interpolation::CatmullRom ? "the catmull_rom spline through its keys overshoots; "
+                                                                    "use \"linear\" or keys of nearer values"
+                                                                  : "check its keys") + ")");
+        return glm::vec3(v);
+    };
     RigidKey k;
+    glm::dvec3 t, r, sc;
     if (interpolation_ == Interpolation::Linear) {
-        k.translate = glm::mix(keys_[i1].translate, keys_[i2].translate, u);
-        k.rotateDeg = glm::mix(keys_[i1].rotateDeg, keys_[i2].rotateDeg, u);
-        k.scale = glm::mix(keys_[i1].scale, keys_[i2].scale, u);
+        t = glm::mix(glm::dvec3(keys_[i1].translate), glm::dvec3(keys_[i2].translate), u);
+        r = glm::mix(glm::dvec3(keys_[i1].rotateDeg), glm::dvec3(keys_[i2].rotateDeg), u);
+        sc = glm::mix(glm::dvec3(keys_[i1].scale), glm::dvec3(keys_[i2].scale), u);
     } else {
         size_t i0 = i1 == 0 ? 0 : i1 - 1, i3 = std::min(i2 + 1, keys_.size() - 1);
-        k.translate = catmullRom(keys_[i0].translate, keys_[i1].translate, keys_[i2].translate, keys_[i3].translate, u);
-        k.rotateDeg = catmullRom(keys_[i0].rotateDeg, keys_[i1].rotateDeg, keys_[i2].rotateDeg, keys_[i3].rotateDeg, u);
-        k.scale = catmullRom(keys_[i0].scale, keys_[i1].scale, keys_[i2].scale, keys_[i3].scale, u);
+        auto spline = [&](glm::vec3 RigidKey::*member) {
+            return catmullRom(glm::dvec3(keys_[i0].*member), glm::dvec3(keys_[i1].*member), glm::dvec3(keys_[i2].*member),
+                              glm::dvec3(keys_[i3].*member), u);
+        };
+        t = spline(&RigidKey::translate);
+        r = spline(&RigidKey::rotateDeg);
+        sc = spline(&RigidKey::scale);
         // A spline through positive scales can dip below zero between them; a scale is never mirrored here.
-        k.scale = glm::max(k.scale, 1e-6f * glm::min(keys_[i1].scale, keys_[i2].scale));
+        // (glm::max would pass a NaN through silently; toFloat below refuses it.)
+        const glm::dvec3 floor = 1e-6 * glm::min(glm::dvec3(keys_[i1].scale), glm::dvec3(keys_[i2].scale));
+        for (int a = 0; a < 3; ++a)
+            if (sc[a] < floor[a]) sc[a] = floor[a];
     }
+    k.translate = toFloat(t, "translate");
+    k.rotateDeg = toFloat(r, "rotate_deg");
+    k.scale = toFloat(sc, "scale");
     return pose(k);
 }
 
@@ -78,11 +124,24 @@ RigidPath RigidPath::parse(JsonNode node) {
     }
     if (keys.empty()) node.fail("keyframes", "a path needs at least one keyframe");
     node.finish();
-    return RigidPath(std::move(keys), interp);
+    RigidPath path(std::move(keys), interp);
+    path.file = node.file();
+    path.jsonPath = node.path();
+    return path;
 }
 
 MotionFn RigidPath::motion() const {
     return [path = *this](double time) { return path.at(time); };
+}
+
+MotionFn composeMotion(MotionFn outer, MotionFn inner, std::string file, std::string jsonPath) {
+    return [outer = std::move(outer), inner = std::move(inner), file = std::move(file), jsonPath = std::move(jsonPath)](double time) {
+        const glm::mat4 m = outer(time) * inner(time);
+        if (!isFinite(m))
+            throw InputError(file, jsonPath,
+                             "the pose composed with the motion inside this object overflows a float " + atTimeText(time));
+        return m;
+    };
 }
 
 void MovingPart::setLocal(std::vector<glm::vec3> vertices) {
@@ -90,7 +149,12 @@ void MovingPart::setLocal(std::vector<glm::vec3> vertices) {
     localMin = glm::vec3(0.0f), localMax = glm::vec3(0.0f);
     if (local.empty()) return;
     localMin = localMax = local.front();
-    for (const glm::vec3& v : local) localMin = glm::min(localMin, v), localMax = glm::max(localMax, v);
+    // Not glm::min / glm::max, which drop a NaN operand: a NaN vertex must show in the box.
+    for (const glm::vec3& v : local)
+        for (int a = 0; a < 3; ++a) {
+            if (std::isnan(v[a]) || std::isnan(localMin[a])) localMin[a] = localMax[a] = std::nanf("");
+            else localMin[a] = std::min(localMin[a], v[a]), localMax[a] = std::max(localMax[a], v[a]);
+        }
 }
 
 void poseTriangle(const glm::mat4& m, const glm::vec3* local, glm::vec3* out, glm::vec3& normal) {

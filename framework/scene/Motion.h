@@ -15,6 +15,13 @@
 
 namespace shadowlab {
 
+/// Every element is finite. A NaN or infinite pose moves its triangles out of every view (they
+/// vanish without an error), so each pose is checked before anything uses it.
+bool isFinite(const glm::mat4& m);
+bool isFinite(glm::vec3 v);
+/// "at time 1.25 s", for errors about a pose.
+std::string atTimeText(double time);
+
 /// translate · rotate · scale, the rotation as Euler degrees applied X first, then Y, then Z
 /// (the convention of a config's "transform").
 glm::mat4 composeTransform(glm::vec3 translate, glm::vec3 rotateDeg, glm::vec3 scale);
@@ -39,6 +46,8 @@ public:
     RigidPath() = default;
     RigidPath(std::vector<RigidKey> keys, Interpolation interpolation);
 
+    /// The pose at `time`; InputError (naming the path's file and JSON path, and the time) when an
+    /// interpolated value or the matrix is not finite or does not fit a float.
     glm::mat4 at(double time) const;
     /// The path as a motion function (a copy: it outlives this object).
     std::function<glm::mat4(double)> motion() const;
@@ -49,6 +58,9 @@ public:
     ///        "interpolation": "catmull_rom" | "linear" | "step"}; at least one keyframe, times
     /// strictly increasing, scales positive (a mirror belongs in the static "transform").
     static RigidPath parse(JsonNode node);
+
+    /// Where the path was read from, for its errors (parse() sets it).
+    std::string file, jsonPath;
 
 private:
     std::vector<RigidKey> keys_;
@@ -66,10 +78,16 @@ struct MovingPart {
     MotionFn worldFromLocal;
     double startTime = 0, endTime = 0; ///< when its motion starts and ends (the default clock)
     glm::vec3 localMin{0.0f}, localMax{0.0f}; ///< box of `local` (setLocal() keeps it)
+    /// Where its motion was given (a config's path, a glTF node), named by errors about its pose.
+    std::string sourceFile, sourcePath;
 
     /// Sets the local copy and its box.
     void setLocal(std::vector<glm::vec3> vertices);
 };
+
+/// `outer` composed onto `inner` (world = outer(t) · inner(t)), checked: a product of two finite
+/// poses can still overflow a float, which is blamed on the outer motion (file, JSON path, time).
+MotionFn composeMotion(MotionFn outer, MotionFn inner, std::string file, std::string jsonPath);
 
 /// Places one triangle of a moving part with matrix `m`: the three vertices, the winding flipped
 /// back under a mirroring matrix, and the unit normal ((0, 1, 0) should the triangle collapse).

@@ -1,5 +1,7 @@
 #include "framework/scene/Scene.h"
 
+#include "framework/core/Error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -62,9 +64,14 @@ void Scene::append(const Scene& other, const glm::mat4& m) {
         MovingPart part = other.moving[p];
         part.firstTriangle = partStart[p];
         MotionFn inner = part.worldFromLocal;
-        part.worldFromLocal = [inner, m](double time) { return m * inner(time); };
+        part.worldFromLocal = [inner, m, file = part.sourceFile, path = part.sourcePath](double time) {
+            const glm::mat4 r = m * inner(time);
+            if (!isFinite(r))
+                throw InputError(file, path, "the pose, placed by the transforms around it, overflows a float " + atTimeText(time));
+            return r;
+        };
         // Posed from its local copy with the composed matrix, exactly as every later frame is.
-        const glm::mat4 rest = part.worldFromLocal(0.0);
+        const glm::mat4 rest = poseOf(part, 0.0);
         for (size_t i = 0; i < part.triangleCount; ++i) {
             const size_t t = part.firstTriangle + i;
             poseTriangle(rest, &part.local[3 * i], &positions[3 * t], normals[t]);
@@ -99,10 +106,18 @@ size_t Scene::movingTriangleCount() const {
     return n;
 }
 
+glm::mat4 poseOf(const MovingPart& part, double time) {
+    // The motions check themselves and name their own key or channel; this is the last guard, for
+    // a motion function written without such checks: a NaN pose would make the part vanish.
+    const glm::mat4 m = part.worldFromLocal(time);
+    if (!isFinite(m)) throw InputError(part.sourceFile, part.sourcePath, "the moving object's pose is not finite " + atTimeText(time));
+    return m;
+}
+
 std::vector<glm::mat4> Scene::poseAt(double time) const {
     std::vector<glm::mat4> pose;
     pose.reserve(moving.size());
-    for (const MovingPart& part : moving) pose.push_back(part.worldFromLocal(time));
+    for (const MovingPart& part : moving) pose.push_back(poseOf(part, time));
     return pose;
 }
 
@@ -136,7 +151,8 @@ glm::dvec2 Scene::motionTimeRange() const {
     return r;
 }
 
-void Scene::attachMotion(const MotionFn& motion, double startTime, double endTime) {
+void Scene::attachMotion(const MotionFn& motion, double startTime, double endTime, const std::string& sourceFile,
+                         const std::string& sourcePath) {
     std::vector<MovingPart> parts;
     for (auto [from, to] : staticRuns()) {
         MovingPart part;
@@ -144,13 +160,14 @@ void Scene::attachMotion(const MotionFn& motion, double startTime, double endTim
         part.triangleCount = to - from;
         part.setLocal({positions.begin() + ptrdiff_t(3 * from), positions.begin() + ptrdiff_t(3 * to)});
         part.worldFromLocal = motion;
+        part.sourceFile = sourceFile;
+        part.sourcePath = sourcePath;
         part.startTime = startTime;
         part.endTime = endTime;
         parts.push_back(std::move(part));
     }
     for (MovingPart& part : moving) {
-        MotionFn inner = part.worldFromLocal;
-        part.worldFromLocal = [inner, motion](double time) { return motion(time) * inner(time); };
+        part.worldFromLocal = composeMotion(motion, part.worldFromLocal, sourceFile, sourcePath);
         part.startTime = std::min(part.startTime, startTime);
         part.endTime = std::max(part.endTime, endTime);
         parts.push_back(std::move(part));

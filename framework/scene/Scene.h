@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -19,15 +20,36 @@ struct Material {
     float opacity = 1.0f;    ///< 1 = opaque caster; < 1 lets light through ("x-ray" casters), in [0, 1]
 };
 
+/// An axis-aligned box. extend() keeps a NaN: glm::min / glm::max (and std::min) return the other
+/// operand when one is NaN, so a posed point that became NaN would silently vanish from the box and
+/// every range check on it would pass. Here a NaN coordinate makes the box NaN, which finite() and
+/// any `!(|x| <= limit)` check catch.
 struct Bounds {
     glm::vec3 min{1e30f}, max{-1e30f};
-    void extend(glm::vec3 p) { min = glm::min(min, p); max = glm::max(max, p); }
-    void extend(const Bounds& b) { min = glm::min(min, b.min); max = glm::max(max, b.max); }
+    void extend(glm::vec3 p) {
+        for (int a = 0; a < 3; ++a) min[a] = lowest(min[a], p[a]), max[a] = highest(max[a], p[a]);
+    }
+    void extend(const Bounds& b) {
+        for (int a = 0; a < 3; ++a) min[a] = lowest(min[a], b.min[a]), max[a] = highest(max[a], b.max[a]);
+    }
+    /// Every coordinate of both corners is finite (an empty box counts as finite).
+    bool finite() const {
+        for (int a = 0; a < 3; ++a)
+            if (!std::isfinite(min[a]) || !std::isfinite(max[a])) return false;
+        return true;
+    }
     bool empty() const { return min.x > max.x; }
     glm::vec3 center() const { return 0.5f * (min + max); }
     glm::vec3 extent() const { return max - min; }
     float radius() const { return 0.5f * glm::length(max - min); } ///< of the bounding sphere around center()
+
+private:
+    static float lowest(float a, float b) { return std::isnan(a) || std::isnan(b) ? std::nanf("") : (b < a ? b : a); }
+    static float highest(float a, float b) { return std::isnan(a) || std::isnan(b) ? std::nanf("") : (b > a ? b : a); }
 };
+
+/// One part's world matrix at `time`, checked as poseAt() checks it.
+glm::mat4 poseOf(const MovingPart& part, double time);
 
 /// A triangle soup in world space: triangle i has vertices positions[3i..3i+2].
 struct Scene {
@@ -46,7 +68,8 @@ struct Scene {
     size_t movingTriangleCount() const;
     /// The ranges [from, to) of triangles outside every moving part, in order.
     std::vector<std::pair<size_t, size_t>> staticRuns() const;
-    /// Each moving part's world matrix at `time`.
+    /// Each moving part's world matrix at `time`; InputError (naming where the motion was given and
+    /// the time) when one is not finite.
     std::vector<glm::mat4> poseAt(double time) const;
     /// Rewrites the moving parts' positions and normals for `pose` (poseAt()), and the bounds.
     void applyPose(const std::vector<glm::mat4>& pose);
@@ -58,7 +81,9 @@ struct Scene {
     /// Turns every triangle outside a moving part into parts moving with `motion` (their current
     /// positions are their local ones) and composes `motion` onto the existing parts; then poses
     /// the scene at time 0.
-    void attachMotion(const MotionFn& motion, double startTime, double endTime);
+    /// `sourceFile` and `sourcePath` name the motion (a config's path) in errors about its poses.
+    void attachMotion(const MotionFn& motion, double startTime, double endTime, const std::string& sourceFile = {},
+                      const std::string& sourcePath = {});
 
     /// Appends triangles (already in world space) using `material`; degenerate triangles
     /// (zero area) are dropped since they cast no shadow and have no normal.

@@ -45,6 +45,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <utility>
 
@@ -234,11 +235,16 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         }
         GltfMotion motion;
         motion.animation = animation;
+        std::map<size_t, std::string> nodesMoved;  // node → the node_paths entry that moves it
         for (JsonNode& np : node.objectArray("node_paths")) {
             GltfNodeMotion nm;
             if (!np.has("node")) np.fail("node", "required key is missing");
             if (!np.has("path")) np.fail("path", "required key is missing");
             nm.node = size_t(np.getInt("node", 0, 0));
+            // A node has one path: a second would replace the first, which would silently not move.
+            if (auto [it, fresh] = nodesMoved.emplace(nm.node, np.path()); !fresh)
+                np.fail("node", "node " + std::to_string(nm.node) + " already has a path (" + it->second +
+                                    "); give each node one path");
             nm.aboutCentre = np.getEnum("pivot", "centre", {"centre", "origin"}) == "centre";
             RigidPath path = RigidPath::parse(np.child("path"));
             nm.motion = path.motion();
@@ -279,7 +285,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         }
         if (m != glm::mat4(1.0f)) transformInPlace(s, m);
         // The path moves the placed object: world(t) = path(t) · transform · object.
-        if (path) s.attachMotion(path->motion(), path->startTime(), path->endTime());
+        if (path) s.attachMotion(path->motion(), path->startTime(), path->endTime(), path->file, path->jsonPath);
         checkBuilt(s, node);
         return s;
     };
