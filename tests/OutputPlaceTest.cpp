@@ -111,5 +111,119 @@ TEST(OutputPlaceTest, PlacesThatCannotHoldAnOutputAreBadInput) {
     EXPECT_TRUE(fs::is_directory(base + "/fresh"));
 }
 
+std::string commitError(OutputPlace& p) {
+    try {
+        p.commit();
+    } catch (const RuntimeError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(OutputPlaceTest, AnOutputInsideARunInProgressOrInsideAnotherOutputIsRefused) {
+    std::string base = test::makeTempDir("place-nest"), outer = base + "/X/L", inner = outer + "/sub";
+    {
+        // The longer run into X/L started first; the shorter one into X/L/sub would have created
+        // X/L and committed there, then been replaced by the first one's commit.
+        OutputPlace first = OutputPlace::open(outer, false);
+        std::string err = errorOf(inner, false);
+        EXPECT_NE(err.find("inside " + fs::absolute(outer).string() + ", the output of a shadowlab run in progress (pid " +
+                           std::to_string(::getpid()) + ")"),
+                  std::string::npos)
+            << err;
+        EXPECT_FALSE(fs::exists(outer)) << "nothing may be created for a refused run";
+        std::ofstream(first.partialDir() + "/summary.json") << "outer";
+        first.commit();
+    }
+    // Once committed, X/L is an output: a run inside it would be deleted by the next --force there.
+    EXPECT_NE(errorOf(inner, true).find("a shadowlab run's output (it holds summary.json)"), std::string::npos);
+    EXPECT_NE(errorOf(outer + "/images/deeper", true).find("a shadowlab run's output"), std::string::npos);
+    EXPECT_NE(errorOf(outer + ".partial-12/sub", true).find("temporary directory"), std::string::npos);
+    EXPECT_EQ(slurp(outer + "/summary.json"), "outer");
+}
+
+TEST(OutputPlaceTest, ForceDoesNotReplaceADirectoryHoldingARunInProgress) {
+    std::string base = test::makeTempDir("place-nest-live"), outer = base + "/X/L";
+    // The shorter run into X/L/sub started first (and created X/L); the longer one aims at X/L.
+    OutputPlace inner = OutputPlace::open(outer + "/sub", false);
+    std::string err = errorOf(outer, true);
+    EXPECT_NE(err.find("sub.lock, the lock of a shadowlab run in progress"), std::string::npos) << err;
+    EXPECT_NE(errorOf(outer, false).find("already exists"), std::string::npos);
+    std::ofstream(inner.partialDir() + "/summary.json") << "inner";
+    inner.commit();
+    EXPECT_EQ(slurp(outer + "/sub/summary.json"), "inner");
+    // Done, X/L holds an output in a subdirectory: still not a single run's output to replace.
+    EXPECT_NE(errorOf(outer, true).find("not a shadowlab output"), std::string::npos);
+    EXPECT_EQ(slurp(outer + "/sub/summary.json"), "inner");
+}
+
+TEST(OutputPlaceTest, ForceReplacesOnlyASingleRunsOutputNeverOneHoldingOthers) {
+    std::string base = test::makeTempDir("place-force-nested");
+    makeOutput(base + "/A", "a");
+    makeOutput(base + "/A/B", "nested run");
+    std::string err = errorOf(base + "/A", true);
+    EXPECT_NE(err.find("/A/B, another shadowlab output (it holds summary.json)"), std::string::npos) << err;
+    makeOutput(base + "/S", "s");
+    fs::create_directories(base + "/S/sweep/runs");
+    std::ofstream(base + "/S/sweep/sweep.json") << "{}";
+    EXPECT_NE(errorOf(base + "/S", true).find("another shadowlab sweep (it holds sweep.json)"), std::string::npos);
+    // A sweep's own directory is not a run's output either.
+    fs::create_directories(base + "/T/runs");
+    std::ofstream(base + "/T/sweep.json") << "{}";
+    EXPECT_NE(errorOf(base + "/T", true).find("is a sweep (it holds sweep.json)"), std::string::npos);
+    EXPECT_TRUE(fs::exists(base + "/T/sweep.json"));
+    EXPECT_EQ(slurp(base + "/A/B/summary.json"), "nested run");
+    EXPECT_TRUE(fs::exists(base + "/S/sweep/sweep.json"));
+}
+
+TEST(OutputPlaceTest, ASweepsRunSlotsAreTheOnlyOutputsInsideIt) {
+    std::string base = test::makeTempDir("place-sweep"), sweep = base + "/sweep";
+    fs::create_directories(sweep + "/runs");
+    std::ofstream(sweep + "/sweep.json") << "{}";
+    {
+        OutputPlace run = OutputPlace::open(sweep + "/runs/abc123", true);  // as `sweep run` starts its runs
+        std::ofstream(run.partialDir() + "/summary.json") << "run";
+        run.commit();
+    }
+    EXPECT_EQ(slurp(sweep + "/runs/abc123/summary.json"), "run");
+    EXPECT_NE(errorOf(sweep + "/mine", false).find("inside the sweep directory"), std::string::npos);
+    EXPECT_NE(errorOf(sweep + "/runs/abc123/x", false).find("a shadowlab run's output"), std::string::npos);
+}
+
+TEST(OutputPlaceTest, ACommitKeepsWhatAppearedAtThePlaceAfterOpenAndKeepsItsOwnResultsBeside) {
+    std::string base = test::makeTempDir("place-appeared"), out = base + "/X/L";
+    std::string kept = out + ".kept-" + std::to_string(::getpid());
+    {
+        OutputPlace p = OutputPlace::open(out, false);
+        std::ofstream(p.partialDir() + "/summary.json") << "mine";
+        // Meanwhile another run (one that passed its checks just before this one took its lock)
+        // committed X/L/sub, creating X/L.
+        makeOutput(out + "/sub", "theirs");
+        std::string err = commitError(p);
+        EXPECT_NE(err.find("not replacing " + out + ": it appeared while this run was working"), std::string::npos) << err;
+        EXPECT_NE(err.find(kept), std::string::npos) << err;
+    }  // the destructor keeps the moved results
+    EXPECT_EQ(slurp(out + "/sub/summary.json"), "theirs");
+    EXPECT_EQ(slurp(kept + "/summary.json"), "mine");
+    EXPECT_FALSE(fs::exists(out + ".lock"));
+    // The kept results are no leftover: a later run into the place leaves them alone.
+    fs::remove_all(out);
+    {
+        OutputPlace again = OutputPlace::open(out, false);
+        again.commit();
+    }
+    EXPECT_EQ(slurp(kept + "/summary.json"), "mine");
+
+    // --force: the checked output was given an output inside it meanwhile.
+    std::string forced = base + "/F";
+    makeOutput(forced, "old");
+    OutputPlace p = OutputPlace::open(forced, true);
+    makeOutput(forced + "/late", "late");
+    std::string err = commitError(p);
+    EXPECT_NE(err.find("it now holds " + forced + "/late, another shadowlab output"), std::string::npos) << err;
+    EXPECT_EQ(slurp(forced + "/late/summary.json"), "late");
+    EXPECT_EQ(slurp(forced + "/summary.json"), "old");
+}
+
 } // namespace
 } // namespace shadowlab

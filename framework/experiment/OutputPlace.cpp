@@ -36,20 +36,130 @@ bool containsWorkingDir(const std::string& dir) {
     }
 }
 
+/// The file that marks `dir` as shadowlab's ("summary.json", "config.resolved.json": a run's
+/// output; "sweep.json": a sweep's directory), or "" for none.
+std::string markerOf(const fs::path& dir) {
+    std::error_code ec;
+    for (const char* name : {"summary.json", "config.resolved.json", "sweep.json"})
+        if (fs::exists(fs::symlink_status(dir / name, ec))) return name;
+    return "";
+}
+
+/// A run's output (or an empty directory, which holds nothing to lose).
 bool isShadowlabOutput(const fs::path& dir) {
     std::error_code ec;
-    return fs::exists(dir / "summary.json", ec) || fs::exists(dir / "config.resolved.json", ec) || fs::is_empty(dir, ec);
+    const std::string m = markerOf(dir);
+    return m == "summary.json" || m == "config.resolved.json" || (m.empty() && fs::is_empty(dir, ec));
+}
+
+/// Whether another run holds `lockPath` now: its holder keeps an exclusive flock for the whole run,
+/// so a shared non-blocking attempt fails. The probe holds its shared lock for microseconds, and
+/// acquireLock() retries for a while before it calls a place busy, so probing never turns a run away.
+bool lockIsLive(const std::string& lockPath) {
+    const int fd = ::open(lockPath.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) return false;  // none (a run unlinks its lock when it ends), or not ours to read
+    struct stat st {};
+    bool live = false;
+    if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+        if (::flock(fd, LOCK_SH | LOCK_NB) != 0) live = errno == EWOULDBLOCK;
+        else ::flock(fd, LOCK_UN);
+    }
+    ::close(fd);
+    return live;
+}
+
+std::string lockOwner(const std::string& lockPath) {
+    const int fd = ::open(lockPath.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) return "";
+    char owner[24] = {0};
+    const ssize_t n = ::pread(fd, owner, sizeof owner - 1, 0);
+    ::close(fd);
+    std::string pid(owner, n > 0 ? size_t(n) : 0);
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) return "";
+    return " (pid " + pid + ")";
+}
+
+/// "X.partial-123" or "X.old-123": a run's temporary directory beside its output.
+bool isRunTemporary(const std::string& name) {
+    for (const char* tag : {".partial-", ".old-", ".kept-"}) {
+        const size_t at = name.rfind(tag);
+        if (at != std::string::npos && at > 0 && at + std::strlen(tag) < name.size() &&
+            name.find_first_not_of("0123456789", at + std::strlen(tag)) == std::string::npos)
+            return true;
+    }
+    return false;
+}
+
+/// An output inside another run's output, inside a run in progress, or inside a sweep (other than a
+/// sweep's own run slot, SWEEP/runs/ID) would be lost or corrupt when that one is replaced, or
+/// would replace part of it: refused before anything is created.
+void checkAncestors(const std::string& dir) {
+    std::error_code ec;
+    const fs::path lexical = fs::absolute(dir, ec).lexically_normal();
+    std::vector<fs::path> chains = {lexical};
+    const fs::path real = fs::weakly_canonical(lexical, ec);  // through symbolic links, where they exist
+    if (!ec && real != lexical) chains.push_back(real);
+    for (const fs::path& target : chains) {
+        int depth = 0;  // of `target` below `a`
+        for (fs::path a = target.parent_path(); a.has_relative_path(); a = a.parent_path()) {
+            ++depth;
+            const std::string lock = a.string() + ".lock";
+            if (lockIsLive(lock))
+                throw InputError(dir, "", "the output lies inside " + a.string() + ", the output of a shadowlab run in progress" +
+                                              lockOwner(lock) + "; its commit would replace this one. Choose --out outside it");
+            if (isRunTemporary(a.filename().string()))
+                throw InputError(dir, "", "the output lies inside " + a.string() +
+                                              ", a shadowlab run's temporary directory; choose --out outside it");
+            const std::string marker = fs::is_directory(fs::symlink_status(a, ec)) ? markerOf(a) : "";
+            if (marker.empty()) continue;
+            if (marker == "sweep.json") {
+                // A sweep runs each of its runs into SWEEP/runs/ID; anything else inside it is not its.
+                if (depth == 2 && target.parent_path().filename() == "runs") continue;
+                throw InputError(dir, "", "the output lies inside the sweep directory " + a.string() +
+                                              " (it holds sweep.json); its runs go to runs/ID. Choose --out outside it");
+            }
+            throw InputError(dir, "", "the output lies inside " + a.string() + ", a shadowlab run's output (it holds " + marker +
+                                          "); replacing that one would delete this. Choose --out outside it");
+        }
+    }
+}
+
+/// What inside `dir` must not be replaced along with it: a run in progress (a live DIR.lock) or
+/// another shadowlab output or sweep in a subdirectory. "" when there is none. At most `limit`
+/// entries are looked at; a directory larger than that is no single run's output.
+std::string nestedInside(const fs::path& dir, size_t limit = 200000) {
+    std::error_code ec;
+    size_t seen = 0;
+    for (auto it = fs::recursive_directory_iterator(dir, fs::directory_options::skip_permission_denied, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        if (++seen > limit)
+            return "more than " + std::to_string(limit) + " entries (more than one run's output)";
+        const fs::path& p = it->path();
+        const std::string name = p.filename().string();
+        if (name.size() > 5 && name.compare(name.size() - 5, 5, ".lock") == 0 && lockIsLive(p.string()))
+            return p.string() + ", the lock of a shadowlab run in progress" + lockOwner(p.string());
+        if (it.depth() >= 1 && (name == "summary.json" || name == "config.resolved.json" || name == "sweep.json"))
+            return p.parent_path().string() + ", another shadowlab " + (name == "sweep.json" ? "sweep" : "output") +
+                   " (it holds " + name + ")";
+    }
+    if (ec) return "an unreadable entry (" + ec.message() + ")";
+    return "";
 }
 
 /// Takes the lock file's exclusive flock. The file is unlinked by its holder at the end, so after
 /// locking, check that the path still names the file we locked (else a newer lock file exists).
 int acquireLock(const std::string& lockPath, const std::string& dir) {
     for (int attempt = 0; attempt < 100; ++attempt) {
-        int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
         if (fd < 0)
             throw InputError(dir, "", "cannot create the lock file " + lockPath + ": " + std::strerror(errno) +
                                           " (is the output's parent directory writable?)");
-        if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        // Another run's lockIsLive() probe holds a shared lock for an instant: wait that out (50 ms)
+        // before calling the place busy; a run in progress holds its lock for the whole run.
+        bool locked = false;
+        for (int wait = 0; wait < 10 && !(locked = ::flock(fd, LOCK_EX | LOCK_NB) == 0) && errno == EWOULDBLOCK; ++wait)
+            ::usleep(5000);
+        if (!locked) {
             char owner[32] = {0};
             ssize_t n = ::pread(fd, owner, sizeof owner - 1, 0);
             ::close(fd);
@@ -79,6 +189,7 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
                                   "(an output is a directory of its own, e.g. --out results/run1)");
     fs::path finalPath(dir);
     fs::path parent = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
+    checkAncestors(dir);  // before anything is created
     std::error_code ec;
     fs::create_directories(parent, ec);
     if (ec) throw InputError(dir, "", "cannot create the parent directory " + parent.string() + ": " + ec.message());
@@ -125,9 +236,18 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
         if (!force)
             throw InputError(dir, "", "output directory already exists; pass --force to replace it once the new run "
                                       "completes, or --out DIR");
-        if (!isShadowlabOutput(finalPath))
+        if (markerOf(finalPath) == "sweep.json")
+            throw InputError(dir, "", "the directory is a sweep (it holds sweep.json); --force replaces only one run's output");
+        const bool output = isShadowlabOutput(finalPath);
+        // Whatever it is, a run in progress or another output inside it is never replaced with it.
+        if (const std::string inside = nestedInside(finalPath, output ? 200000 : 10000); !inside.empty() &&
+                                                                                     (output || inside.find(".lock") != std::string::npos))
+            throw InputError(dir, "", "the directory holds " + inside + "; --force replaces only a single run's output");
+        if (!output)
             throw InputError(dir, "", "the directory exists and is not a shadowlab output (no summary.json or "
                                       "config.resolved.json); --force replaces only outputs");
+        struct stat st {};
+        if (::lstat(dir.c_str(), &st) == 0) place.existed_ = true, place.dev_ = uint64_t(st.st_dev), place.ino_ = uint64_t(st.st_ino);
     }
     place.partial_ = dir + ".partial-" + pidSuffix();
     fs::create_directories(place.partial_ + "/images", ec);
@@ -137,14 +257,14 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
 
 OutputPlace::OutputPlace(OutputPlace&& o) noexcept
     : final_(std::move(o.final_)), partial_(std::move(o.partial_)), lockPath_(std::move(o.lockPath_)), lockFd_(o.lockFd_),
-      committed_(o.committed_) {
+      committed_(o.committed_), kept_(o.kept_), existed_(o.existed_), dev_(o.dev_), ino_(o.ino_) {
     o.lockFd_ = -1;
     o.partial_.clear();
 }
 
 OutputPlace::~OutputPlace() {
     std::error_code ec;
-    if (!committed_ && !partial_.empty()) fs::remove_all(partial_, ec);
+    if (!committed_ && !kept_ && !partial_.empty()) fs::remove_all(partial_, ec);
     release();
 }
 
@@ -155,9 +275,31 @@ void OutputPlace::release() {
     lockFd_ = -1;
 }
 
+void OutputPlace::refuseCommit(const std::string& why) {
+    // Both are kept: what is at the place now, and this run's results under a name no later run
+    // cleans up (only DIR.partial-* and DIR.old-* are a killed run's leftovers).
+    const std::string kept = final_ + ".kept-" + pidSuffix();
+    std::error_code ec;
+    fs::rename(partial_, kept, ec);
+    if (!ec) partial_ = kept;
+    kept_ = true;
+    release();
+    throw RuntimeError("not replacing " + final_ + ": " + why + "; it is left as it is and this run's results are in " +
+                       partial_);
+}
+
 void OutputPlace::commit() {
     std::error_code ec;
-    bool exists = fs::exists(fs::symlink_status(final_, ec));
+    struct stat st {};
+    const bool exists = ::lstat(final_.c_str(), &st) == 0;
+    // Only what open() checked is replaced: a directory that appeared since (a run into a folder
+    // inside this place creates it), or one swapped in for the checked one, is somebody else's.
+    if (exists && !existed_) refuseCommit("it appeared while this run was working and was not created by it");
+    if (exists && (uint64_t(st.st_dev) != dev_ || uint64_t(st.st_ino) != ino_))
+        refuseCommit("it was replaced by another directory while this run was working");
+    if (exists)
+        if (const std::string inside = nestedInside(final_); !inside.empty())
+            refuseCommit("it now holds " + inside);
     if (exists) {
         if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, final_.c_str(), RENAME_EXCHANGE) == 0) {
             committed_ = true;
@@ -176,8 +318,10 @@ void OutputPlace::commit() {
         }
     } else {
         if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, final_.c_str(), RENAME_NOREPLACE) != 0) {
+            if (errno == EEXIST || errno == ENOTEMPTY) refuseCommit("it appeared while this run was working and was not created by it");
             // RENAME_NOREPLACE is unsupported on some file systems; the lock still keeps other runs out.
             if (errno != EINVAL && errno != ENOSYS) throw RuntimeError("cannot rename " + partial_ + " to " + final_ + ": " + std::strerror(errno));
+            if (fs::exists(fs::symlink_status(final_, ec))) refuseCommit("it appeared while this run was working and was not created by it");
             fs::rename(partial_, final_, ec);
             if (ec) throw RuntimeError("cannot rename " + partial_ + " to " + final_ + ": " + ec.message());
         }

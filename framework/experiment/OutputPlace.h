@@ -5,10 +5,17 @@
 //             replaceable only with force and only if it is a shadowlab output), takes an exclusive
 //             lock (DIR.lock, flock: released by the kernel even on SIGKILL), removes what earlier
 //             killed runs left behind (DIR.partial-PID, DIR.old-PID), and creates DIR.partial-PID.
+//             An output inside another run's output, inside a run in progress or inside a sweep
+//             (but a sweep's own SWEEP/runs/ID) is refused, and so is --force on a directory that
+//             holds a run in progress or another output or sweep.
 //   commit(): swaps the finished DIR.partial-PID with DIR in one step (renameat2 RENAME_EXCHANGE),
 //             so DIR always holds either the previous or the new results, then drops the old ones.
+//             It replaces only the directory open() checked: one that appeared since, or now holds
+//             a run or an output, is kept, and the new results are kept beside it as DIR.kept-PID
+//             (RuntimeError, exit 1).
 //   ~OutputPlace(): without commit (an error, an interrupt), removes the partial directory; the
 //             previous DIR is untouched.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -37,10 +44,15 @@ public:
 private:
     OutputPlace() = default;
     void release();
+    [[noreturn]] void refuseCommit(const std::string& why);
 
     std::string final_, partial_, lockPath_;
     int lockFd_ = -1;
     bool committed_ = false;
+    bool kept_ = false;  ///< the results were moved to DIR.kept-PID by a refused commit
+    /// DIR as open() found it (the directory --force may replace).
+    bool existed_ = false;
+    uint64_t dev_ = 0, ino_ = 0;
 };
 
 } // namespace shadowlab
