@@ -6,6 +6,7 @@
 
 #include <stb_image.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -227,6 +228,73 @@ TEST(GuiTest, BadInputIsOneLineAndExitCode2) {
         std::string trimmed = out.substr(0, out.find_last_not_of('\n') + 1);
         EXPECT_EQ(trimmed.find('\n'), std::string::npos) << out;
     }
+}
+
+/// The GUI's exit code and one-line error, before any window opens (no X server needed).
+int guiError(const std::string& args, std::string& out) {
+    int rc = test::runCommand(kGui + " " + args, out);
+    return rc;
+}
+
+TEST(GuiTest, HelpExitsZeroWhateverElseTheLineHolds) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    for (const std::string args : {"--help", "-h", "--help --frames x", "--size 1x1 --help"}) {
+        std::string out;
+        EXPECT_EQ(guiError(args, out), 0) << args << "\n" << out;
+        EXPECT_NE(out.find("Usage:"), std::string::npos) << args << "\n" << out;
+    }
+}
+
+TEST(GuiTest, WindowSizesBeyondWhatX11AndGlCanMakeAreBadInput) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    // 100000² used to end in an Xlib abort once the window was asked for.
+    for (const std::string args : {"--size 100000x100000", "--size 8193x600", "--resize 640x40000", "--size 10x10"}) {
+        std::string out;
+        EXPECT_EQ(guiError(kSmoke + " " + args + " --frames 1", out), 2) << args << "\n" << out;
+        EXPECT_NE(out.find("64 to 8192"), std::string::npos) << args << "\n" << out;  // 10x10: below the minimum
+        EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out;
+    }
+}
+
+TEST(GuiTest, OutputFilesOntoAFolderALinkOrADeviceAreRefusedAndLeftAsTheyWere) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    std::string dir = test::makeTempDir("gui-outputs"), out;
+    fs::create_directories(dir + "/folder");
+    std::ofstream(dir + "/real.json") << "precious";
+    fs::create_symlink(dir + "/real.json", dir + "/link.json");
+    const std::string keys = " --record-keyframes \"0,3,5,0,0.4,0\" --frames 1";
+    EXPECT_EQ(guiError(kSmoke + keys + " --save-config " + dir + "/folder", out), 2) << out;
+    EXPECT_NE(out.find("--save-config: the path is a directory"), std::string::npos) << out;
+    EXPECT_EQ(guiError(kSmoke + keys + " --save-config " + dir + "/link.json", out), 2) << out;
+    EXPECT_NE(out.find("is a symbolic link"), std::string::npos) << out;
+    EXPECT_EQ(guiError(kSmoke + " --frames 1 --report " + dir + "/link.json", out), 2) << out;
+    EXPECT_EQ(guiError(kSmoke + " --frames 1 --report /dev/full", out), 2) << out;
+    EXPECT_NE(out.find("is a character device"), std::string::npos) << out;
+    EXPECT_EQ(guiError(kSmoke + " --frames 1 --screenshot " + dir + "/link.json", out), 2) << out;
+    EXPECT_EQ(guiError(kSmoke + " --frames 1 --screenshot " + dir + "/no/such/shot.png", out), 2) << out;
+    EXPECT_NE(out.find("does not exist"), std::string::npos) << out;
+    // All as they were, and nothing beside them (no folder.tmp, no link.json.tmp-PID).
+    EXPECT_TRUE(fs::is_directory(dir + "/folder"));
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir + "/link.json")));
+    EXPECT_TRUE(fs::is_character_file("/dev/full"));
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+    EXPECT_EQ(names, (std::set<std::string>{"folder", "real.json", "link.json"}));
+    std::ifstream in(dir + "/real.json");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "precious");
+}
+
+TEST(GuiTest, AMovingObjectWithANonFinitePoseIsRefusedNotShownVanished) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    std::string dir = test::makeTempDir("gui-pose"), out;
+    std::ofstream(dir + "/c.json") << R"({"frames": 2, "resolution": [16, 16],
+        "scene": {"time_range": [0, 1.5], "objects": [{"procedural": "plane"},
+          {"procedural": "sphere", "path": {"keyframes": [{"time": 0, "scale": 1}, {"time": 1, "scale": 3.4e38},
+            {"time": 2, "scale": 3.4e38}, {"time": 3, "scale": 1}]}}]},
+        "algorithms": [{"algorithm": "shadow_map"}]})";
+    EXPECT_EQ(guiError(dir + "/c.json --frames 1", out), 2) << out;
+    EXPECT_NE(out.find("/scene/objects/1/path"), std::string::npos) << out;
+    EXPECT_NE(out.find("frame 1"), std::string::npos) << out;
 }
 
 } // namespace

@@ -1,17 +1,19 @@
 #include "framework/gui/GuiApp.h"
 
 #include "framework/core/Error.h"
+#include "framework/core/FileIO.h"
 #include "framework/gl/Gl.h"
 #include "framework/gui/Automation.h"
 #include "framework/gui/DefaultScene.h"
 #include "framework/gui/GlfwContext.h"
 #include "framework/gui/GuiState.h"
-#include "framework/metrics/Images.h"
 
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
+#include <stb_image_write.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -51,7 +53,9 @@ public:
     ImGuiSession& operator=(const ImGuiSession&) = delete;
 };
 
-/// The default framebuffer (the whole window, panel included) as a PNG.
+/// The default framebuffer (the whole window, panel included) as a PNG. Encoded in memory and
+/// written with writeFileAtomic: a symbolic link, a device or a directory at `file` is refused
+/// rather than replaced, and a failed write leaves neither a half PNG nor a temporary.
 void writeScreenshot(const std::string& file, glm::ivec2 size) {
     std::vector<unsigned char> rgba(size_t(size.x) * size_t(size.y) * 4);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
@@ -60,7 +64,16 @@ void writeScreenshot(const std::string& file, glm::ivec2 size) {
     glReadPixels(0, 0, size.x, size.y, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     for (size_t i = 3; i < rgba.size(); i += 4) rgba[i] = 255; // the window is opaque, whatever alpha ImGui left
-    writePngRGBA(file, size.x, size.y, rgba);
+    // GL rows are bottom-up; a PNG's top-down.
+    const size_t row = size_t(size.x) * 4;
+    std::vector<unsigned char> flipped(rgba.size());
+    for (int y = 0; y < size.y; ++y) std::copy_n(rgba.data() + size_t(size.y - 1 - y) * row, row, flipped.data() + size_t(y) * row);
+    std::string png;
+    const bool ok = stbi_write_png_to_func(
+        [](void* context, void* data, int n) { static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(n)); },
+        &png, size.x, size.y, 4, flipped.data(), int(row));
+    if (!ok) throw RuntimeError("cannot encode the screenshot " + file);
+    writeFileAtomic(file, png);
 }
 
 void drawSidePanel(GuiState& s) {
@@ -94,6 +107,13 @@ int runGui(const GuiOptions& opts) {
     AutomationPlan plan = planAutomation(opts, config);
 
     GlfwContext context(opts.windowSize, "shadowlab — " + config.name, opts.frames == 0);
+    {
+        GLint viewport[2] = {0, 0}, texture = 0;
+        glGetIntegerv(GL_MAX_VIEWPORT_DIMS, viewport);
+        glGetIntegerv(GL_MAX_TEXTURE_SIZE, &texture);
+        checkWindowSize("--size", opts.windowSize, std::min(viewport[0], viewport[1]), texture);
+        if (opts.resizeTo.x > 0) checkWindowSize("--resize", opts.resizeTo, std::min(viewport[0], viewport[1]), texture);
+    }
     installGlDebugCallback(true);
     ImGuiSession imgui(context);
 
@@ -160,9 +180,9 @@ int runGui(const GuiOptions& opts) {
             try {
                 writeScreenshot(s.screenshotRequest, fb);
                 s.message = "wrote " + s.screenshotRequest;
-            } catch (const RuntimeError& e) {
-                if (lastFrame) throw; // automation: a missing screenshot is a failure (exit 1)
-                s.message = e.what();
+            } catch (const std::exception& e) {
+                if (lastFrame) throw; // automation: a missing screenshot is a failure
+                s.message = e.what(); // F12 onto a link or a folder: say so, keep the session
             }
             s.screenshotRequest.clear();
         }

@@ -8,6 +8,17 @@
 
 using namespace shadowlab;
 
+namespace {
+
+/// One line of at most 400 characters, whatever a failure's message echoes (a path, a GL log).
+std::string oneLine(const char* text) {
+    std::string out;
+    for (const char* c = text; *c && out.size() < 400; ++c) out += *c == '\n' ? ' ' : *c;
+    return *text && std::string(text).size() > 400 ? out + "..." : out;
+}
+
+} // namespace
+
 int main(int argc, char** argv) {
     try {
         GuiOptions opts = parseGuiOptions(std::vector<std::string>(argv + 1, argv + argc));
@@ -24,7 +35,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "shadowlab-gui: error: %s\n", e.what());
         return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "shadowlab-gui: failed: %s\n", e.what());
+        std::fprintf(stderr, "shadowlab-gui: failed: %s\n", oneLine(e.what()).c_str());
         return 1;
     }
 }

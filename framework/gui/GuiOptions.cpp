@@ -1,9 +1,12 @@
 #include "framework/gui/GuiOptions.h"
 
 #include "framework/core/Error.h"
+#include "framework/core/FileIO.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 namespace shadowlab {
@@ -26,8 +29,8 @@ Automation (tests, docs; each acts through the same code as the widgets):
   --record-step S           path seconds between recorded keyframes
   --save-config FILE.json   save the recorded path and current settings as an experiment config
   --report FILE.json        log every rendered frame (camera, light, stage times)
-  --size WxH                window size (default 1280x800);  --render-scale S  (0.125-1)
-  --resize WxH              resize the window after the first frame
+  --size WxH                window size (default 1280x800; 64-8192 per side);  --render-scale S  (0.125-1)
+  --resize WxH              resize the window after the first frame (64-8192 per side)
 
 Exit codes: 0 success, 2 bad input (one line), 1 runtime failure. F1 in the window lists the keys.
 )";
@@ -36,17 +39,22 @@ namespace {
 
 InputError usage(const std::string& cause) { return InputError("command line", "", cause + " (see --help)"); }
 
+/// What the user typed, echoed back at most 60 characters long (a pasted file stays one short line).
+std::string echoed(const std::string& text) {
+    return "\"" + (text.size() > 60 ? text.substr(0, 57) + "..." : text) + "\"";
+}
+
 double number(const std::string& opt, const std::string& text) {
     char* end = nullptr;
     double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end || !std::isfinite(v)) throw usage(opt + " expects a number, got \"" + text + "\"");
+    if (text.empty() || *end || !std::isfinite(v)) throw usage(opt + " expects a number, got " + echoed(text));
     return v;
 }
 
 int integer(const std::string& opt, const std::string& text, int minValue) {
     double v = number(opt, text);
     if (v != std::floor(v) || v < minValue || v > 1e9)
-        throw usage(opt + " expects an integer >= " + std::to_string(minValue) + ", got \"" + text + "\"");
+        throw usage(opt + " expects an integer >= " + std::to_string(minValue) + ", got " + echoed(text));
     return int(v);
 }
 
@@ -63,11 +71,11 @@ std::vector<std::pair<glm::vec3, glm::vec3>> parseKeyframes(const std::string& t
     std::vector<std::pair<glm::vec3, glm::vec3>> out;
     for (const std::string& key : split(text, ';')) {
         std::vector<std::string> f = split(key, ',');
-        if (f.size() != 6) throw usage("--record-keyframes: \"" + key + "\" needs 6 numbers x,y,z,tx,ty,tz");
+        if (f.size() != 6) throw usage("--record-keyframes: " + echoed(key) + " needs 6 numbers x,y,z,tx,ty,tz");
         float v[6];
         for (int i = 0; i < 6; ++i) v[i] = float(number("--record-keyframes", f[size_t(i)]));
         glm::vec3 position(v[0], v[1], v[2]), target(v[3], v[4], v[5]);
-        if (position == target) throw usage("--record-keyframes: \"" + key + "\" looks at its own position");
+        if (position == target) throw usage("--record-keyframes: " + echoed(key) + " looks at its own position");
         out.push_back({position, target});
     }
     if (out.empty()) throw usage("--record-keyframes needs at least one keyframe");
@@ -76,14 +84,36 @@ std::vector<std::pair<glm::vec3, glm::vec3>> parseKeyframes(const std::string& t
 
 glm::ivec2 size(const std::string& opt, const std::string& text) {
     std::vector<std::string> wh = split(text, 'x');
-    if (wh.size() != 2) throw usage(opt + " expects WxH, got \"" + text + "\"");
-    return {integer(opt, wh[0], 64), integer(opt, wh[1], 64)};
+    if (wh.size() != 2) throw usage(opt + " expects WxH, got " + echoed(text));
+    const glm::ivec2 s(integer(opt, wh[0], 1), integer(opt, wh[1], 1));
+    if (s.x < kWindowSideMin || s.y < kWindowSideMin || s.x > kWindowSideMax || s.y > kWindowSideMax)
+        throw usage(opt + " " + echoed(text) + ": each side must be " + std::to_string(kWindowSideMin) + " to " +
+                    std::to_string(kWindowSideMax));
+    return s;
+}
+
+/// An output file must be one that can be written as a whole and replaced: a directory, link,
+/// device or FIFO there is refused (writeFileAtomic would refuse it only after the whole session).
+void checkOutputFile(const std::string& opt, const std::string& file) {
+    if (file.empty()) throw usage(opt + " needs a file name");
+    if (const std::string kind = nonRegularKind(file, false); !kind.empty())
+        throw InputError(file, "", opt + ": the path is " + kind + ", not a file it can replace");
+    const std::filesystem::path parent = std::filesystem::path(file).parent_path();
+    std::error_code ec;
+    if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+        throw InputError(file, "", opt + ": the folder " + echoed(parent.string()) + " does not exist");
 }
 
 } // namespace
 
 GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
     GuiOptions o;
+    // Help is help, whatever else the line holds (a half-typed command, an option it explains).
+    for (const std::string& a : args) {
+        if (a == "--help" || a == "-h") o.help = true;
+        if (a == "--version") o.version = true;
+    }
+    if (o.help || o.version) return o;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         auto value = [&]() -> const std::string& {
@@ -96,12 +126,12 @@ GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
         else if (a == "--set") {
             const std::string& kv = value();
             size_t eq = kv.find('=');
-            if (eq == std::string::npos || eq == 0) throw usage("--set expects KEY=VALUE, got \"" + kv + "\"");
+            if (eq == std::string::npos || eq == 0) throw usage("--set expects KEY=VALUE, got " + echoed(kv));
             o.sets.push_back({kv.substr(0, eq), kv.substr(eq + 1)});
         } else if (a == "--view") {
             o.view = value();
             if (o.view != "shaded" && o.view != "visibility" && o.view != "heat" && o.view != "difference")
-                throw usage("--view expects shaded, visibility, heat or difference, got \"" + o.view + "\"");
+                throw usage("--view expects shaded, visibility, heat or difference, got " + echoed(o.view));
         } else if (a == "--reference") o.reference = true;
         else if (a == "--play") o.play = true;
         else if (a == "--frame") o.startFrame = integer(a, value(), 0);
@@ -119,13 +149,24 @@ GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
             if (o.renderScale < kRenderScaleMin || o.renderScale > kRenderScaleMax)
                 throw usage("--render-scale must be in [" + std::to_string(kRenderScaleMin) + ", " +
                             std::to_string(kRenderScaleMax) + "]");
-        } else if (!a.empty() && a[0] == '-') throw usage("unknown option " + a);
+        } else if (!a.empty() && a[0] == '-') throw usage("unknown option " + echoed(a));
         else if (o.config.empty()) o.config = a;
-        else throw usage("unexpected argument " + a);
+        else throw usage("unexpected argument " + echoed(a));
     }
     if (!o.screenshot.empty() && o.frames == 0) throw usage("--screenshot needs --frames N (it is taken after the last frame)");
     if (!o.saveConfig.empty() && o.recordKeyframes.empty()) throw usage("--save-config needs --record-keyframes");
+    if (!o.screenshot.empty()) checkOutputFile("--screenshot", o.screenshot);
+    if (!o.report.empty()) checkOutputFile("--report", o.report);
+    if (!o.saveConfig.empty()) checkOutputFile("--save-config", o.saveConfig);
     return o;
+}
+
+void checkWindowSize(const std::string& option, glm::ivec2 size, int maxViewport, int maxTexture) {
+    const int limit = std::min(maxViewport, maxTexture);
+    if (limit > 0 && (size.x > limit || size.y > limit))
+        throw InputError("command line", "", option + " " + std::to_string(size.x) + "x" + std::to_string(size.y) +
+                                                 " exceeds this GL context's limit of " + std::to_string(limit) +
+                                                 " pixels per side (GL_MAX_VIEWPORT_DIMS / GL_MAX_TEXTURE_SIZE)");
 }
 
 } // namespace shadowlab

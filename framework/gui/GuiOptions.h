@@ -11,6 +11,10 @@ namespace shadowlab {
 
 /// Render resolution relative to the viewport's pixels: below 1/8 images are too coarse to judge.
 constexpr float kRenderScaleMin = 0.125f, kRenderScaleMax = 1.0f;
+/// Window sides (--size, --resize), in screen units: X11 cannot make windows above 32767 (Xlib
+/// aborts the process), and above 8192 no GL driver's viewport or texture is sure to follow; the
+/// context's own GL_MAX_VIEWPORT_DIMS / GL_MAX_TEXTURE_SIZE are checked once it exists.
+constexpr int kWindowSideMin = 64, kWindowSideMax = 8192;
 
 struct GuiOptions {
     std::string config;                 ///< CONFIG.json; empty = the built-in default scene
@@ -32,8 +36,14 @@ struct GuiOptions {
     bool help = false, version = false;
 };
 
-/// Parses argv[1..]; throws InputError (one line) on anything malformed.
+/// Parses argv[1..]; throws InputError (one line) on anything malformed, including an output file
+/// (--screenshot, --report, --save-config) that names a directory, a symbolic link, a device or a
+/// FIFO, or lies in a folder that does not exist: refused before a window opens or anything is
+/// written. With --help (or --version) anywhere, nothing else is checked.
 GuiOptions parseGuiOptions(const std::vector<std::string>& args);
+
+/// The window size checked against the GL context's limits (InputError naming the option).
+void checkWindowSize(const std::string& option, glm::ivec2 size, int maxViewport, int maxTexture);
 
 extern const char* const kGuiUsage;
 
