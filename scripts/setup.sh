@@ -13,6 +13,8 @@ PACKAGES=(
   # (scripts/slurm_local.sh). slurm-wlm brings slurmctld, slurmd and the client (sbatch, squeue);
   # munge is its authentication daemon.
   slurm-wlm munge
+  # tests/ReportTest.cpp opens report.html in headless chromium to check that its images decode.
+  chromium
 )
 
 PACKAGES+=("$@")
