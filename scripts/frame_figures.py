@@ -58,27 +58,55 @@ def scale_text(legend):
     return text
 
 
-def draw_heat(ax, legend, title):
+# A fixed grid in inches, laid out by hand: matplotlib's layout engines measure every text box and
+# took most of the drawing time. A cell is the title band over the image and, for a heat map, its
+# colour bar and the bar's labels to the right.
+TITLE_IN, TOP_IN, MARGIN_IN = 0.62, 0.42, 0.08
+BAR_GAP_IN, BAR_IN, BAR_LABELS_IN = 0.07, 0.13, 0.62
+
+
+class Grid:
+    def __init__(self, rows, cols, image_w, image_h, top=TOP_IN, widest=3.2):
+        self.top = top  # room for a figure title
+        # The image's width in inches: its pixels at 100 dpi, within [2.4, widest].
+        self.panel = max(2.4, min(widest, image_w / 100))
+        self.image_h = self.panel * image_h / image_w
+        self.cell_w = MARGIN_IN + self.panel + BAR_GAP_IN + BAR_IN + BAR_LABELS_IN
+        self.cell_h = TITLE_IN + self.image_h + MARGIN_IN
+        self.size = (cols * self.cell_w, rows * self.cell_h + top)
+
+    def axes(self, fig, r, c, bar=False):
+        """The image's axes of cell (r, c) and, with bar, the colour bar's beside it."""
+        W, H = self.size
+        left = c * self.cell_w + MARGIN_IN
+        bottom = H - self.top - r * self.cell_h - TITLE_IN - self.image_h
+        ax = fig.add_axes([left / W, bottom / H, self.panel / W, self.image_h / H])
+        ax.set_axis_off()
+        if not bar:
+            return ax, None
+        cax = fig.add_axes([(left + self.panel + BAR_GAP_IN) / W, bottom / H, BAR_IN / W, self.image_h / H])
+        return ax, cax
+
+
+def draw_heat(ax, cax, legend, title):
     """A heat map panel: the runner's PNG exactly as written, and a colour bar over its scale."""
-    ax.imshow(mpimg.imread(legend["png"]), interpolation="nearest")
+    ax.imshow(mpimg.imread(legend["png"]), interpolation="nearest", aspect="auto")
     ramp = LinearSegmentedColormap.from_list("shadowlab_heat", legend["ramp"])
     # The bar spans [min, max] of the JSON, the values the ramp's ends stand for; an arrow marks
     # pixels above max, drawn in the top colour.
     mappable = plt.cm.ScalarMappable(norm=Normalize(legend["min"], legend["max"]), cmap=ramp)
-    bar = ax.figure.colorbar(mappable, ax=ax, fraction=0.05, pad=0.02,
-                             extend="max" if legend["clipped_pixels"] else "neither")
+    bar = ax.figure.colorbar(mappable, cax=cax, extend="max" if legend["clipped_pixels"] else "neither")
     bar.set_label(legend["unit"] or "value", fontsize=7)
     bar.ax.tick_params(labelsize=6)
     ax.set_title(f"{title}\n{scale_text(legend)}", fontsize=7)
-    ax.set_axis_off()
 
 
 def labelled_heat_maps(legends):
     for legend in legends:
-        w, h = legend["width"], legend["height"]
-        size = max(2.5, min(6.0, w / 100))
-        fig, ax = plt.subplots(figsize=(size * 1.25, size * h / w + 0.7), layout="constrained")
-        draw_heat(ax, legend, f"{legend['id']} · {legend['name']} · frame {legend['frame']}")
+        grid = Grid(1, 1, legend["width"], legend["height"], top=0.0, widest=10.24)
+        fig = plt.figure(figsize=grid.size)
+        ax, cax = grid.axes(fig, 0, 0, bar=True)
+        draw_heat(ax, cax, legend, f"{legend['id']} · {legend['name']} · frame {legend['frame']}")
         fig.savefig(legend["labelled"], dpi=100)
         plt.close(fig)
 
@@ -133,30 +161,29 @@ def contact_sheet(path, frame, entries, ids, scores):
         cols += 1
     first = next(what for p in panels.values() for kind, what in p if kind != "heat")
     h, w = mpimg.imread(first).shape[:2]
-    panel = max(2.4, min(3.2, w / 100))
-    fig, axes = plt.subplots(len(rows), cols, squeeze=False, layout="constrained",
-                             figsize=(cols * panel * 1.25, len(rows) * (panel * h / w + 0.75) + 0.5))
-    fig.suptitle(f"Frame {frame}: shaded, difference against the reference, heat maps", fontsize=10)
+    grid = Grid(len(rows), cols, w, h)
+    fig = plt.figure(figsize=grid.size)
+    fig.suptitle(f"Frame {frame}: shaded, difference against the reference, heat maps", fontsize=10,
+                 y=1 - 0.1 / grid.size[1], va="top")
     for r, aid in enumerate(rows):
         for c in range(cols):
-            ax = axes[r][c]
-            ax.set_axis_off()
             if c >= len(panels[aid]):
                 if legend_wanted:
-                    draw_diff_legend(ax)
+                    draw_diff_legend(grid.axes(fig, r, c)[0])
                     legend_wanted = False
                 continue
             kind, what = panels[aid][c]
+            ax, cax = grid.axes(fig, r, c, bar=kind == "heat")
             if kind == "shaded":
-                ax.imshow(mpimg.imread(what), interpolation="nearest")
+                ax.imshow(mpimg.imread(what), interpolation="nearest", aspect="auto")
                 ax.set_title(f"{aid} · shaded" + (" (ground truth)" if aid == "reference" else ""), fontsize=8)
             elif kind == "diff":
-                ax.imshow(mpimg.imread(what), interpolation="nearest")
+                ax.imshow(mpimg.imread(what), interpolation="nearest", aspect="auto")
                 score = scores.get((aid, frame))
                 note = "not scored" if score is None else f"{100 * score:.3g} % of lit pixels wrong"
                 ax.set_title(f"{aid} · difference\n{note}", fontsize=7)
             else:
-                draw_heat(ax, what, f"{aid} · {what['name']}")
+                draw_heat(ax, cax, what, f"{aid} · {what['name']}")
     fig.savefig(path, dpi=100)
     plt.close(fig)
 
