@@ -4,7 +4,8 @@ as a data URI, tables as HTML tables, no script, no style sheet or font from els
 opens from disk in any browser, moved or mailed alone. Links to other local files stay relative.
 
 Handles the markdown these reports are written in: headings, paragraphs, "- " lists, pipe tables
-(with "---:" alignment), images, links, **bold**, *italic*, `code`, and HTML comments.
+(with "---:" alignment), images, links, **bold**, *italic*, `code`, backslash escapes and HTML
+comments.
 
 Usage: report_html.py REPORT.md [OUT.html]   (OUT defaults to REPORT.html)
 """
@@ -27,7 +28,7 @@ code { background: #f4f4f4; padding: 0 3px; }
 .missing { color: #b00; }
 """
 
-INLINE = re.compile(r"!\[(?P<alt>[^\]]*)\]\((?P<src>[^)\s]+)\)|\[(?P<text>[^\]]+)\]\((?P<href>[^)\s]+)\)"
+INLINE = re.compile(r"\\(?P<esc>[\\`*_{}\[\]()#+\-.!|$<>])|!\[(?P<alt>[^\]]*)\]\((?P<src>[^)\s]+)\)|\[(?P<text>[^\]]+)\]\((?P<href>[^)\s]+)\)"
                     r"|`(?P<code>[^`]+)`|\*\*(?P<bold>.+?)\*\*|\*(?P<em>[^*\s][^*]*?)\*")
 
 
@@ -43,7 +44,9 @@ def inline(text, base):
     for m in INLINE.finditer(text):
         out.append(html.escape(text[pos:m.start()]))
         pos = m.end()
-        if m["src"] is not None:
+        if m["esc"] is not None:
+            out.append(html.escape(m["esc"]))  # a backslash-escaped character stands for itself
+        elif m["src"] is not None:
             path = os.path.join(base, m["src"])
             if os.path.exists(path):
                 out.append(f'<img src="{data_uri(path)}" alt="{html.escape(m["alt"])}" title="{html.escape(m["alt"])}">')
@@ -62,12 +65,13 @@ def inline(text, base):
 
 
 def cells(line):
+    """A table row's cells; "\\|" is a pipe inside a cell, as in GitHub's markdown."""
     line = line.strip()
     if line.startswith("|"):
         line = line[1:]
-    if line.endswith("|"):
+    if line.endswith("|") and not line.endswith("\\|"):
         line = line[:-1]
-    return [c.strip() for c in line.split("|")]
+    return [c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", line)]
 
 
 def table(lines, base):
