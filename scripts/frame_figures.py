@@ -159,11 +159,13 @@ def contact_sheet(path, frame, entries, ids, scores):
     legend_wanted = any("diff" in entries[aid] for aid in rows)
     if legend_wanted and all(len(p) == cols for p in panels.values()):
         cols += 1
-    first = next(what for p in panels.values() for kind, what in p if kind != "heat")
+    first = next(what["png"] if kind == "heat" else what for p in panels.values() for kind, what in p)
     h, w = mpimg.imread(first).shape[:2]
     grid = Grid(len(rows), cols, w, h)
     fig = plt.figure(figsize=grid.size)
-    fig.suptitle(f"Frame {frame}: shaded, difference against the reference, heat maps", fontsize=10,
+    shown = ["shaded"] + [what for kind, what in (("diff", "difference against the reference"), ("heat", "heat maps"))
+                          if any(k == kind for p in panels.values() for k, _ in p)]
+    fig.suptitle(f"Frame {frame}: " + ", ".join(shown), fontsize=10,
                  y=1 - 0.1 / grid.size[1], va="top")
     for r, aid in enumerate(rows):
         for c in range(cols):
