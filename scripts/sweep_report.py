@@ -48,14 +48,14 @@ def nlogn_ratio(ns, ts):
 
 class Sweep:
     def __init__(self, directory):
-        with open(os.path.join(directory, "plan.json")) as f:
+        with open(os.path.join(directory, "plan.json"), encoding="utf-8") as f:
             self.plan = json.load(f)
         self.axes = self.plan["axes"]
         self.merge = self.plan.get("merge") or {}
         # run id -> {"axes": {name: label}, "triangles", "pixels", "values": {alg id: {measure: float}}}
         self.runs = {}
         self.algorithms = {}  # alg id -> algorithm name, in first-seen order
-        with open(os.path.join(directory, "sweep.csv"), newline="") as f:
+        with open(os.path.join(directory, "sweep.csv"), newline="", encoding="utf-8") as f:
             for row in csv.DictReader(f):
                 r = self.runs.setdefault(row["run"], {"index": int(row["index"]), "triangles": int(row["triangles"]),
                                                       "pixels": int(row["pixels"]), "values": defaultdict(dict),
@@ -310,13 +310,25 @@ def html_report(directory):
     report_html.convert(os.path.join(directory, "sweep.md"), os.path.join(directory, "sweep.html"))
 
 
+def plain_text():
+    """Names, ids and labels are drawn as written: a '$' in a label must not start matplotlib's
+    math parser, whose errors ("Expected \\frac{num}{den}") would fail the whole report."""
+    import matplotlib
+    matplotlib.rcParams["text.parse_math"] = False
+
+
 def main():
     args = sys.argv[1:]
     if not args or len(args) > 2 or (len(args) == 2 and args[1] != "--no-plots"):
         sys.exit(__doc__)
-    s = Sweep(args[0])
+    try:
+        s = Sweep(args[0])
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        # One line naming what could not be read, not a traceback (json and csv errors are ValueErrors).
+        sys.exit(f"sweep_report.py: {args[0]}: cannot read plan.json and sweep.csv as `sweep merge` writes them: {e!r}"[:500])
     report(s, args[0])
     if len(args) == 1:
+        plain_text()
         plots(s, args[0])
         stage_plot(s, args[0])
         figures(s, args[0])

@@ -1,5 +1,6 @@
 // The command line as a user meets it: exit codes, one-line errors, and malformed scene files.
 #include "framework/core/JsonNode.h"
+#include "tests/SweepTestData.h"
 #include "tests/TestSupport.h"
 
 #include <algorithm>
@@ -20,6 +21,58 @@ TEST(CliTest, HelpAndListSucceed) {
     EXPECT_EQ(test::runCommand(bin() + " list", out), 0);
     EXPECT_NE(out.find("shadow_map"), std::string::npos);
     EXPECT_NE(out.find("reference"), std::string::npos);
+}
+
+// Every command and subcommand: --help and -h print that command's usage on stdout, exit code 0,
+// whatever else is on the line.
+TEST(CliTest, HelpOnEveryCommand) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> commands = {
+        {{}, "shadowlab run CONFIG.json"},
+        {{"run"}, "shadowlab run CONFIG.json"},
+        {{"validate"}, "shadowlab validate CONFIG.json"},
+        {{"list"}, "shadowlab list ["},
+        {{"sweep"}, "shadowlab sweep merge DIR"},
+        {{"sweep", "plan"}, "shadowlab sweep plan SWEEP.json"},
+        {{"sweep", "config"}, "shadowlab sweep config SWEEP.json INDEX"},
+        {{"sweep", "run"}, "shadowlab sweep run SWEEP.json"},
+        {{"sweep", "slurm"}, "shadowlab sweep slurm SWEEP.json"},
+        {{"sweep", "merge"}, "shadowlab sweep merge DIR"},
+    };
+    const std::string config = std::string(SHADOWLAB_SOURCE_DIR) + "/configs/smoke.json";
+    for (const auto& [command, usage] : commands) {
+        for (const char* flag : {"--help", "-h"}) {
+            for (bool withArgs : {false, true}) {
+                std::vector<std::string> argv = {bin()};
+                argv.insert(argv.end(), command.begin(), command.end());
+                // Also after the command's own arguments: help wins, nothing runs.
+                if (withArgs && !command.empty() && command[0] != "list") argv.push_back(config);
+                argv.push_back(flag);
+                const test::Ran r = test::runArgs(argv);
+                std::string shown;
+                for (const auto& a : argv) shown += a + " ";
+                EXPECT_EQ(r.rc, 0) << shown << r.err;
+                EXPECT_NE(r.out.find(usage), std::string::npos) << shown << ":\n" << r.out;
+                EXPECT_EQ(r.err, "") << shown;
+                if (command.size() == 2) EXPECT_EQ(r.out.find("shadowlab run CONFIG"), std::string::npos) << "only " << command[1] << "'s usage";
+            }
+        }
+    }
+}
+
+// What `run` echoes of its input (the config's name, in the progress line) is cut to one short line.
+TEST(CliTest, RunEchoesABoundedName) {
+    const std::string dir = test::makeTempDir("cli-name");
+    const std::string name(100000, 'n'); // below the kernel's 128 KiB per argument
+    const test::Ran r = test::runArgs({bin(), "run", std::string(SHADOWLAB_SOURCE_DIR) + "/configs/smoke.json", "--out", dir + "/out",
+                                       "--no-progress", "--set", "name=" + name, "--set", "resolution=[32,32]", "--set", "frames=1",
+                                       "--set", "output.plots=false", "--set", "output.images_at_frames=[]"});
+    EXPECT_EQ(r.rc, 0) << r.err.substr(0, 2000);
+    EXPECT_LT(r.err.size(), 4000u) << r.err.substr(0, 2000);
+    EXPECT_NE(r.err.find("nnnnn..."), std::string::npos) << r.err.substr(0, 2000);
+    // Bad input that echoes a typed value: one short line too.
+    const test::Ran bad = test::runArgs({bin(), "run", "--" + name});
+    EXPECT_EQ(bad.rc, 2);
+    EXPECT_LT(bad.err.size(), 1000u);
 }
 
 TEST(CliTest, UnknownCommandIsBadInput) {

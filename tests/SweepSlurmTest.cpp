@@ -17,6 +17,12 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string bin() { return SHADOWLAB_BINARY; }
+/// 'text' for the shell that runCommand starts.
+std::string q(const std::string& text) {
+    std::string out = "'";
+    for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
 const std::string kScript = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/slurm_local.sh";
 
 class SweepSlurmTest : public ::testing::Test {
@@ -60,12 +66,14 @@ protected:
 
 TEST_F(SweepSlurmTest, ArrayJobGivesTheSameTableAsALocalRun) {
     const std::string file = test::writeJson(dir_ + "/small.sweep.json", test::smallSweep());
-    const std::string local = dir_ + "/local", slurm = dir_ + "/slurm";
+    // The job's folder has a space and a quote in its name: sbatch reads the quoted #SBATCH --output
+    // and bash the quoted paths of the task's command as the same folder.
+    const std::string local = dir_ + "/local", slurm = dir_ + "/slurm job's out";
     std::string out;
     ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + local + " --jobs 2", out), 0) << out;
     ASSERT_EQ(test::runCommand(bin() + " sweep merge " + local + " --no-plots", out), 0) << out;
 
-    ASSERT_EQ(test::runCommand("(" + env_ + bin() + " sweep slurm " + file + " --out " + slurm + " --time 00:10:00 --submit 2>/dev/null)", out), 0)
+    ASSERT_EQ(test::runCommand("(" + env_ + bin() + " sweep slurm " + file + " --out " + q(slurm) + " --time 00:10:00 --submit 2>/dev/null)", out), 0)
         << out;
     const std::string job = out.substr(0, out.find('\n'));
     ASSERT_FALSE(job.empty());
@@ -84,7 +92,7 @@ TEST_F(SweepSlurmTest, ArrayJobGivesTheSameTableAsALocalRun) {
     EXPECT_NE(script.find("--index \"$SLURM_ARRAY_TASK_ID\""), std::string::npos) << script;
     for (int k = 0; k < 4; ++k) EXPECT_TRUE(fs::exists(slurm + "/slurm/" + job + "_" + std::to_string(k) + ".out")) << k;
 
-    ASSERT_EQ(test::runCommand(bin() + " sweep merge " + slurm + " --no-plots", out), 0) << out;
+    ASSERT_EQ(test::runCommand(bin() + " sweep merge " + q(slurm) + " --no-plots", out), 0) << out;
     EXPECT_EQ(test::runIds(slurm + "/sweep.csv").size(), 4u);
     EXPECT_EQ(test::runIds(slurm + "/sweep.csv"), test::runIds(local + "/sweep.csv"));
     // Every run, algorithm and measure on both sides, and the same accuracy. (Counters, memory and

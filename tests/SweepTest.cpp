@@ -60,6 +60,24 @@ const BadSweep kBadSweeps[] = {
     {"BadBaseOutsideAnyAxis", R"({"base": {"frames": -1}})", "/base/frames|out of range"},
     {"NoBase", R"({"base": null})", "/base|required"},
     {"BadRatio", R"({"merge": {"ratios": ["psv"]}})", "/merge/ratios|not ID/ID"},
+    // Every fixed column of sweep.csv, `kind` included: the report reads rows by column name.
+    {"AxisNamedKind", R"({"axes": [{"name": "kind", "values": {"frames": [1, 2]}}]})", "/axes/0/name|column"},
+    {"AxisNamedValue", R"({"axes": [{"name": "value", "values": {"frames": [1, 2]}}]})", "/axes/0/name|column"},
+    // A "value" axis is plotted at its labels: words there would pass plan and crash the report.
+    {"ValueScaleWithWordLabels", R"({"axes": [{"name": "f", "values": {"frames": [1, 2]}, "labels": ["one", "two"], "scale": "value"}]})",
+     "/axes/0/scale|positive number|\"one\""},
+    {"ValueScaleWithNonNumbers", R"({"axes": [{"name": "l", "values": {"light.type": ["point", "directional"]}, "scale": "value"}]})",
+     "/axes/0/scale|positive numbers"},
+    // A label is one cell of the plan's TSV and of the tables.
+    {"LabelWithNewline", R"({"axes": [{"name": "f", "values": {"frames": [1, 2]}, "labels": ["a\nb", "c"]}]})",
+     "/axes/0/labels/0|control character (a newline)"},
+    {"LabelWithTab", R"({"axes": [{"name": "f", "values": {"frames": [1, 2]}, "labels": ["a", "b\tc"]}]})",
+     "/axes/0/labels/1|control character (a tab)"},
+    {"NameWithNewline", R"({"name": "small\n#SBATCH --wrap=id"})", "/name|control character (a newline)"},
+    {"EmptyOutputDir", R"({"output": {"dir": ""}})", "/output/dir|must not be empty"},
+    // Parsed by a walker that would wrap such an index (std::stoul) or throw something else than bad input.
+    {"ArrayIndexPastAnyArray", R"({"axes": [{"name": "pcf", "values": {"algorithms.99999999999999999999.params.pcf": [0, 1]}}]})",
+     "axis \"pcf\"|past any array"},
 };
 
 void PrintTo(const BadSweep& c, std::ostream* os) { *os << c.name << ": " << c.patch; }
@@ -150,7 +168,7 @@ TEST(SweepTest, SlurmScriptRunsOneTaskPerRunOrPerShard) {
         return ss.str();
     };
     const std::string perRun = script("--partition debug --time 00:05:00 --max-parallel 2");
-    for (const char* line : {"#SBATCH --array=0-3%2\n", "#SBATCH --partition=debug\n", "#SBATCH --time=00:05:00\n",
+    for (const char* line : {"#SBATCH --array=0-3%2\n", "#SBATCH --partition='debug'\n", "#SBATCH --time='00:05:00'\n",
                              "/shadowlab' sweep run '", "/out/sweep.json' --out '", " --index \"$SLURM_ARRAY_TASK_ID\"\n"})
         EXPECT_NE(perRun.find(line), std::string::npos) << line << " in\n" << perRun;
     EXPECT_EQ(perRun.find("--gpus-per-task"), std::string::npos) << perRun;

@@ -217,6 +217,8 @@ int sweepCommand(const std::vector<std::string>& args) {
     if (cmd == "run") return run(args);
     if (cmd == "slurm") return slurm(args);
     if (cmd == "merge") return merge(args);
+    // `sweep SOMETHING --help`: the help asked for wins over the unknown command.
+    if (std::any_of(args.begin() + 1, args.end(), [](const std::string& a) { return a == "--help" || a == "-h"; })) return printUsage("");
     throw InputError("sweep", "", (cmd.empty() ? std::string("needs a command") : "unknown command \"" + shortText(cmd, 40) + "\"") +
                                       ": plan, config, run, slurm or merge (see shadowlab sweep --help)");
 }

@@ -77,7 +77,7 @@ void makeFolders(const std::string& outputDir) {
 } // namespace
 
 RunPaths::RunPaths(const std::string& outputDir, const std::string& id)
-    : dir(outputDir + "/runs/" + id), config(dir + ".config.json"), log(dir + ".log"), error(dir + ".error.json"), lock(dir + ".lock") {}
+    : dir(outputDir + "/runs/" + id), config(dir + ".config.json"), log(dir + ".log"), error(dir + ".error.json"), lock(dir + ".sweep.lock") {}
 
 bool RunPaths::complete(std::string* why) const {
     if (why) why->clear();

@@ -18,7 +18,7 @@ struct SweepRunOptions {
 
 /// Where a run's files go.
 struct RunPaths {
-    std::string dir, config, log, error, lock;
+    std::string dir, config, log, error, lock; ///< lock: held by the sweep process running it
     RunPaths(const std::string& outputDir, const std::string& id);
     /// Whether the run finished: its summary.json (written last, see Runner.h) parses and says
     /// `"complete": true`. When not, `why` (if given) gets the reason, "" when there is no
@@ -42,7 +42,7 @@ void writeSweepSnapshot(const Sweep& sweep, const std::string& outputDir);
 /// DIR/sweep.lock is held for the whole call: exclusively for a whole sweep, shared for a part
 /// (--index, --shard: the array tasks of a Slurm job run side by side), so a second `sweep run`
 /// of the whole sweep is refused (InputError) while anything runs there. Each run being run holds
-/// DIR/runs/ID.lock. The kernel releases both when the process dies, kill -9 included; the runs
+/// DIR/runs/ID.sweep.lock (ID.lock is the run's own, taken by `shadowlab run`). The kernel releases both when the process dies, kill -9 included; the runs
 /// it started get SIGTERM then.
 int runSweep(const Sweep& sweep, const SweepRunOptions& options);
 
