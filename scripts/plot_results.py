@@ -54,7 +54,7 @@ def plot_frame_time(directory, ids, total, colour):
     ax.set_xlabel("frame")
     ax.set_ylabel("visibility time per frame (ms, wall clock)")
     ax.set_yscale("log")
-    ax.set_title("Frame time along the fly-through")
+    ax.set_title("Frame time along the fly-through (timed pass: statistics compiled out)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
@@ -90,7 +90,7 @@ def plot_stages(directory, ids, total, stages, wall):
     ax.set_ylim(0, top * 1.08)
     source = "wall clock of each stage run to completion" if wall else "GL timer queries; CPU stages wall clock"
     ax.set_ylabel(f"mean ms per frame ({source})", fontsize=8)
-    ax.set_title("Mean time per frame of each stage")
+    ax.set_title("Mean time per frame of each stage (timed pass: statistics compiled out)")
     ax.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
     fig.savefig(f"{directory}/plot_stages.png", dpi=120)
