@@ -152,6 +152,7 @@ int run(const std::vector<std::string>& args) {
     const std::string& dir = place.finalDir();
     std::fprintf(stderr, "shadowlab: wrote %s (report.md, summary.json) in %.1f s\n", shortText(dir, 300).c_str(),
                  r.meta["wall_time_s"].get<double>());
+    std::fputs(summaryTable(r.summary()).c_str(), stdout);
     if (glErrorCount() > 0) {
         std::fprintf(stderr, "shadowlab: %d OpenGL errors were reported during the run\n", glErrorCount());
         return 1;
