@@ -324,6 +324,8 @@ const EdgeSweep kEdgeSweeps[] = {
         {"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])"},
 };
 
+void PrintTo(const EdgeSweep& e, std::ostream* os) { *os << e.name << ": " << e.axes; }
+
 class SweepMergeEdgeSweepTest : public ::testing::TestWithParam<EdgeSweep> {};
 
 TEST_P(SweepMergeEdgeSweepTest, WhatPlanAcceptsTheReportAccepts) {
@@ -482,7 +484,8 @@ bool gone(pid_t pid) {
 }
 
 TEST(SweepStateTest, KillingTheSweepAloneStopsItsRuns) {
-    const std::string dir = test::makeTempDir("sweep-kill9"), file = smallFile(dir), out = dir + "/out";
+    // Runs of many frames (a minute each), so that they still render when their sweep is killed.
+    const std::string dir = test::makeTempDir("sweep-kill9"), file = smallFile(dir, {{"base", {{"frames", 20000}}}}), out = dir + "/out";
     const pid_t sweepPid = fork();
     if (sweepPid == 0) {
         const int log = open((dir + "/sweep.log").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -491,25 +494,31 @@ TEST(SweepStateTest, KillingTheSweepAloneStopsItsRuns) {
         execl(kBin.c_str(), kBin.c_str(), "sweep", "run", file.c_str(), "--out", out.c_str(), "--jobs", "2", static_cast<char*>(nullptr));
         _exit(127);
     }
-    // Wait until runs are in flight, then SIGKILL the sweep process only (no process group).
+    // Wait until both runs are in flight, then SIGKILL the sweep process only (no process group):
+    // it gets no chance to stop them itself.
     std::vector<pid_t> runs;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-    while (runs.empty() && std::chrono::steady_clock::now() < deadline) {
+    while (runs.size() < 2 && std::chrono::steady_clock::now() < deadline) {
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
         runs = childrenOf(sweepPid);
     }
-    ASSERT_FALSE(runs.empty()) << test::readText(dir + "/sweep.log");
-    std::this_thread::sleep_for(std::chrono::milliseconds(200)); // past the child's prctl
+    ASSERT_EQ(runs.size(), 2u) << test::readText(dir + "/sweep.log");
+    std::this_thread::sleep_for(std::chrono::milliseconds(500)); // the runs are rendering
     kill(sweepPid, SIGKILL);
     waitpid(sweepPid, nullptr, 0);
-    const auto stop = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    const auto stop = std::chrono::steady_clock::now() + std::chrono::seconds(8);
     for (pid_t run : runs) {
         while (!gone(run) && std::chrono::steady_clock::now() < stop) std::this_thread::sleep_for(std::chrono::milliseconds(20));
         EXPECT_TRUE(gone(run)) << "run process " << run << " outlived its sweep";
+        if (!gone(run)) kill(run, SIGKILL); // not left rendering after the test
     }
-    // The folder lock died with the sweep; the sweep finishes when started again.
-    const Ran again = runArgs(sweep({"run", file, "--out", out, "--jobs", "2"}));
-    EXPECT_EQ(again.rc, 0) << again.err;
+    // Stopped, not finished: no run folder, no partial one left.
+    for (const auto& e : fs::directory_iterator(out + "/runs"))
+        EXPECT_FALSE(e.is_directory()) << e.path() << " is left";
+    // The folder's lock died with the sweep (the runs never held it).
+    const int fd = open((out + "/sweep.lock").c_str(), O_RDWR);
+    EXPECT_EQ(flock(fd, LOCK_EX | LOCK_NB), 0);
+    close(fd);
 }
 
 TEST(SweepStateTest, BrokenResultsAreRunAgain) {

@@ -47,7 +47,8 @@ std::string logTail(const std::string& log) {
         for (size_t start = 0; start <= lines.size();) {
             size_t nl = lines.find('\n', start);
             if (nl == std::string::npos) nl = lines.size();
-            tail += (tail.empty() ? "" : "\n") + validUtf8(lines.substr(start, std::min<size_t>(nl - start, 1000)));
+            if (!tail.empty()) tail += '\n';
+            tail += validUtf8(lines.substr(start, std::min<size_t>(nl - start, 1000)));
             start = nl + 1;
         }
         return tail;

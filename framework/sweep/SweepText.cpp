@@ -93,7 +93,8 @@ std::string validUtf8(const std::string& text) {
 }
 
 size_t parseCount(const std::string& text, const std::string& option, size_t minValue, size_t maxValue) {
-    const std::string range = "[" + std::to_string(minValue) + ", " + std::to_string(maxValue) + "]";
+    std::string range = "[";
+    range += std::to_string(minValue) + ", " + std::to_string(maxValue) + "]";
     const std::string cause = "expected a whole number in " + range + ", got \"" + shortText(text, 40) + "\"";
     // Digits only: std::stoul would take "-1" (wrapping to 2^64 - 1), "+3", " 3" and "0x10".
     if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) throw InputError(shortText(option, 40), "", cause);
