@@ -36,7 +36,7 @@ def heat_legends(directory):
     """Every heat map's legend (the runner's JSON), with the path of its labelled PNG added."""
     out = []
     for path in sorted(glob.glob(os.path.join(directory, "images", "*_heat_*.json"))):
-        with open(path) as f:
+        with open(path, encoding="utf-8") as f:
             legend = json.load(f)
         legend["labelled"] = path[:-len(".json")] + "_labelled.png"
         legend["png"] = os.path.join(os.path.dirname(path), legend["image"])
@@ -116,7 +116,7 @@ def mismatch(directory):
     out = {}
     path = os.path.join(directory, "frames.csv")
     if os.path.exists(path):
-        with open(path, newline="") as f:
+        with open(path, newline="", encoding="utf-8") as f:
             for row in csv.DictReader(f):
                 if row["stage"] == "total" and row.get("mismatch_ratio"):
                     out[(row["id"], int(row["frame"]))] = float(row["mismatch_ratio"])
@@ -195,7 +195,7 @@ def ordered_ids(directory, frames):
     ids = []
     path = os.path.join(directory, "frames.csv")
     if os.path.exists(path):
-        with open(path, newline="") as f:
+        with open(path, newline="", encoding="utf-8") as f:
             ids = list(dict.fromkeys(row["id"] for row in csv.DictReader(f)))
     rest = sorted({i for per in frames.values() for i in per} - set(ids))
     ids += rest

@@ -35,7 +35,7 @@ FIGURES_HEADING = "## Figures"
 def load(path, wall):
     total = defaultdict(dict)     # id -> frame -> row of the "total" stage
     stages = defaultdict(lambda: defaultdict(float))  # id -> stage -> sum of ms over frames
-    with open(path, newline="") as f:
+    with open(path, newline="", encoding="utf-8") as f:
         for row in csv.DictReader(f):
             if row["stage"] == "total":
                 total[row["id"]][int(row["frame"])] = row
@@ -141,13 +141,13 @@ def append_figures(directory, sheets, heats):
     path = os.path.join(directory, "report.md")
     if not os.path.exists(path):
         return None
-    with open(path) as f:
+    with open(path, encoding="utf-8") as f:
         text = f.read()
     cut = text.find("\n" + FIGURES_HEADING + "\n")
     if cut >= 0:
         text = text[:cut + 1]
     text = text.rstrip("\n") + "\n\n" + "\n".join(figures_section(directory, sheets, heats)).rstrip("\n") + "\n"
-    with open(path, "w") as f:
+    with open(path, "w", encoding="utf-8") as f:
         f.write(text)
     return path
 

@@ -174,7 +174,7 @@ def report(s, directory):
     for axis in s.axes:
         if axis["scale"] in SIZE_SCALES:
             lines += [""] + fit_table(s, axis)
-    with open(os.path.join(directory, "sweep.md"), "w") as f:
+    with open(os.path.join(directory, "sweep.md"), "w", encoding="utf-8") as f:
         f.write("\n".join(lines) + "\n")
 
 
@@ -292,7 +292,7 @@ def figures(s, directory):
     names.append(("sweep_stages.png", "The stages of each run, per algorithm id"))
     shown = [(n, title) for n, title in names if os.path.exists(os.path.join(directory, n))]
     path = os.path.join(directory, "sweep.md")
-    with open(path) as f:
+    with open(path, encoding="utf-8") as f:
         text = f.read()
     cut = text.find("\n## Figures\n")
     if cut >= 0:
@@ -300,7 +300,7 @@ def figures(s, directory):
     if shown:
         text = text.rstrip("\n") + "\n\n## Figures\n\n" + "\n\n".join(
             f"![{title}]({n})" for n, title in shown) + "\n"
-        with open(path, "w") as f:
+        with open(path, "w", encoding="utf-8") as f:
             f.write(text)
 
 

@@ -18,7 +18,7 @@ public:
 
 private:
     static std::string format(const std::string& file, const std::string& path, const std::string& cause) {
-        std::string s = file.empty() ? std::string("<input>") : file;
+        std::string s = file.empty() ? std::string("<input>") : cut(file, 300);
         if (!path.empty()) s += ": at " + cut(path, 200);
         return s + ": " + cut(cause, 300);
     }
