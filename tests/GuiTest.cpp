@@ -245,6 +245,17 @@ TEST(GuiTest, HelpExitsZeroWhateverElseTheLineHolds) {
     }
 }
 
+TEST(GuiTest, EchoedValuesStayShort) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    const std::string huge(5000, 'v');
+    for (const std::string args : {"--view " + huge, "--frames " + huge, "--" + huge, "--report /nonexistent/" + huge + "/r.json"}) {
+        std::string out;
+        EXPECT_EQ(guiError(kSmoke + " " + args, out), 2) << out.substr(0, 300);
+        EXPECT_LT(out.size(), 500u) << out.substr(0, 300);
+        EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out.substr(0, 300);
+    }
+}
+
 TEST(GuiTest, WindowSizesBeyondWhatX11AndGlCanMakeAreBadInput) {
     if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
     // 100000² used to end in an Xlib abort once the window was asked for.

@@ -225,5 +225,21 @@ TEST(OutputPlaceTest, ACommitKeepsWhatAppearedAtThePlaceAfterOpenAndKeepsItsOwnR
     EXPECT_EQ(slurp(forced + "/summary.json"), "old");
 }
 
+TEST(OutputPlaceTest, AnAbsurdlyLongPathIsEchoedShort) {
+    std::string base = test::makeTempDir("place-long");
+    std::string deep = base;
+    for (int i = 0; i < 30; ++i) deep += "/" + std::string(100, 'd');  // 3,000 characters
+    std::ofstream(base + "/file") << "x";
+    std::string err = errorOf(base + "/file/" + std::string(3000, 'x'), true);
+    EXPECT_FALSE(err.empty());
+    EXPECT_LT(err.size(), 600u) << err;
+    fs::create_directories(deep);
+    makeOutput(deep, "x");
+    err = errorOf(deep, false);
+    EXPECT_NE(err.find("already exists"), std::string::npos) << err;
+    EXPECT_NE(err.find("..."), std::string::npos) << err;
+    EXPECT_LT(err.size(), 600u) << err;
+}
+
 } // namespace
 } // namespace shadowlab

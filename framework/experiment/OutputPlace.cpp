@@ -19,6 +19,14 @@ namespace {
 
 std::string pidSuffix() { return std::to_string(::getpid()); }
 
+/// A path as echoed in a message: at most 160 characters, its start and its end (which names the
+/// folder) kept around "...", so an absurd --out stays one readable line.
+std::string shortPath(const std::string& path) {
+    if (path.size() <= 160) return path;
+    return path.substr(0, 70) + "..." + path.substr(path.size() - 87);
+}
+std::string shortPath(const fs::path& path) { return shortPath(path.string()); }
+
 /// "results/run/" → "results/run"; "" stays "" (rejected by the caller).
 std::string normalize(std::string dir) {
     while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
@@ -105,20 +113,20 @@ void checkAncestors(const std::string& dir) {
             ++depth;
             const std::string lock = a.string() + ".lock";
             if (lockIsLive(lock))
-                throw InputError(dir, "", "the output lies inside " + a.string() + ", the output of a shadowlab run in progress" +
+                throw InputError(shortPath(dir), "", "the output lies inside " + shortPath(a.string()) + ", the output of a shadowlab run in progress" +
                                               lockOwner(lock) + "; its commit would replace this one. Choose --out outside it");
             if (isRunTemporary(a.filename().string()))
-                throw InputError(dir, "", "the output lies inside " + a.string() +
+                throw InputError(shortPath(dir), "", "the output lies inside " + shortPath(a.string()) +
                                               ", a shadowlab run's temporary directory; choose --out outside it");
             const std::string marker = fs::is_directory(fs::symlink_status(a, ec)) ? markerOf(a) : "";
             if (marker.empty()) continue;
             if (marker == "sweep.json") {
                 // A sweep runs each of its runs into SWEEP/runs/ID; anything else inside it is not its.
                 if (depth == 2 && target.parent_path().filename() == "runs") continue;
-                throw InputError(dir, "", "the output lies inside the sweep directory " + a.string() +
+                throw InputError(shortPath(dir), "", "the output lies inside the sweep directory " + shortPath(a.string()) +
                                               " (it holds sweep.json); its runs go to runs/ID. Choose --out outside it");
             }
-            throw InputError(dir, "", "the output lies inside " + a.string() + ", a shadowlab run's output (it holds " + marker +
+            throw InputError(shortPath(dir), "", "the output lies inside " + shortPath(a.string()) + ", a shadowlab run's output (it holds " + marker +
                                           "); replacing that one would delete this. Choose --out outside it");
         }
     }
@@ -137,9 +145,9 @@ std::string nestedInside(const fs::path& dir, size_t limit = 200000) {
         const fs::path& p = it->path();
         const std::string name = p.filename().string();
         if (name.size() > 5 && name.compare(name.size() - 5, 5, ".lock") == 0 && lockIsLive(p.string()))
-            return p.string() + ", the lock of a shadowlab run in progress" + lockOwner(p.string());
+            return shortPath(p) + ", the lock of a shadowlab run in progress" + lockOwner(p.string());
         if (it.depth() >= 1 && (name == "summary.json" || name == "config.resolved.json" || name == "sweep.json"))
-            return p.parent_path().string() + ", another shadowlab " + (name == "sweep.json" ? "sweep" : "output") +
+            return shortPath(p.parent_path()) + ", another shadowlab " + (name == "sweep.json" ? "sweep" : "output") +
                    " (it holds " + name + ")";
     }
     if (ec) return "an unreadable entry (" + ec.message() + ")";
@@ -151,9 +159,11 @@ std::string nestedInside(const fs::path& dir, size_t limit = 200000) {
 int acquireLock(const std::string& lockPath, const std::string& dir) {
     for (int attempt = 0; attempt < 100; ++attempt) {
         int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
-        if (fd < 0)
-            throw InputError(dir, "", "cannot create the lock file " + lockPath + ": " + std::strerror(errno) +
+        if (fd < 0) {
+            const int err = errno;
+            throw InputError(shortPath(dir), "", "cannot create the lock file " + shortPath(lockPath) + ": " + std::strerror(err) +
                                           " (is the output's parent directory writable?)");
+        }
         // Another run's lockIsLive() probe holds a shared lock for an instant: wait that out (50 ms)
         // before calling the place busy; a run in progress holds its lock for the whole run.
         bool locked = false;
@@ -164,7 +174,7 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
             ssize_t n = ::pread(fd, owner, sizeof owner - 1, 0);
             ::close(fd);
             std::string who = n > 0 ? " (pid " + std::string(owner, size_t(n)) + ")" : "";
-            throw InputError(dir, "", "output directory is in use by another shadowlab run" + who +
+            throw InputError(shortPath(dir), "", "output directory is in use by another shadowlab run" + who +
                                           "; wait for it or choose another --out");
         }
         struct stat held {}, named {};
@@ -176,7 +186,7 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
         }
         ::close(fd);  // the holder unlinked it meanwhile: lock the new one
     }
-    throw RuntimeError("could not lock " + lockPath);
+    throw RuntimeError("could not lock " + shortPath(lockPath));
 }
 
 } // namespace
@@ -185,14 +195,14 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
     const std::string dir = normalize(given);
     if (dir.empty()) throw InputError("--out", "", "the output directory must not be empty");
     if (dir == "/" || containsWorkingDir(dir))
-        throw InputError(dir, "", "the output directory cannot be the working directory or one above it "
+        throw InputError(shortPath(dir), "", "the output directory cannot be the working directory or one above it "
                                   "(an output is a directory of its own, e.g. --out results/run1)");
     fs::path finalPath(dir);
     fs::path parent = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
     checkAncestors(dir);  // before anything is created
     std::error_code ec;
     fs::create_directories(parent, ec);
-    if (ec) throw InputError(dir, "", "cannot create the parent directory " + parent.string() + ": " + ec.message());
+    if (ec) throw InputError(shortPath(dir), "", "cannot create the parent directory " + shortPath(parent.string()) + ": " + ec.message());
 
     OutputPlace place;
     place.final_ = dir;
@@ -215,43 +225,43 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
         // complete and were never replaced, so put them back.
         fs::rename(olds.back(), finalPath, ec);
         if (!ec) {
-            note("recovered " + dir + " from " + olds.back().string() + " (a run was killed while committing)");
+            note("recovered " + shortPath(dir) + " from " + shortPath(olds.back().string()) + " (a run was killed while committing)");
             olds.pop_back();
         }
     }
     for (const auto& p : partials) {
         fs::remove_all(p, ec);
-        note("removed " + p.string() + ", left by an interrupted run");
+        note("removed " + shortPath(p.string()) + ", left by an interrupted run");
     }
     for (const auto& p : olds) {
         fs::remove_all(p, ec);
-        note("removed " + p.string() + ", left by an interrupted run");
+        note("removed " + shortPath(p.string()) + ", left by an interrupted run");
     }
 
     auto status = fs::symlink_status(finalPath, ec);
     if (fs::is_symlink(status))
-        throw InputError(dir, "", "the output path is a symbolic link; give the directory it should name instead");
+        throw InputError(shortPath(dir), "", "the output path is a symbolic link; give the directory it should name instead");
     if (fs::exists(status)) {
-        if (!fs::is_directory(status)) throw InputError(dir, "", "the output path exists and is not a directory");
+        if (!fs::is_directory(status)) throw InputError(shortPath(dir), "", "the output path exists and is not a directory");
         if (!force)
-            throw InputError(dir, "", "output directory already exists; pass --force to replace it once the new run "
+            throw InputError(shortPath(dir), "", "output directory already exists; pass --force to replace it once the new run "
                                       "completes, or --out DIR");
         if (markerOf(finalPath) == "sweep.json")
-            throw InputError(dir, "", "the directory is a sweep (it holds sweep.json); --force replaces only one run's output");
+            throw InputError(shortPath(dir), "", "the directory is a sweep (it holds sweep.json); --force replaces only one run's output");
         const bool output = isShadowlabOutput(finalPath);
         // Whatever it is, a run in progress or another output inside it is never replaced with it.
         if (const std::string inside = nestedInside(finalPath, output ? 200000 : 10000); !inside.empty() &&
                                                                                      (output || inside.find(".lock") != std::string::npos))
-            throw InputError(dir, "", "the directory holds " + inside + "; --force replaces only a single run's output");
+            throw InputError(shortPath(dir), "", "the directory holds " + inside + "; --force replaces only a single run's output");
         if (!output)
-            throw InputError(dir, "", "the directory exists and is not a shadowlab output (no summary.json or "
+            throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no summary.json or "
                                       "config.resolved.json); --force replaces only outputs");
         struct stat st {};
         if (::lstat(dir.c_str(), &st) == 0) place.existed_ = true, place.dev_ = uint64_t(st.st_dev), place.ino_ = uint64_t(st.st_ino);
     }
     place.partial_ = dir + ".partial-" + pidSuffix();
     fs::create_directories(place.partial_ + "/images", ec);
-    if (ec) throw InputError(dir, "", "cannot create " + place.partial_ + ": " + ec.message());
+    if (ec) throw InputError(shortPath(dir), "", "cannot create " + shortPath(place.partial_) + ": " + ec.message());
     return place;
 }
 
@@ -284,8 +294,8 @@ void OutputPlace::refuseCommit(const std::string& why) {
     if (!ec) partial_ = kept;
     kept_ = true;
     release();
-    throw RuntimeError("not replacing " + final_ + ": " + why + "; it is left as it is and this run's results are in " +
-                       partial_);
+    throw RuntimeError("not replacing " + shortPath(final_) + ": " + why + "; it is left as it is and this run's results are in " +
+                       shortPath(partial_));
 }
 
 void OutputPlace::commit() {
@@ -308,22 +318,25 @@ void OutputPlace::commit() {
             // A file system without exchange: two renames; open() recovers DIR.old-PID if killed between.
             std::string old = final_ + ".old-" + pidSuffix();
             fs::rename(final_, old, ec);
-            if (ec) throw RuntimeError("cannot move " + final_ + " aside: " + ec.message());
+            if (ec) throw RuntimeError("cannot move " + shortPath(final_) + " aside: " + ec.message());
             fs::rename(partial_, final_, ec);
-            if (ec) throw RuntimeError("cannot rename " + partial_ + " to " + final_ + ": " + ec.message());
+            if (ec) throw RuntimeError("cannot rename " + shortPath(partial_) + " to " + shortPath(final_) + ": " + ec.message());
             committed_ = true;
             fs::remove_all(old, ec);
         } else {
-            throw RuntimeError("cannot replace " + final_ + ": " + std::strerror(errno));
+            const int err = errno;
+            throw RuntimeError("cannot replace " + shortPath(final_) + ": " + std::strerror(err));
         }
     } else {
         if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, final_.c_str(), RENAME_NOREPLACE) != 0) {
             if (errno == EEXIST || errno == ENOTEMPTY) refuseCommit("it appeared while this run was working and was not created by it");
             // RENAME_NOREPLACE is unsupported on some file systems; the lock still keeps other runs out.
-            if (errno != EINVAL && errno != ENOSYS) throw RuntimeError("cannot rename " + partial_ + " to " + final_ + ": " + std::strerror(errno));
+            const int err = errno;
+            if (err != EINVAL && err != ENOSYS)
+                throw RuntimeError("cannot rename " + shortPath(partial_) + " to " + shortPath(final_) + ": " + std::strerror(err));
             if (fs::exists(fs::symlink_status(final_, ec))) refuseCommit("it appeared while this run was working and was not created by it");
             fs::rename(partial_, final_, ec);
-            if (ec) throw RuntimeError("cannot rename " + partial_ + " to " + final_ + ": " + ec.message());
+            if (ec) throw RuntimeError("cannot rename " + shortPath(partial_) + " to " + shortPath(final_) + ": " + ec.message());
         }
         committed_ = true;
     }
