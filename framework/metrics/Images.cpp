@@ -1,5 +1,7 @@
 #include "framework/metrics/Images.h"
 
+#include "framework/core/FileIO.h"
+
 #include "framework/core/Error.h"
 
 #include <algorithm>
@@ -14,8 +16,13 @@ void writePngRGBA(const std::string& path, int width, int height, const std::vec
     size_t row = size_t(width) * 4;
     for (int y = 0; y < height; ++y)
         std::copy_n(rgba.data() + size_t(height - 1 - y) * row, row, flipped.data() + size_t(y) * row);
-    if (!stbi_write_png(path.c_str(), width, height, 4, flipped.data(), int(row)))
-        throw RuntimeError("cannot write " + path);
+    // Encoded in memory, then written like every other output file (writeFileAtomic): a full disk
+    // or a link at the target never leaves a truncated PNG under the real name.
+    std::string png;
+    auto append = [](void* context, void* data, int size) { static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size)); };
+    if (!stbi_write_png_to_func(append, &png, width, height, 4, flipped.data(), int(row)))
+        throw RuntimeError("cannot encode " + path);
+    writeFileAtomic(path, png);
 }
 
 static void put(std::vector<unsigned char>& out, size_t i, float r, float g, float b) {
