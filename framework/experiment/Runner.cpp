@@ -43,6 +43,16 @@ std::unique_ptr<AlgorithmHost> makeHost(const AlgorithmEntry& e, bool instrument
     return host;
 }
 
+/// The per-frame record of a measurement, as either pass keeps it.
+FrameRecord recordOf(const FrameMeasurement& m, int frame) {
+    FrameRecord rec;
+    rec.frame = frame;
+    rec.stages = m.stagesWithTotal();
+    for (const auto& c : m.counters) rec.counters[c.name] = c.value;
+    rec.overflow = m.overflow;
+    return rec;
+}
+
 /// A fingerprint of a visibility image: the statistics pass must reproduce the timed pass's bits.
 uint64_t visibilityHash(const std::vector<float>& vis) {
     uint64_t h = 1469598103934665603ull;  // FNV-1a over the raw words
@@ -107,6 +117,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     }
     const std::vector<int> statFrames = cfg.statisticsFrames();
     auto isStatFrame = [&](int f) { return std::binary_search(statFrames.begin(), statFrames.end(), f); };
+    auto isImageFrame = [&](int f) {
+        return opt.writeOutputs && std::find(cfg.imagesAtFrames.begin(), cfg.imagesAtFrames.end(), f) != cfg.imagesAtFrames.end();
+    };
 
     ExperimentResults results;
     results.meta = {{"name", cfg.name},
@@ -166,8 +179,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         const CpuGBuffer& g = getCpuG();
         std::vector<uint8_t> lit = litMask(g, light);
         std::vector<uint8_t> covered = coveredMask(g);
-        bool saveImages = opt.writeOutputs &&
-                          std::find(cfg.imagesAtFrames.begin(), cfg.imagesAtFrames.end(), frame) != cfg.imagesAtFrames.end();
+        const bool saveImages = isImageFrame(frame);
         std::vector<float> reference;
 
         if (!std::any_of(lit.begin(), lit.end(), [](uint8_t v) { return v != 0; })) framesWithoutLit.push_back(frame);
@@ -178,11 +190,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
             m.stages.insert(m.stages.begin(), sceneUpdate.stages.begin(), sceneUpdate.stages.end());
             m.wallMs += sceneUpdate.wallMs;
-            FrameRecord rec;
-            rec.frame = frame;
-            rec.stages = m.stagesWithTotal();
-            for (const auto& c : m.counters) rec.counters[c.name] = c.value;
-            rec.overflow = m.overflow;
+            FrameRecord rec = recordOf(m, frame);
             inst.results.memoryBytes = std::max(inst.results.memoryBytes, m.memoryBytes);
 
             std::vector<float> vis = inst.host->readVisibility();
@@ -219,17 +227,11 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         if (frame == statFrames.front())
             for (auto& inst : instances)
                 for (int w = 0; w < cfg.warmupFrames; ++w) inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
-        const bool saveImages = opt.writeOutputs &&
-                                std::find(cfg.imagesAtFrames.begin(), cfg.imagesAtFrames.end(), frame) != cfg.imagesAtFrames.end();
+        const bool saveImages = isImageFrame(frame);
         for (auto& inst : instances) {
             throwIfInterrupted();
             progress.step(inst.entry->id + " statistics, frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
-            FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
-            FrameRecord rec;
-            rec.frame = frame;
-            rec.stages = m.stagesWithTotal();
-            for (const auto& c : m.counters) rec.counters[c.name] = c.value;
-            rec.overflow = m.overflow;
+            FrameRecord rec = recordOf(inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer), frame);
             if (visibilityHash(inst.host->readVisibility()) != inst.timedVisibility[frame]) inst.results.visibilityDiffers.push_back(frame);
             if (saveImages) writeHeatMaps(dir, inst.entry->id, frame, res, inst.host->algorithm().debugViews());
             inst.results.statistics.push_back(std::move(rec));
