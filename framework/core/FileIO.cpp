@@ -87,6 +87,11 @@ std::vector<unsigned char> readInputFileBytes(const std::string& path, size_t ma
     return readRegular<std::vector<unsigned char>>(path, maxBytes);
 }
 
+std::string shortPath(const std::string& path) {
+    if (path.size() <= 160) return path;
+    return path.substr(0, 70) + "..." + path.substr(path.size() - 87);
+}
+
 std::string nonRegularKind(const std::string& path, bool followLinks) {
     struct stat st {};
     if ((followLinks ? ::stat(path.c_str(), &st) : ::lstat(path.c_str(), &st)) != 0) return "";

@@ -28,6 +28,10 @@ std::vector<unsigned char> readInputFileBytes(const std::string& path, size_t ma
 /// "a FIFO", "a directory", "a symbolic link", ... for messages; "" for a regular file or nothing there.
 std::string nonRegularKind(const std::string& path, bool followLinks);
 
+/// A path as echoed in a message: at most 160 characters, its start and its end (which names the
+/// file or folder) kept around "...", so an absurd path stays one readable line.
+std::string shortPath(const std::string& path);
+
 /// Writes `text` to `path` atomically (see above). RuntimeError on an I/O failure; InputError when
 /// the target is not a regular file (the caller named a place that cannot hold a file).
 void writeFileAtomic(const std::string& path, const std::string& text);

@@ -1,6 +1,7 @@
 #include "framework/experiment/OutputPlace.h"
 
 #include "framework/core/Error.h"
+#include "framework/core/FileIO.h"
 
 #include <cerrno>
 #include <cstdio>
@@ -19,13 +20,7 @@ namespace {
 
 std::string pidSuffix() { return std::to_string(::getpid()); }
 
-/// A path as echoed in a message: at most 160 characters, its start and its end (which names the
-/// folder) kept around "...", so an absurd --out stays one readable line.
-std::string shortPath(const std::string& path) {
-    if (path.size() <= 160) return path;
-    return path.substr(0, 70) + "..." + path.substr(path.size() - 87);
-}
-std::string shortPath(const fs::path& path) { return shortPath(path.string()); }
+std::string shortPath(const fs::path& path) { return shadowlab::shortPath(path.string()); }
 
 /// "results/run/" → "results/run"; "" stays "" (rejected by the caller).
 std::string normalize(std::string dir) {

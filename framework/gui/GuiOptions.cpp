@@ -96,8 +96,7 @@ glm::ivec2 size(const std::string& opt, const std::string& text) {
 /// device or FIFO there is refused (writeFileAtomic would refuse it only after the whole session).
 void checkOutputFile(const std::string& opt, const std::string& file) {
     if (file.empty()) throw usage(opt + " needs a file name");
-    // The name as echoed: its start and end (the file's own name) around "..." when it is long.
-    const std::string shown = file.size() <= 160 ? file : file.substr(0, 70) + "..." + file.substr(file.size() - 87);
+    const std::string shown = shortPath(file);
     if (const std::string kind = nonRegularKind(file, false); !kind.empty())
         throw InputError(shown, "", opt + ": the path is " + kind + ", not a file it can replace");
     const std::filesystem::path parent = std::filesystem::path(file).parent_path();
