@@ -15,6 +15,9 @@ PACKAGES=(
   slurm-wlm munge
   # tests/ReportTest.cpp opens report.html in headless chromium to check that its images decode.
   chromium
+  # The portability matrix (scripts/portability.sh) runs the GL tests a second time on zink (GL on
+  # Vulkan) over lavapipe: mesa-vulkan-drivers brings lavapipe and zink.
+  mesa-vulkan-drivers
 )
 
 PACKAGES+=("$@")

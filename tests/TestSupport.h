@@ -2,6 +2,7 @@
 // Shared test helpers: a GL context with a debug callback that fails the test on any GL error,
 // and paths to the real test data.
 #include "framework/gl/GlContext.h"
+#include "framework/gl/Shader.h"
 
 #include <gtest/gtest.h>
 #include <memory>
@@ -16,6 +17,16 @@ protected:
     void SetUp() override;
     void TearDown() override;
     std::unique_ptr<GlContext> context_;
+};
+
+/// Compiles every program made while it lives with `faults` (SHADOWLAB_FAULT_* defines, see
+/// setShaderFaultDefines): the algorithm must be created inside the scope.
+class ScopedShaderFaults {
+public:
+    explicit ScopedShaderFaults(ShaderDefines faults) { setShaderFaultDefines(std::move(faults)); }
+    ~ScopedShaderFaults() { setShaderFaultDefines({}); }
+    ScopedShaderFaults(const ScopedShaderFaults&) = delete;
+    ScopedShaderFaults& operator=(const ScopedShaderFaults&) = delete;
 };
 
 /// Debian's assimp-testmodels glTF folder.

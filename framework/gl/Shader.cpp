@@ -49,6 +49,16 @@ static std::string expandIncludes(const std::string& relPath, std::set<std::stri
     return out.str();
 }
 
+namespace {
+ShaderDefines& faultDefines() {
+    static ShaderDefines d;
+    return d;
+}
+} // namespace
+
+void setShaderFaultDefines(ShaderDefines defines) { faultDefines() = std::move(defines); }
+const ShaderDefines& shaderFaultDefines() { return faultDefines(); }
+
 std::string loadShaderSource(const std::string& relPath, const ShaderDefines& defines) {
     std::set<std::string> seen;
     std::string src = expandIncludes(relPath, seen);
@@ -58,6 +68,7 @@ std::string loadShaderSource(const std::string& relPath, const ShaderDefines& de
     auto eol = src.find('\n', v);
     std::string header;
     for (const auto& [name, value] : defines) header += "#define " + name + " " + value + "\n";
+    for (const auto& [name, value] : faultDefines()) header += "#define " + name + " " + value + "\n";
     header += "#line 2\n";
     return src.substr(0, eol + 1) + header + src.substr(eol + 1);
 }

@@ -16,6 +16,14 @@ using ShaderDefines = std::vector<std::pair<std::string, std::string>>;
 /// The shader folder: $SHADOWLAB_SHADER_DIR if set, else the source tree's shaders/ (compiled in).
 std::string shaderDir();
 
+/// Fault injection, for tests only (nothing else calls it): defines added to every program compiled
+/// from now on. A software GL keeps denormals, runs a subgroup's lanes in lockstep and has a loop
+/// cap, so the faults a GPU may show (a flushed denormal, a lane missing from a vote, a NaN step
+/// that never ends a loop) are forced through SHADOWLAB_FAULT_* defines read at each fault site
+/// (docs/architecture.md, "GPU portability"). Empty again with setShaderFaultDefines({}).
+void setShaderFaultDefines(ShaderDefines defines);
+const ShaderDefines& shaderFaultDefines();
+
 /// Loads a stage source with includes expanded and defines prepended.
 std::string loadShaderSource(const std::string& relPath, const ShaderDefines& defines);
 
