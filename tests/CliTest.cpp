@@ -31,6 +31,7 @@ TEST(CliTest, HelpOnEveryCommand) {
         {{"run"}, "shadowlab run CONFIG.json"},
         {{"validate"}, "shadowlab validate CONFIG.json"},
         {{"list"}, "shadowlab list ["},
+        {{"info"}, "shadowlab info [--json]"},
         {{"sweep"}, "shadowlab sweep merge DIR"},
         {{"sweep", "plan"}, "shadowlab sweep plan SWEEP.json"},
         {{"sweep", "config"}, "shadowlab sweep config SWEEP.json INDEX"},
@@ -73,6 +74,58 @@ TEST(CliTest, RunEchoesABoundedName) {
     const test::Ran bad = test::runArgs({bin(), "run", "--" + name});
     EXPECT_EQ(bad.rc, 2);
     EXPECT_LT(bad.err.size(), 1000u);
+}
+
+// `info` says what a run would run on: the implementation, the subgroup width and what each auto
+// parameter resolves to, as text and as JSON with the same values.
+TEST(CliTest, InfoPrintsTheDeviceAndTheResolvedAutos) {
+    const test::Ran j = test::runArgs({bin(), "info", "--json"});
+    ASSERT_EQ(j.rc, 0) << j.err;
+    EXPECT_EQ(j.err, "");
+    const Json info = Json::parse(j.out);
+    const Json& device = info.at("device");
+    for (const char* key : {"vendor", "renderer", "version", "glsl_version"})
+        EXPECT_FALSE(device.at(key).get<std::string>().empty()) << key;
+    EXPECT_EQ(device.at("backend"), "OSMesa");
+    const int subgroup = device.at("subgroup_size").get<int>();
+    EXPECT_GE(subgroup, 0);
+    EXPECT_GT(device.at("limits").at("GL_MAX_SHADER_STORAGE_BLOCK_SIZE").get<long long>(), 0);
+    EXPECT_EQ(device.at("limits").at("GL_MAX_COMPUTE_WORK_GROUP_COUNT").size(), 3u);
+    // The extensions the shaders name, each with whether the context has it.
+    for (const char* ext : {"GL_ARB_shader_ballot", "GL_ARB_gpu_shader_int64"}) EXPECT_TRUE(device.at("extensions").at(ext).is_boolean()) << ext;
+    EXPECT_EQ(device.at("extensions").at("GL_ARB_shader_ballot").get<bool>(), subgroup > 0);
+    const Json& ptsv = info.at("algorithms").at("ptsv").at("resolved_params");
+    const std::string traversal = ptsv.at("traversal").get<std::string>();
+    EXPECT_NE(traversal, "auto");
+    for (const char* key : {"vote", "lanes", "split_level", "jobs_per_workgroup"}) EXPECT_TRUE(ptsv.contains(key)) << key;
+    EXPECT_TRUE(info.at("algorithms").at("metric_tree").at("resolved_params").contains("tile"));
+    // Every registered algorithm has an entry, none failed.
+    std::string list;
+    ASSERT_EQ(test::runCommand(bin() + " list --json 2>/dev/null", list), 0);
+    for (const auto& a : Json::parse(list)) {
+        ASSERT_TRUE(info["algorithms"].contains(a["name"].get<std::string>())) << a["name"];
+        EXPECT_FALSE(info["algorithms"][a["name"].get<std::string>()].contains("error")) << a["name"];
+    }
+
+    const test::Ran t = test::runArgs({bin(), "info"});
+    ASSERT_EQ(t.rc, 0) << t.err;
+    EXPECT_NE(t.out.find(device.at("renderer").get<std::string>()), std::string::npos) << t.out;
+    EXPECT_NE(t.out.find("subgroup width " + std::to_string(subgroup)), std::string::npos) << t.out;
+    EXPECT_NE(t.out.find("traversal = " + traversal), std::string::npos) << t.out;
+    EXPECT_NE(t.out.find("GL_MAX_TEXTURE_BUFFER_SIZE"), std::string::npos) << t.out;
+}
+
+// Bad input to `info` is exit code 2 and one line, with nothing on stdout.
+TEST(CliTest, InfoRefusesUnknownArguments) {
+    for (const std::vector<std::string>& extra : {std::vector<std::string>{"--jsn"}, {"--json", "extra"}, {"-x"}}) {
+        std::vector<std::string> argv = {bin(), "info"};
+        argv.insert(argv.end(), extra.begin(), extra.end());
+        const test::Ran r = test::runArgs(argv);
+        EXPECT_EQ(r.rc, 2) << extra.back();
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find(extra.back()), std::string::npos) << r.err;
+        EXPECT_EQ(r.out, "");
+    }
 }
 
 TEST(CliTest, UnknownCommandIsBadInput) {
@@ -126,6 +179,15 @@ TEST(CliTest, EglRunnerRunsTheSmokeConfig) {
     for (const auto& [id, a] : s["algorithms"].items())
         if (a["algorithm"] == "psv" || a["algorithm"] == "bvh_raytrace")
             EXPECT_LE(a["accuracy"]["mismatch_ratio_max"].get<double>(), 0.001) << id; // exact, as on OSMesa
+    EXPECT_EQ(s["device"]["backend"], "EGL");
+}
+
+TEST(CliTest, EglInfoNamesItsBackend) {
+    const test::Ran r = test::runArgs({SHADOWLAB_EGL_BINARY, "info", "--json"});
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const Json info = Json::parse(r.out);
+    EXPECT_EQ(info["device"]["backend"], "EGL");
+    EXPECT_TRUE(info["algorithms"]["ptsv"]["resolved_params"].contains("traversal"));
 }
 #endif
 

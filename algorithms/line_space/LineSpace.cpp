@@ -303,6 +303,13 @@ public:
         return uint64_t(c[LS_C_OVERFLOW]) + c[LS_C_TRUNCATED];
     }
 
+    /// The storage block size build() splits the line-space pool by, in MiB, on this device.
+    std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
+        const size_t cap = size_t(p_.maxBlockMib) << 20;
+        const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
+        return {{"max_block_mib", std::to_string(limit >> 20)}};
+    }
+
 private:
     ShaderDefines defines(bool classify) const {
         return {{"LS_N", std::to_string(p_.n)},

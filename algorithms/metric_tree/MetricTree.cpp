@@ -304,6 +304,13 @@ public:
         return uint64_t(c[MT_C_STACK_OVERFLOW]) + c[MT_C_BUILD_ERRORS];
     }
 
+    /// The tile shape tilePixels() gives on this device (used by the tile query).
+    std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
+        if (p_.tile != "auto") return {{"tile", p_.tile}};
+        const int n = tilePixels();
+        return {{"tile", n == 8 ? "4x2" : n == 16 ? "8x2" : n == 32 ? "8x4" : "8x8"}};
+    }
+
 private:
     void compile() {
         auto flag = [](bool on) { return on ? std::string("1") : std::string("0"); };

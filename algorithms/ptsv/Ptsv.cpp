@@ -306,6 +306,23 @@ public:
         return uint64_t(c[PTSV_C_JOB_OVERFLOW]) + c[PTSV_C_TRUNCATED] + c[PTSV_C_SUBGROUP_MISMATCH];
     }
 
+    /// What compile() chose on this device: the traversal, the vote (none without cooperative
+    /// traversal), the workgroup width, and the split depth (its rule, "levels" or "levels - 1",
+    /// until a frame has laid out the tree) and jobs per workgroup that 0 stands for.
+    std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
+        const std::string traversal = packet_ ? "packet" : perInvocation_ ? "invocation" : "cooperative";
+        const std::string vote = vote_ == kVoteBallot ? "ballot" : vote_ == kVoteShared ? "shared" : "none";
+        const std::string split = layout_.levels > 0     ? std::to_string(splitDepth())
+                                  : p_.splitLevel != 0   ? std::to_string(p_.splitLevel)
+                                  : perInvocation_       ? "levels"
+                                                         : "levels - 1";
+        return {{"split_level", split},
+                {"jobs_per_workgroup", std::to_string(jobsPerWorkgroup())},
+                {"traversal", traversal},
+                {"vote", vote},
+                {"lanes", std::to_string(lanes_)}};
+    }
+
 private:
     /// Timing mode compiles the statistics out: the heat map and the per-job iteration record too.
     void instrumentParams() {

@@ -4,8 +4,10 @@
 #include "framework/algorithm/SharedParams.h"
 #include "framework/reference/EmbreeTracer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
+#include <thread>
 
 namespace shadowlab {
 namespace {
@@ -77,6 +79,11 @@ public:
 
     std::vector<Counter> counters() const override { return {{"rays", rays_}, {"mrays_per_s", mraysPerS_}}; }
     size_t memoryBytes() const override { return tracer_ ? tracer_->memoryBytes() : 0; }
+
+    /// The threads tracing rays (EmbreeTracer::traceVisibility's rule for 0: all hardware threads).
+    std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
+        return {{"threads", std::to_string(p_.threads > 0 ? p_.threads : int(std::max(1u, std::thread::hardware_concurrency())))}};
+    }
 
     /// The visibility of the last frame (row-major, width * height), as uploaded.
     const std::vector<float>& lastVisibility() const { return visibility_; }

@@ -24,6 +24,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shadowlab {
@@ -95,6 +96,10 @@ public:
     virtual size_t memoryBytes() const { return 0; }
     /// Fixed-size structures that overflowed in the last frame (0 = the image is trustworthy).
     virtual uint64_t overflowCount() const { return 0; }
+    /// The value each parameter whose choice depends on the device ("auto", "0 = ...") resolved to
+    /// on this device with the current values, as (key, value) text in schema order, e.g.
+    /// {"traversal", "packet"}; empty when it has none. `shadowlab info` and summary.json report it.
+    virtual std::vector<std::pair<std::string, std::string>> resolvedParams() const { return {}; }
 };
 
 /// One registered algorithm: the registry key is also its folder, JSON "algorithm" value and label.

@@ -3,7 +3,9 @@
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
 #include "framework/experiment/Config.h"
+#include "framework/experiment/DeviceReport.h"
 #include "framework/experiment/Runner.h"
+#include "framework/gl/DeviceInfo.h"
 #include "framework/gl/GlContext.h"
 #include "framework/sweep/SweepCli.h"
 #include "framework/sweep/SweepText.h"
@@ -34,10 +36,17 @@ const char* kListUsage = R"(  shadowlab list [--json | --markdown [NAME]]
       Lists the registered algorithms and their parameters; --markdown prints each parameter table
       as docs/algorithms/NAME.md holds it (scripts/update_param_docs.py rewrites the docs from it).
 )";
+const char* kInfoUsage = R"(  shadowlab info [--json]
+      Prints what this binary runs on: the GL implementation (vendor, renderer, version, GLSL, back
+      end), the limits the algorithms depend on, the subgroup width (0: no ARB_shader_ballot), the
+      extensions the shaders use and whether each is present, and for every algorithm what its
+      device-dependent parameters (auto, or 0 for a rule) resolve to with the defaults. --json: one
+      JSON object, summary.json's device record plus each algorithm's resolved_params.
+)";
 
 std::string fullUsage() {
     return std::string("shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.\n\nUsage:\n") +
-           kRunUsage + kValidateUsage + kListUsage + kSweepUsage + "  shadowlab --help | --version\n\n" +
+           kRunUsage + kValidateUsage + kListUsage + kInfoUsage + kSweepUsage + "  shadowlab --help | --version\n\n" +
            "Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.\n";
 }
 
@@ -160,6 +169,32 @@ int run(const std::vector<std::string>& args) {
     return 0;
 }
 
+/// `shadowlab info`: the device and what each algorithm's auto parameters resolve to on it. Exit 1
+/// when an algorithm cannot be created here or GL reported an error.
+int info(const std::vector<std::string>& args) {
+    bool json = false;
+    if (std::any_of(args.begin() + 1, args.end(), isHelp)) return commandUsage(kInfoUsage);
+    for (size_t i = 1; i < args.size(); ++i) {
+        if (args[i] == "--json") json = true;
+        else if (!args[i].empty() && args[i][0] == '-') usageError("unknown option " + args[i] + " (info takes only --json)");
+        else usageError("unexpected argument " + args[i] + " (info takes only --json)");
+    }
+    auto context = createHeadlessContext(false);
+    installGlDebugCallback(true);
+    const Json device = deviceRecord(context->backend());
+    const std::vector<ResolvedDefaults> algorithms = resolveDefaults();
+    if (json) std::cout << deviceInfoJson(device, algorithms).dump(2) << "\n";
+    else std::cout << deviceInfoText(device, algorithms);
+    bool failed = glErrorCount() > 0;
+    for (const auto& a : algorithms)
+        if (!a.error.empty()) {
+            std::fprintf(stderr, "shadowlab: %s cannot be created here: %s\n", a.algorithm.c_str(), shortText(a.error, 600).c_str());
+            failed = true;
+        }
+    if (glErrorCount() > 0) std::fprintf(stderr, "shadowlab: %d OpenGL errors were reported\n", glErrorCount());
+    return failed ? 1 : 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -207,6 +242,7 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (args[0] == "run") return run(args);
+        if (args[0] == "info") return info(args);
         if (args[0] == "sweep") return sweepCommand(args);
         usageError("unknown command " + args[0]);
     } catch (const InputError& e) {

@@ -123,6 +123,27 @@ Json counterStats(const std::vector<FrameRecord>& frames) {
     return cj;
 }
 
+/// summary.json's device record in one line: the implementation, the subgroup width, the limits
+/// that bound the algorithms' structures and the extensions the shaders use.
+std::string deviceLine(const Json& d) {
+    std::ostringstream os;
+    const Json lim = d.value("limits", Json::object());
+    auto limit = [&](const char* key) -> long long { return lim.contains(key) && lim[key].is_number() ? lim[key].get<long long>() : 0; };
+    os << d.value("vendor", std::string()) << ", OpenGL " << d.value("version", std::string()) << ", GLSL "
+       << d.value("glsl_version", std::string()) << "; subgroup width " << d.value("subgroup_size", 0) << "; storage block "
+       << (limit("GL_MAX_SHADER_STORAGE_BLOCK_SIZE") >> 20) << " MiB, texture buffer " << limit("GL_MAX_TEXTURE_BUFFER_SIZE")
+       << " texels, compute shared memory " << (limit("GL_MAX_COMPUTE_SHARED_MEMORY_SIZE") >> 10) << " KiB, "
+       << limit("GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS") << " invocations per work group; extensions:";
+    std::string missing;
+    const Json extensions = d.value("extensions", Json::object());
+    for (const auto& [name, present] : extensions.items()) {
+        if (present.get<bool>()) os << " " << name;
+        else missing += " " + name;
+    }
+    if (!missing.empty()) os << " (missing:" << missing << ")";
+    return os.str();
+}
+
 } // namespace
 
 Json ExperimentResults::summary() const {
@@ -182,6 +203,9 @@ Json ExperimentResults::summary() const {
         }
         j["memory_bytes"] = a.memoryBytes;
         j["overflow"] = overflow;
+        Json resolved = Json::object();
+        for (const auto& [k, v] : a.resolvedParams) resolved[k] = v;
+        j["resolved_params"] = resolved;
         algs[a.id] = j;
     }
     out["algorithms"] = algs;
@@ -194,12 +218,27 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
     os << std::fixed;
     os << "# " << s.value("name", std::string("experiment")) << "\n\n";
     os << "- renderer: " << s.value("renderer", std::string()) << " (" << s.value("backend", std::string()) << ")\n";
+    if (s.contains("device")) os << "- device: " << deviceLine(s["device"]) << "\n";
     os << "- resolution: " << s["resolution"][0] << "×" << s["resolution"][1] << ", frames: " << s["frames"]
        << ", triangles: " << s["triangles"] << "\n";
     os << "- wall time: " << std::setprecision(1) << s.value("wall_time_s", 0.0) << " s\n";
     if (s.contains("warnings"))
         for (const auto& w : s["warnings"]) os << "- **warning**: " << w.get<std::string>() << "\n";
     os << "\n";
+
+    if (std::any_of(algorithms.begin(), algorithms.end(), [](const AlgorithmResults& a) { return !a.resolvedParams.empty(); })) {
+        os << "## Parameters resolved on this device\n\n"
+              "What each parameter whose choice depends on the device (`auto`, or 0 for a rule) came to in this run.\n\n"
+              "| id | algorithm | resolved |\n|---|---|---|\n";
+        for (const auto& a : algorithms) {
+            if (a.resolvedParams.empty()) continue;
+            os << "| " << a.id << " | " << a.algorithm << " | ";
+            for (size_t i = 0; i < a.resolvedParams.size(); ++i)
+                os << (i ? ", " : "") << a.resolvedParams[i].first << " = " << a.resolvedParams[i].second;
+            os << " |\n";
+        }
+        os << "\n";
+    }
 
     if (s.value("stage_time_source", std::string("gpu")) == "gpu")
         os << "## Time per frame (ms; GPU timer queries where the stage runs on the GPU, CPU time otherwise)\n\n";

@@ -8,6 +8,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shadowlab {
@@ -33,6 +34,8 @@ struct AlgorithmResults {
     /// Frames of the statistics pass whose visibility differed from the timed pass's (it must not:
     /// instrumentation only counts), for the summary's warning.
     std::vector<int> visibilityDiffers;
+    /// ShadowAlgorithm::resolvedParams() after the timed pass: what its device-dependent choices were.
+    std::vector<std::pair<std::string, std::string>> resolvedParams;
 };
 
 struct Stats {
@@ -42,7 +45,7 @@ struct Stats {
 Stats computeStats(std::vector<double> values);
 
 struct ExperimentResults {
-    Json meta; ///< name, renderer, resolution, triangles, ... (copied into summary.json)
+    Json meta; ///< name, renderer, device, resolution, triangles, ... (copied into summary.json)
     std::vector<AlgorithmResults> algorithms;
 
     /// frames.csv (the timed pass) or, with `statisticsPass`, statistics.csv (the statistics pass).

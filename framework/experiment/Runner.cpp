@@ -5,6 +5,7 @@
 #include "framework/core/Interrupt.h"
 #include "framework/experiment/OutputPlace.h"
 #include "framework/experiment/Progress.h"
+#include "framework/gl/DeviceInfo.h"
 #include "framework/gl/GlContext.h"
 #include "framework/gl/Shader.h"
 #include "framework/experiment/FrameImages.h"
@@ -131,6 +132,8 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     // "wall" = the wall clock of each stage run synchronously.
                     {"stage_time_source", softwareGl ? "wall" : "gpu"},
                     {"subgroup_size", querySubgroupSize()},
+                    // Implementation strings, limits and extensions (framework/gl/DeviceInfo.h).
+                    {"device", deviceRecord(backend)},
                     {"resolution", {res.x, res.y}},
                     {"frames", cfg.frames},
                     {"warmup_frames", cfg.warmupFrames},
@@ -209,6 +212,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             inst.results.frames.push_back(std::move(rec));
         }
     }
+
+    // What each algorithm's device-dependent choices came to, as the timed pass ran them.
+    for (auto& inst : instances) inst.results.resolvedParams = inst.host->algorithm().resolvedParams();
 
     // The statistics pass: the same frames again with instrumented shaders, untimed as far as any
     // table goes. The timed hosts are released first, so the two passes never hold their GPU
