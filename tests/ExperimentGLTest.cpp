@@ -3,6 +3,7 @@
 #include "framework/core/JsonNode.h"
 #include "tests/TestSupport.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -139,6 +140,31 @@ TEST(ExperimentOutputGLTest, SmokeWritesEveryOutput) {
         EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
     EXPECT_FALSE(s["renderer"].get<std::string>().empty());
     EXPECT_GT(s["triangles"].get<size_t>(), 1000u);
+    // The device record: the same strings as the older top-level keys, limits and extensions.
+    const Json& device = s["device"];
+    ASSERT_TRUE(device.is_object());
+    EXPECT_EQ(device["renderer"], s["renderer"]);
+    EXPECT_EQ(device["version"], s["gl_version"]);
+    EXPECT_EQ(device["backend"], s["backend"]);
+    EXPECT_EQ(device["subgroup_size"], s["subgroup_size"]);
+    for (const char* key : {"vendor", "glsl_version"}) EXPECT_FALSE(device[key].get<std::string>().empty()) << key;
+    EXPECT_GT(device["limits"]["GL_MAX_SHADER_STORAGE_BLOCK_SIZE"].get<long long>(), 0);
+    EXPECT_EQ(device["limits"]["GL_MAX_COMPUTE_WORK_GROUP_SIZE"].size(), 3u);
+    EXPECT_TRUE(device["extensions"]["GL_ARB_shader_ballot"].is_boolean());
+    // What each entry's auto parameters came to; ptsv's split depth is a number once it has run.
+    for (const auto& [id, a] : s["algorithms"].items()) EXPECT_TRUE(a["resolved_params"].is_object()) << id;
+    for (const auto& [id, a] : s["algorithms"].items()) {
+        if (a["algorithm"] == "ptsv") {
+            EXPECT_NE(a["resolved_params"]["traversal"], "auto");
+            const std::string split = a["resolved_params"]["split_level"].get<std::string>();
+            EXPECT_TRUE(!split.empty() && std::all_of(split.begin(), split.end(), ::isdigit)) << split;
+        }
+        if (a["algorithm"] == "metric_tree") EXPECT_NE(a["resolved_params"]["tile"], "auto");
+    }
+    const std::string report = slurp(dir + "/report.md");
+    EXPECT_NE(report.find("\n- device: "), std::string::npos);
+    EXPECT_NE(report.find("## Parameters resolved on this device"), std::string::npos);
+    EXPECT_NE(report.find("traversal = "), std::string::npos);
     // Every registered algorithm appears in the smoke config.
     std::string list;
     ASSERT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " list --json", list), 0);
