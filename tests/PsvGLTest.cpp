@@ -154,6 +154,26 @@ TEST_F(PsvGLTest, MemoryIs128BytesPerTrianglePlusOne) {
     }
 }
 
+// A triangle's status is decided once, by frusta.comp, and build.comp reads it: two shaders that
+// decide it each for itself need not agree (GLSL 4.50 section 4.7.1), and build.comp linking a
+// triangle frusta.comp culled would link four nodes nobody wrote. The fault makes every other
+// shader that decides a status call a culled triangle a caster, and fills the node buffer with
+// planes that hold everything beforehand: the old build.comp, which decided again, linked those
+// planes and shadowed most of the image; now nothing changes.
+TEST_F(PsvGLTest, FaultStatusDecidedTwiceNeverLinksUnwrittenNodes) {
+    const Shot s = withEdgeOnWall(thousandsOfTriangles());
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_STATUS_DISAGREES", "1"}, {"SHADOWLAB_FAULT_STALE_PLANES", "1"}});
+    for (bool ffc : {false, true}) {
+        SCOPED_TRACE(ffc ? "front-face culling" : "both faces");
+        Outcome o = run(s, {{"front_face_culling", ffc}});
+        EXPECT_GT(o.counters["culled_edge_on"], 0.0) << "the wall is edge-on";
+        if (ffc) EXPECT_GT(o.counters["culled_front_facing"], 0.0);
+        EXPECT_EQ(o.counters["build_errors"], 0.0);
+        EXPECT_EQ(o.overflow, 0u);
+        EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+    }
+}
+
 TEST_F(PsvGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
     Outcome o = run(thousandsOfTriangles(), {{"stack_size", 1}, {"wedge", false}});
     const double pixels = o.counters["stack_overflow_pixels"];

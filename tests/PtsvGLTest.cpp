@@ -215,6 +215,63 @@ TEST_F(PtsvGLTest, TinyJobListOverflowsButStaysExact) {
     }
 }
 
+// ---- Faults a GPU may show and a software GL does not (framework/gl/Shader.h) ----------------------
+
+// A culled triangle's status survives a GPU that flushes denormals (GLSL 4.50 section 4.7.1), and
+// its planes are never a previous frame's: with every plane read flushed and the plane buffer
+// filled beforehand with planes that would shadow everything, every culled triangle (front faces,
+// and those whose plane holds the light) still casts nothing. The old status, the bit pattern
+// uintBitsToFloat(1u or 2u), read as 0 (= caster) here and shadowed most of the image.
+TEST_F(PtsvGLTest, FaultFlushedStatusAndStalePlanesCastNothing) {
+    const Shot s = withEdgeOnWall(fenceDiscontinuity()); // status 1: edge-on
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_FLUSH_DENORMALS", "1"}, {"SHADOWLAB_FAULT_STALE_PLANES", "1"}});
+    for (const auto& traversal : {kCooperative, kPerInvocation, kPacket})
+        for (bool ffc : {false, true}) {
+            SCOPED_TRACE(std::get<std::string>(traversal.second) + (ffc ? ", front-face culling" : ""));
+            if (traversal == kPacket && querySubgroupSize() == 0) continue; // packets need ARB_shader_ballot
+            Outcome o = run(s, {traversal, {"front_face_culling", ffc}});
+            EXPECT_GT(o.counters["culled_edge_on"], 0.0) << "the wall is edge-on";
+            if (ffc) EXPECT_GT(o.counters["culled_front_facing"], 0.0);
+            EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+            EXPECT_EQ(o.overflow, 0u);
+        }
+}
+
+// Lanes need not reconverge after divergent code (ARB_shader_ballot gives no such promise): a vote
+// that misses a lane is seen by its paired ballot, and the node is then classified by each lane
+// alone, so the image stays exact and the recovery is counted. The fault leaves lane 1 out of every
+// vote; the old votes lost its children (missing shadows). A broadcast that does not come from
+// lane 0 (the job-list slot in pass one, which matters when the list is full) makes the subtree
+// finish where it is.
+TEST_F(PtsvGLTest, FaultLaneMissingFromVotesIsRecoveredExactly) {
+    const int width = querySubgroupSize();
+    if (!(width == 4 || width == 8 || width == 16 || width == 32 || width == 64))
+        GTEST_SKIP() << "votes are ballots only with ARB_shader_ballot (this context: subgroup width " << width << ")";
+    const std::map<std::string, ParamValue> ballot = {kCooperative, {"vote", std::string("ballot")}};
+    Outcome clean = run(thousandsOfTriangles(), ballot);
+    EXPECT_EQ(clean.counters["vote_recoveries"], 0.0) << "no lane is ever missing on its own";
+    {
+        ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_VOTE_DROPS_LANE", "1"}});
+        for (bool twoPass : {true, false}) {
+            SCOPED_TRACE(twoPass ? "two passes" : "one pass");
+            std::map<std::string, ParamValue> p = ballot;
+            p["two_pass"] = twoPass;
+            Outcome o = run(thousandsOfTriangles(), p);
+            EXPECT_GT(o.counters["vote_recoveries"], 0.0);
+            EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+            EXPECT_EQ(o.overflow, 0u);
+            EXPECT_EQ(o.visibility, clean.visibility);
+        }
+    }
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_BROADCAST_MISSES_LEADER", "1"}});
+    std::map<std::string, ParamValue> p = ballot;
+    p["job_capacity"] = 1; // almost every push fails: the broadcast slot decides who finishes the subtree
+    Outcome o = run(thousandsOfTriangles(), p);
+    EXPECT_GT(o.counters["vote_recoveries"], 0.0);
+    EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+    EXPECT_EQ(o.visibility, clean.visibility);
+}
+
 // The heat map (Figure 3) counts exactly the test-and-set operations.
 TEST_F(PtsvGLTest, HeatMapSumsToTheTestAndSetCount) {
     Outcome o = run(fenceDiscontinuity(), {{"heat_map", true}}, false);

@@ -146,4 +146,11 @@ Shot smokeAreaShot(int samples, float side, const char* pattern) {
     return s;
 }
 
+Shot withEdgeOnWall(Shot s) {
+    // makePlane lies in y = 0; turned about z it lies in x = 0, then moved to the light's x.
+    const glm::vec3 l = s.light.position, c = s.scene.bounds.center();
+    s.scene.append(makePlane({2.0f, 2.0f}, 2, Material{}), translate({l.x, c.y, c.z}) * rotate(90, {0, 0, 1}));
+    return s;
+}
+
 } // namespace shadowlab::test

@@ -45,6 +45,10 @@ Shot cameraInsideShadow();
 /// A few thousand triangles of closed meshes (a sphere and a tilted torus) under a point light.
 Shot thousandsOfTriangles();
 
+/// `s` with a 2 × 2 wall added in a plane that holds its point light, beside the scene's centre:
+/// a triangle whose shadow volume is empty (status "edge-on"), which shadow-volume algorithms cull.
+Shot withEdgeOnWall(Shot s);
+
 /// The smoke scene's objects (≈ 3,800 triangles): a sphere, a tilted torus and a thin fence on an
 /// 8 × 8 plane; with the camera the ray-tracing algorithms' tests look at it from (55°, a little
 /// narrower than the other shots) and a point light.

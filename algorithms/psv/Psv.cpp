@@ -101,6 +101,13 @@ public:
         counters_.clear();
         // Node 0 is the sentinel whose `pos` is the root pointer: emptying it empties the tree.
         // The other nodes need no clearing: frusta.comp rewrites every node that can be linked.
+        if (shaderFaultActive("SHADOWLAB_FAULT_STALE_PLANES")) {
+            // Test fault: every node left holding a plane that has everything inside it (a buffer
+            // GL never initialised, or a previous scene's), which only a node frusta.comp did not
+            // rewrite can show.
+            const float inside[4] = {0.0f, 0.0f, 0.0f, -1.0f};
+            glClearNamedBufferData(nodes_.id(), GL_RGBA32F, GL_RGBA, GL_FLOAT, inside);
+        }
         const GLuint zero = 0;
         glClearNamedBufferSubData(nodes_.id(), GL_R32UI, 0, PSV_NODE_BYTES, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
         scene_->bindStorage();

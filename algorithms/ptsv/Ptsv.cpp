@@ -189,6 +189,12 @@ public:
         f.timer.begin("setup");
         const size_t n = scene_->triangleCount();
         if (n > 0) {
+            if (shaderFaultActive("SHADOWLAB_FAULT_STALE_PLANES")) {
+                // Test fault: planes left over that would shadow every sample (inside all of them),
+                // as a buffer GL never initialised or a previous scene may hold.
+                const float inside[4] = {0.0f, 0.0f, 0.0f, -1.0f};
+                glClearNamedBufferData(planes_.id(), GL_RGBA32F, GL_RGBA, GL_FLOAT, inside);
+            }
             setup_.set("uTriangleCount", unsigned(n));
             dispatchLinear(setup_, n);
         }
@@ -249,6 +255,8 @@ public:
                                     {"packet_traversal", packet_ ? 1.0 : 0.0},
                                     {"subgroup_size", double(subgroupSize_)},
                                     {"subgroup_mismatch_groups", double(c[PTSV_C_SUBGROUP_MISMATCH])},
+                                    // Votes or broadcasts that missed a lane and were decided alone (exact).
+                                    {"vote_recoveries", double(c[PTSV_C_VOTE_RECOVERED])},
                                     {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
         if (!options_.instrumentation) return out;
         out.insert(out.end(), {{"test_and_set", wide(PTSV_C_TESTS_LO)},

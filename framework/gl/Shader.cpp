@@ -58,6 +58,11 @@ ShaderDefines& faultDefines() {
 
 void setShaderFaultDefines(ShaderDefines defines) { faultDefines() = std::move(defines); }
 const ShaderDefines& shaderFaultDefines() { return faultDefines(); }
+bool shaderFaultActive(const std::string& name) {
+    for (const auto& d : faultDefines())
+        if (d.first == name && d.second != "0") return true;
+    return false;
+}
 
 std::string loadShaderSource(const std::string& relPath, const ShaderDefines& defines) {
     std::set<std::string> seen;
@@ -142,15 +147,24 @@ bool hasExtension(const char* name) {
 }
 
 int querySubgroupSize() {
-    if (!hasExtension("GL_ARB_shader_ballot")) return 0;
+    // A ballot's uint64_t needs GL_ARB_gpu_shader_int64 to be read at all.
+    if (!hasExtension("GL_ARB_shader_ballot") || !hasExtension("GL_ARB_gpu_shader_int64")) return 0;
     ShaderProgram p = ShaderProgram::compute("common/subgroup_size.comp");
-    GlBuffer out(sizeof(uint32_t));
-    out.clearUint(0);
+    GlBuffer out(3 * sizeof(uint32_t));
+    const uint32_t init[3] = {0, 0, ~0u};
+    out.upload(init, sizeof init);
     out.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
     p.use();
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    return int(out.read<uint32_t>(1)[0]);
+    auto r = out.read<uint32_t>(3);
+    // The lanes a ballot holds, not gl_SubGroupSizeARB: that is only the largest size a subgroup
+    // may have (ARB_shader_ballot section 7.4), and a driver may pick the width per shader. Seen
+    // here: llvmpipe on an AVX-512 CPU compiles a shader with no subgroup operation 16 lanes wide
+    // (gl_SubGroupSizeARB 16 there) and shaders with ballots 8 wide. Every shader that depends on
+    // the width checks it again itself.
+    (void)r[0], (void)r[2];
+    return int(r[1]);
 }
 
 } // namespace shadowlab

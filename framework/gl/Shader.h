@@ -23,6 +23,8 @@ std::string shaderDir();
 /// (docs/architecture.md, "GPU portability"). Empty again with setShaderFaultDefines({}).
 void setShaderFaultDefines(ShaderDefines defines);
 const ShaderDefines& shaderFaultDefines();
+/// Whether the fault `name` is set (for the few faults that act on the host, e.g. stale buffers).
+bool shaderFaultActive(const std::string& name);
 
 /// Loads a stage source with includes expanded and defines prepended.
 std::string loadShaderSource(const std::string& relPath, const ShaderDefines& defines);
@@ -60,8 +62,10 @@ private:
     GlProgramName program_;
 };
 
-/// The subgroup (warp) width of the current context, read at run time (ARB_shader_ballot's
-/// gl_SubGroupSizeARB through a tiny compute shader); 0 when the extension is absent.
+/// The subgroup (warp) width of the current context, read at run time: the lanes a ballot holds
+/// in a tiny compute shader (not gl_SubGroupSizeARB, only an upper bound; see Shader.cpp); 0 when
+/// ARB_shader_ballot or ARB_gpu_shader_int64 is absent. A hint for `auto` choices: a driver may
+/// pick another width for another shader, so each shader that depends on it checks it again.
 int querySubgroupSize();
 bool hasExtension(const char* name);
 

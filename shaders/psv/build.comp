@@ -36,10 +36,12 @@ uint psvLinkChild(uint node, uint slot, uint child) {
 // Merges triangle t; returns the counter its outcome adds to (PSV_C_*), and the nodes it tested.
 uint insertTriangle(uint t, out uint tested) {
     tested = 0u;
+    // The status frusta.comp decided and stored: never decided again here (see frusta.comp).
+    uint status = psvStoredStatus(t);
+    if (status == uint(PSV_CASTER_EDGE_ON)) return PSV_C_CULLED_EDGE_ON;
+    if (status == uint(PSV_CASTER_FACING)) return PSV_C_CULLED_FACING;
+    if (status != uint(PSV_CASTER_OK)) return PSV_C_BUILD_ERRORS;
     vec3 v0 = sceneVertex(t, 0u), v1 = sceneVertex(t, 1u), v2 = sceneVertex(t, 2u);
-    PsvFrustum f = psvFrustum(v0, v1, v2);
-    if (f.status == PSV_CASTER_EDGE_ON) return PSV_C_CULLED_EDGE_ON;
-    if (f.status == PSV_CASTER_FACING) return PSV_C_CULLED_FACING;
     uint root = PSV_NODES_PER_TRIANGLE * t + 1u;
     uint nodeCount = PSV_NODES_PER_TRIANGLE * uTriangleCount + 1u;
 #if PSV_DEPTH_SKIP

@@ -7,6 +7,7 @@
 #include "common/light.glsl"
 #define SCENE_POSITION_TEXELS 1
 #include "common/scene.glsl"
+#define PSV_STATUS_WRITER 1 // the one shader that decides a triangle's status (see main)
 #include "psv/tree.glsl"
 layout(local_size_x = 64) in;
 
@@ -17,9 +18,16 @@ void main() {
     if (t >= uTriangleCount) return;
     vec3 v0 = sceneVertex(t, 0u), v1 = sceneVertex(t, 1u), v2 = sceneVertex(t, 2u);
     PsvFrustum f = psvFrustum(v0, v1, v2);
-    if (f.status != PSV_CASTER_OK) return; // never linked into the tree, so never read
     uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
-    for (uint i = 0u; i < 3u; ++i) psvNodes[base + i] = PsvNode(f.planes[i], 0u, 0u, 0u, 0u);
+    // The status is decided here only, and stored for build.comp: two shaders computing it would
+    // not be bound to agree (GLSL 4.50 section 4.7.1 lets each fuse or round differently), and a
+    // triangle build.comp took for a caster that frusta.comp culled would link four nodes nobody
+    // wrote. It lives in the first node's minDepth field, which a shadow plane does not use.
+    if (f.status != PSV_CASTER_OK) { // never linked into the tree: only the status is read
+        psvNodes[base] = PsvNode(PSV_REJECT_ALL, 0u, 0u, 0u, uint(f.status));
+        return;
+    }
+    for (uint i = 0u; i < 3u; ++i) psvNodes[base + i] = PsvNode(f.planes[i], 0u, 0u, 0u, uint(PSV_CASTER_OK));
 #if PSV_DEPTH_SKIP
     // The capping node's depth starts at its own triangle's: the subtree it roots includes it.
     uint minDepth = floatBitsToUint(psvTriangleMinDepth(v0, v1, v2));

@@ -35,11 +35,13 @@
 #define PTSV_KEY_AWAY 0xFFFFFFFEu       // facing away from the light: shadowed without a test
 
 // Per triangle: 3 shadow (edge) planes, the triangle plane, 3 additional culling planes, and an
-// info vec4 whose x holds the PTSV_CASTER_* status as float bits. Inside the volume is negative.
+// info vec4 whose x holds the PTSV_CASTER_* status as a float value (0.0, 1.0 or 2.0). Inside the
+// volume is negative; a culled triangle's seven planes are PTSV_REJECT_ALL (+1 everywhere).
 #define PTSV_PLANES_PER_TRIANGLE 8
 #define PTSV_CASTER_OK 0u
 #define PTSV_CASTER_EDGE_ON 1u
 #define PTSV_CASTER_FACING 2u
+#define PTSV_REJECT_ALL vec4(0.0, 0.0, 0.0, 1.0)
 
 // Per-frame counters, one 32-bit word each.
 #define PTSV_COUNTER_WORDS 32
@@ -64,3 +66,4 @@
 #define PTSV_C_LEAF_VISITS 21    // leaf clusters whose samples were tested
 #define PTSV_C_SHADOWED 20       // receivers written shadowed by the resolve pass
 #define PTSV_C_SUBGROUP_MISMATCH 22 // ballot workgroups on subgroups of another width than compiled: jobs not run (overflow)
+#define PTSV_C_VOTE_RECOVERED 23 // votes or broadcasts that missed a lane (no reconvergence): decided alone, exact

@@ -72,6 +72,17 @@ float ptsvSigned(vec4 plane, vec3 x) {
     return s;
 }
 
+// A plane read back as a GPU that flushes denormal inputs would (GLSL 4.50 section 4.7.1 allows it):
+// SHADOWLAB_FAULT_FLUSH_DENORMALS (tests only, framework/gl/Shader.h) forces that on every read.
+vec4 ptsvFlushDenormals(vec4 p) {
+#if SHADOWLAB_FAULT_FLUSH_DENORMALS
+    bvec4 denormal = equal(floatBitsToUint(p) & 0x7F800000u, uvec4(0u));
+    return vec4(denormal.x ? 0.0 : p.x, denormal.y ? 0.0 : p.y, denormal.z ? 0.0 : p.z, denormal.w ? 0.0 : p.w);
+#else
+    return p;
+#endif
+}
+
 #if PTSV_TEXEL_READS
 // The traversal reads what earlier passes wrote through buffer textures (Ptsv binds the views to
 // the PTSV_*_UNIT units): a SIMD CPU back end (llvmpipe) gathers texel fetches for all its lanes at
@@ -86,14 +97,16 @@ uint ptsvShadowAt(uint slot) { return texelFetch(uPtsvShadowTexels, int(slot)).x
 // (atomicAnd on the storage buffer): a fetch may miss those clears, which only sends the
 // traversal into a subtree whose samples are already shadowed.
 uint ptsvMaskAt(uint word) { return texelFetch(uPtsvMaskTexels, int(word)).x; }
-vec4 ptsvPlane(uint triangle, uint i) { return texelFetch(uPtsvPlaneTexels, int(PTSV_PLANES_PER_TRIANGLE * triangle + i)); }
+vec4 ptsvPlane(uint triangle, uint i) {
+    return ptsvFlushDenormals(texelFetch(uPtsvPlaneTexels, int(PTSV_PLANES_PER_TRIANGLE * triangle + i)));
+}
 uvec4 ptsvSlotAt(uint slot) { return texelFetch(uPtsvSampleTexels, int(slot)); }
 void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
     bmin = texelFetch(uPtsvBoundsTexels, int(2u * node)).xyz;
     bmax = texelFetch(uPtsvBoundsTexels, int(2u * node + 1u)).xyz;
 }
 #else
-vec4 ptsvPlane(uint triangle, uint i) { return ptsvPlanes[PTSV_PLANES_PER_TRIANGLE * triangle + i]; }
+vec4 ptsvPlane(uint triangle, uint i) { return ptsvFlushDenormals(ptsvPlanes[PTSV_PLANES_PER_TRIANGLE * triangle + i]); }
 uint ptsvMaskAt(uint word) { return ptsvMasks[word]; }
 uint ptsvShadowAt(uint slot) { return ptsvShadow[slot]; }
 uvec4 ptsvSlotAt(uint slot) { return ptsvSamples[slot]; }
@@ -106,7 +119,8 @@ void ptsvBoxAt(uint node, out vec3 bmin, out vec3 bmax) {
 vec3 ptsvSampleAt(uint slot) { return uintBitsToFloat(ptsvSlotAt(slot).xyz); }
 uint ptsvKeyAt(uint slot) { return ptsvSlotAt(slot).w; }
 
-uint ptsvStatus(uint triangle) { return floatBitsToUint(ptsvPlane(triangle, 7u).x); }
+// Written as float(status) by setup.comp: an exact small integer, never a denormal.
+uint ptsvStatus(uint triangle) { return uint(ptsvPlane(triangle, 7u).x); }
 
 // The exact per-sample test (the test of test-and-set): inside the three edge planes (closed) and
 // strictly behind the (biased) triangle plane, i.e. the segment from q to the light crosses it.

@@ -70,11 +70,18 @@ void main() {
         ptsvPlanes[base + 4u] = ptsvCullingPlane(e2, e0, v0); // planes meeting at v0: edges v2v0, v0v1
         ptsvPlanes[base + 5u] = ptsvCullingPlane(e0, e1, v1);
         ptsvPlanes[base + 6u] = ptsvCullingPlane(e1, e2, v2);
-    }
+    } else {
+        // A culled triangle's planes are written too, rejecting everything (every value +1): the
+        // buffer is never cleared, so unwritten planes would be a previous frame's or undefined
+        // (GL leaves new storage uninitialised), and a traversal that read them through a wrong
+        // status would cast their shadow. The status test comes first; these make it not matter.
+        for (uint i = 0u; i < 7u; ++i) ptsvPlanes[base + i] = PTSV_REJECT_ALL;
 #if SHADOWLAB_INSTRUMENTATION
-    else {
         atomicAdd(ptsvCounters[status == PTSV_CASTER_FACING ? PTSV_C_CULLED_FACING : PTSV_C_CULLED_EDGE_ON], 1u);
-    }
 #endif
-    ptsvPlanes[base + 7u] = vec4(uintBitsToFloat(status), 0.0, 0.0, 0.0);
+    }
+    // The status as a small integer value (0.0, 1.0, 2.0: exact, and normal numbers), not as the
+    // bit pattern uintBitsToFloat(1u): that is a denormal, which GLSL 4.50 section 4.7.1 lets any
+    // read flush to 0 (= PTSV_CASTER_OK).
+    ptsvPlanes[base + 7u] = vec4(float(status), 0.0, 0.0, 0.0);
 }

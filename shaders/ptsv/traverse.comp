@@ -13,11 +13,20 @@
 // PTSV_BALLOT 1: the workgroup is one subgroup of PTSV_LANES invocations (the driver's subgroup
 //   width, read on the host) and votes are ARB_shader_ballot words, with no shared memory and no
 //   barrier at all (a barrier anywhere in the shader costs llvmpipe 1.7x: it then runs every
-//   workgroup as coroutines). The shader checks gl_SubGroupSizeARB against PTSV_LANES: a
-//   workgroup that runs on subgroups of another width (a driver free to pick SIMD8/16/32, a
-//   wave32/wave64 choice), whose ballots would miss lanes, runs none of its jobs and counts itself
-//   in PTSV_C_SUBGROUP_MISMATCH, which overflowCount() reports (never a silent wrong image); the
+//   workgroup as coroutines). The lane is gl_SubGroupInvocationARB, the bit ballots use. At entry
+//   a ballot must hold exactly lanes 0 .. PTSV_LANES - 1 (gl_SubGroupSizeARB is only the largest
+//   size a subgroup may have, ARB_shader_ballot section 7.4: radeonsi reports 64 and may run
+//   compute in wave32): a workgroup that is not one whole subgroup (a driver free to pick
+//   SIMD8/16/32, a wave32/wave64 choice) runs none of its jobs and counts itself in
+//   PTSV_C_SUBGROUP_MISMATCH, which overflowCount() reports (never a silent wrong image); the
 //   host then recompiles with shared-memory votes for the following frames.
+//   GL does not promise that lanes reconverge after divergent code (classify(), `if (LEADER)`), so
+//   every vote checks who took part: each ballot of b comes with the ballot of !b, and a lane
+//   missing from both is a lane missing from the vote. A lane that sees a vote miss someone
+//   classifies the node's children itself (the per-invocation loop), counts PTSV_C_VOTE_RECOVERED,
+//   and clears its own accepted children; a broadcast carries its sender's lane, and one that did
+//   not come from lane 0 is taken as "not pushed" (the subtree is finished here). Lanes may then
+//   walk different but each complete paths: never a missing shadow.
 // PTSV_BALLOT 0: PTSV_LANES invocations (32 unless forced), votes through shared memory and a
 //   barrier.
 // PTSV_LANES up to 32: each invocation tests 32 / PTSV_LANES children of a node. PTSV_LANES 64
@@ -54,7 +63,11 @@ layout(local_size_x = PTSV_INVOCATION_GROUP) in;
 #define SAMPLE_STEP 1u
 #else
 layout(local_size_x = PTSV_LANES) in;
+#if PTSV_BALLOT
+#define lane gl_SubGroupInvocationARB // the bit of this invocation in a ballot
+#else
 #define lane gl_LocalInvocationIndex
+#endif
 #define LEADER (lane == 0u)
 #define SAMPLE_STEP uint(PTSV_LANES)
 #if PTSV_LANES != 4 && PTSV_LANES != 8 && PTSV_LANES != 16 && PTSV_LANES != 32 && PTSV_LANES != 64
@@ -81,12 +94,34 @@ shared uint sBroadcast;
 uint voteSeq = 0u;
 #endif
 
+#if PTSV_BALLOT
+// Every lane of the workgroup: lanes 0 .. PTSV_LANES - 1 of one subgroup (checked in main()).
+const uint64_t kAllLanes = PTSV_LANES == 64 ? ~0ul : (1ul << uint(PTSV_LANES % 64)) - 1ul;
+// Test faults (framework/gl/Shader.h): lane 1 missing from every vote, as a lane that had not
+// reconverged would be; a broadcast that arrives from lane 1, as if lane 0 had not been there.
+#if SHADOWLAB_FAULT_VOTE_DROPS_LANE
+const uint64_t kFaultDropped = 2ul;
+#else
+const uint64_t kFaultDropped = 0ul;
+#endif
+bool gVoteMissedLane = false; // a vote of the current node did not hear from every lane
+
+// ballotARB(b), and whether every lane took part: a lane absent from the ballot of b (its bit
+// lost if b was true) is absent from the ballot of !b as well only if it missed them, since each
+// lane present sets its bit in exactly one of the two.
+uint64_t checkedBallot(bool b) {
+    uint64_t yes = ballotARB(b) & ~kFaultDropped, no = ballotARB(!b) & ~kFaultDropped;
+    if ((yes | no) != kAllLanes) gVoteMissedLane = true;
+    return yes;
+}
+#endif
+
 // Ballots of a, b and c over the workgroup, 64 bits each as (low, high) words: bit `lane`.
 void vote3(bool a, bool b, bool c, out uvec2 A, out uvec2 B, out uvec2 C) {
 #if PTSV_BALLOT
-    A = unpackUint2x32(ballotARB(a));
-    B = unpackUint2x32(ballotARB(b));
-    C = unpackUint2x32(ballotARB(c));
+    A = unpackUint2x32(checkedBallot(a));
+    B = unpackUint2x32(checkedBallot(b));
+    C = unpackUint2x32(checkedBallot(c));
 #else
     uint slot = voteSeq % 3u, w = lane >> 5u, bit = 1u << (lane & 31u);
     if (a) atomicOr(sVote[slot][w], bit);
@@ -104,7 +139,7 @@ void vote3(bool a, bool b, bool c, out uvec2 A, out uvec2 B, out uvec2 C) {
 // Bit `lane` of x: a, bit `lane` of y: b, over a workgroup of at most 32 invocations.
 uvec2 vote2(bool a, bool b) {
 #if PTSV_BALLOT
-    return uvec2(unpackUint2x32(ballotARB(a)).x, unpackUint2x32(ballotARB(b)).x);
+    return uvec2(unpackUint2x32(checkedBallot(a)).x, unpackUint2x32(checkedBallot(b)).x);
 #else
     uvec2 A, B, C;
     vote3(a, b, false, A, B, C);
@@ -112,10 +147,19 @@ uvec2 vote2(bool a, bool b) {
 #endif
 }
 
-// A value invocation 0 computed, for every invocation.
-uint broadcast(uint v) {
+// A value invocation 0 computed, for every invocation; `fallback` where it cannot be had (a
+// ballot broadcast that did not come from lane 0, see the top).
+uint broadcast(uint v, uint fallback) {
 #if PTSV_BALLOT
-    return readFirstInvocationARB(v);
+    // The sender's lane travels with the value, in the same operation.
+#if SHADOWLAB_FAULT_BROADCAST_MISSES_LEADER
+    uvec2 r = readInvocationARB(uvec2(lane, v), 1u);
+#else
+    uvec2 r = readFirstInvocationARB(uvec2(lane, v));
+#endif
+    if (r.x == 0u) return r.y;
+    atomicAdd(ptsvCounters[PTSV_C_VOTE_RECOVERED], 1u);
+    return fallback;
 #else
     if (lane == 0u) sBroadcast = v;
     barrier();
@@ -219,14 +263,10 @@ void testSamples(uint key) {
     if (LEADER) ++gLeafVisits;
 }
 
-// Tests the children of node (depth, id); returns the intersected ones, clears the accepted ones.
-// `live` false (a packet lane whose own volume missed the node, one job per invocation only): none.
-uint visit(int depth, uint id, bool live) {
-    ++gIterations;
-    uint maskIndex = uMaskOffset[depth] + id;
-    uint mask = ptsvMaskAt(maskIndex);
+// The existing children of node (depth, id) in `mask`, classified one after another by this
+// invocation alone: x = intersected, y = trivially accepted.
+uvec2 classifyAlone(int depth, uint id, uint mask, bool live) {
     uvec2 v = uvec2(0u);
-#if PTSV_PER_INVOCATION
     // The existing children in turn (about 9 of 32 on the peer scene).
     for (uint m = mask; m != 0u; m &= m - 1u) {
         uint c = uint(findLSB(m));
@@ -235,6 +275,22 @@ uint visit(int depth, uint id, bool live) {
         ++gNodeTests;
         if (!r.x) v |= (r.y ? uvec2(0u, 1u) : uvec2(1u, 0u)) << c;
     }
+    return v;
+}
+
+// Tests the children of node (depth, id); returns the intersected ones, clears the accepted ones.
+// `live` false (a packet lane whose own volume missed the node, one job per invocation only): none.
+uint visit(int depth, uint id, bool live) {
+    ++gIterations;
+    uint maskIndex = uMaskOffset[depth] + id;
+    uint mask = ptsvMaskAt(maskIndex);
+    uvec2 v = uvec2(0u);
+    bool clearsAlone = false; // this lane clears the accepted children itself (not only the leader)
+#if PTSV_BALLOT && !PTSV_PER_INVOCATION
+    gVoteMissedLane = false;
+#endif
+#if PTSV_PER_INVOCATION
+    v = classifyAlone(depth, id, mask, live);
 #elif PTSV_LANES == 64
     uint c = lane & 31u, side = lane >> 5u;
     bool exists = ((mask >> c) & 1u) != 0u;
@@ -257,9 +313,18 @@ uint visit(int depth, uint id, bool live) {
         v |= vote2(!r.x && !r.y, r.y) << (round * uint(PTSV_LANES));
     }
 #endif
-    if (v.y != 0u && LEADER) {
+#if PTSV_BALLOT && !PTSV_PER_INVOCATION
+    if (gVoteMissedLane) { // the votes cannot be trusted: this lane decides alone
+        v = classifyAlone(depth, id, mask, true);
+        atomicAdd(ptsvCounters[PTSV_C_VOTE_RECOVERED], 1u);
+    }
+    // With ballots every lane that accepts a child clears it: after a recovery the lanes' verdicts
+    // may differ (each is exact), and a lane that accepted a node does not test its samples.
+    clearsAlone = true;
+#endif
+    if (v.y != 0u && (LEADER || clearsAlone)) {
         atomicAnd(ptsvMasks[maskIndex], ~v.y);
-        gAccepted += uint(bitCount(v.y));
+        if (LEADER) gAccepted += uint(bitCount(v.y));
     }
 #if PTSV_PER_INVOCATION && PTSV_PASS == 1 && PTSV_TWO_PASS
     // Children at the split depth become jobs here, with one atomic for all of them; those a full
@@ -305,7 +370,7 @@ void traverse(int depth, uint id) {
                 else atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], 1u);
             }
 #if !PTSV_PER_INVOCATION
-            slot = broadcast(slot);
+            slot = broadcast(slot, uJobCapacity);
 #endif
             if (slot < uJobCapacity) continue; // pass two finishes it
             // The list is full: finish this subtree here, exactly as the one-pass traversal would.
@@ -436,9 +501,10 @@ void main() {
 #else
     // Each workgroup takes PTSV_JOBS_PER_GROUP consecutive jobs (2D grid past 65535 groups).
 #if PTSV_BALLOT
-    // Ballots only see one subgroup: the workgroup must be exactly one (see the top).
-    if (gl_SubGroupSizeARB != uint(PTSV_LANES)) {
-        if (lane == 0u) atomicAdd(ptsvCounters[PTSV_C_SUBGROUP_MISMATCH], 1u);
+    // Ballots only see one subgroup: the workgroup must be exactly one, its lanes 0 .. PTSV_LANES - 1
+    // (see the top). Checked here, before any divergent code, with the ballot itself.
+    if (ballotARB(true) != kAllLanes) {
+        if (gl_LocalInvocationIndex == 0u) atomicAdd(ptsvCounters[PTSV_C_SUBGROUP_MISMATCH], 1u);
         return;
     }
 #else
