@@ -73,10 +73,10 @@ TEST_F(DeviceInfoGLTest, PtsvResolvesItsAutosByItsRule) {
     EXPECT_EQ(given.at("jobs_per_workgroup"), "4");
 }
 
-// MetricTree.cpp's tilePixels(): one subgroup's pixels (8: 4x2, 16: 8x2, 32: 8x4), else 8x8.
-TEST_F(DeviceInfoGLTest, MetricTreeTileIsOneSubgroup) {
+// autoTilePixels() (MetricTree.h): the tile walkers fill one subgroup, tiles of at least 8 pixels.
+TEST_F(DeviceInfoGLTest, MetricTreeTileWalkersFillOneSubgroup) {
     const int width = querySubgroupSize();
-    const char* expected = width == 8 ? "4x2" : width == 16 ? "8x2" : width == 32 ? "8x4" : "8x8";
+    const char* expected = width == 4 ? "8x2" : "4x2";
     EXPECT_EQ(resolved("metric_tree").at("tile"), expected);
     EXPECT_EQ(resolved("metric_tree", {{"tile", std::string("8x4")}}).at("tile"), "8x4");
 }

@@ -243,6 +243,23 @@ TEST_F(MetricTreeGLTest, MemoryIs128BytesPerClusterPlusCounters) {
     }
 }
 
+// The insertion's "delta pending" sentinel is compared as the raw word it was stored as, and is
+// no NaN: the fault makes every insertion see every node's delta still pending (the memory model
+// allows a reader to miss the final write for the whole dispatch) and converts NaN encodings to
+// 0.0 (uintBitsToFloat leaves them undefined). Everything is then filed under overlap children, a
+// valid if slower tree, and the image stays exact. The old sentinel, NaN bits tested after the
+// conversion, read as a delta of 0 here and filed clusters under far children the query skipped.
+TEST_F(MetricTreeGLTest, FaultPendingDeltaSurvivesUndefinedNanConversion) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_DELTA_UNSEEN", "1"}, {"SHADOWLAB_FAULT_NAN_BITS_UNDEFINED", "1"}});
+    for (const char* query : {"pixel", "tile"}) {
+        SCOPED_TRACE(query);
+        Outcome o = run(thousandsOfTriangles(), {{"query", std::string(query)}});
+        EXPECT_EQ(o.counters["build_errors"], 0.0);
+        EXPECT_EQ(o.overflow, 0u);
+        EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+    }
+}
+
 TEST_F(MetricTreeGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
     Outcome o = run(thousandsOfTriangles(), {{"stack_size", 1}, {"overlap_interval", false}});
     const double pixels = o.counters["stack_overflow_pixels"];
@@ -257,9 +274,8 @@ TEST_F(MetricTreeGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
 // The tile query tests the clusters the per-pixel query would reach (and more), with the same cone
 // test, so the two give the same image; a tile whose list is full falls back to the per-pixel query.
 TEST_F(MetricTreeGLTest, TileQueryGivesThePixelQuerysImage) {
-    // tile = auto: one SIMD group's pixels, as wide as the context's subgroups (64 where unknown).
-    const int width = querySubgroupSize();
-    const double autoPixels = width == 8 || width == 16 || width == 32 ? width : 64;
+    // tile = auto: as many walkers as one subgroup has lanes, tiles of 8 pixels at least.
+    const double autoPixels = autoTilePixels(querySubgroupSize());
     EXPECT_EQ(run(engine(), {}, false).counters["tile_pixels"], autoPixels);
     EXPECT_EQ(run(engine(), {{"query", std::string("pixel")}}, false).counters["tile_pixels"], 0.0);
     for (Shot (*make)() : {engine, fenceDirectional, omniInsideShell}) {
@@ -408,6 +424,17 @@ INSTANTIATE_TEST_SUITE_P(Configs, MetricTreeConfigGLTest, ::testing::ValuesIn(kC
                          [](const auto& info) { return std::string(info.param.name); });
 
 // ---- CPU-only pieces --------------------------------------------------------------------------------
+
+// The rule for `tile: auto` on every width a GPU has: the walkers (64 / pixels of them) fill one
+// subgroup where they can, and a tile never drops under 8 pixels.
+TEST(MetricTreeTest, AutoTileFillsOneSubgroupWithWalkers) {
+    EXPECT_EQ(autoTilePixels(0), 8);  // no ballot: width unknown
+    EXPECT_EQ(autoTilePixels(4), 16); // zink on lavapipe at 128 bits: 4 walkers fill the subgroup
+    EXPECT_EQ(autoTilePixels(8), 8);  // llvmpipe: 8 walkers, one whole subgroup
+    EXPECT_EQ(autoTilePixels(16), 8);
+    EXPECT_EQ(autoTilePixels(32), 8); // NVIDIA: 8 of 32 lanes walk, not 1 of 32 (8 × 4 tiles)
+    EXPECT_EQ(autoTilePixels(64), 8); // AMD wave64: 8 of 64, not 1 of 64 (8 × 8)
+}
 
 TEST(MetricTreeTest, SchemaDeclaresEveryAblation) {
     const AlgorithmInfo info = metricTreeInfo();

@@ -80,8 +80,8 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                 "query's own tests (the same image; no divergent walk)",
                 ParamChange::Recompile)
         .choice("tile", &P::tile, "auto", {"auto", "4x2", "8x2", "8x4", "8x8"},
-                "tile query: the pixels that share one walk; auto = one SIMD group's (subgroup width 8: 4x2, 16: 8x2, "
-                "32: 8x4, else 8x8), so that all its lanes run one list",
+                "tile query: the pixels that share one walk; auto = the tile whose walkers (one invocation per tile) "
+                "fill one subgroup: 8x2 on 4 lanes, else 4x2 (8 walkers)",
                 ParamChange::Recompile)
         .integer("tile_candidates", &P::tileCandidates, 512, 16, 512, "clusters",
                  "tile query: most clusters one tile's list holds; a tile that gathers more falls back to the "
@@ -329,11 +329,10 @@ private:
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
     }
 
-    /// Pixels per tile of the tile query: "WxH" -> W * H; auto -> the subgroup width where it is 8,
-    /// 16 or 32 (a tile is that many consecutive invocations, shaders/common/pixel_order.glsl), else 64.
+    /// Pixels per tile of the tile query: "WxH" -> W * H; auto -> autoTilePixels().
     int tilePixels() const {
         if (p_.tile != "auto") return (p_.tile[0] - '0') * (p_.tile[2] - '0');
-        return subgroupSize_ == 8 || subgroupSize_ == 16 || subgroupSize_ == 32 ? subgroupSize_ : 64;
+        return autoTilePixels(subgroupSize_);
     }
     /// The counter tile_pixels: pixels per tile, 0 with the per-pixel query.
     double tileQueryPixels() const { return p_.query == "tile" ? double(tilePixels()) : 0.0; }
@@ -533,6 +532,11 @@ private:
 };
 
 } // namespace
+
+int autoTilePixels(int subgroupWidth) {
+    if (subgroupWidth <= 0) return 8; // no ballot: the width is unknown; the tile llvmpipe measured best
+    return std::clamp(64 / subgroupWidth, 8, 64);
+}
 
 AlgorithmInfo metricTreeInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<MetricTree>("metric_tree",

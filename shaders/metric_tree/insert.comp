@@ -15,6 +15,7 @@
 // inside [overlapMin, overlapMax], and the element's [dMin, dMax] widens that interval. So no
 // reader ever compares against a delta that is not the node's final one, on any memory model.
 #include "common/light.glsl"
+#define MT_INSERT_PASS 1 // (test faults: tree.glsl)
 #include "metric_tree/tree.glsl"
 layout(local_size_x = 64) in;
 
@@ -53,7 +54,8 @@ uint insertCluster(uint i, out uint crossed) {
         }
         if (child > uClusterCount || ++crossed > uClusterCount) return MT_C_BUILD_ERRORS;
         node = child - 1u;
-        MtNode n = mtNode(node);
+        uint deltaWord;
+        MtNode n = mtNode(node, deltaWord);
 #if MT_DEPTH_SKIP
         // Non-negative floats order like their bits. The bound only ever decreases, so a value read
         // earlier is never below the current one: skipping the atomic when it is not smaller is
@@ -64,7 +66,7 @@ uint insertCluster(uint i, out uint crossed) {
         // uLsEps so that they hold once rounded.
         float dMin = mtMinDist(n.a.xyz, n.b.xyz, a, b) - alpha - uLsEps;
         float dMax = alpha >= kMtPi ? kMtInf : mtMaxDist(n.a.xyz, n.b.xyz, a, b) + alpha + uLsEps;
-        bool pending = floatBitsToUint(n.b.w) == MT_DELTA_PENDING;
+        bool pending = deltaWord == MT_DELTA_PENDING; // the raw word, never a float round trip
         if (!pending && dMax <= n.b.w) {
             slot = MT_CHILD_NEAR;
             delta *= 0.5;

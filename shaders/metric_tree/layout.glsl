@@ -28,10 +28,13 @@
 #define MT_CHILD_FAR 1
 #define MT_CHILD_OVERLAP 2
 
-// MtNode.b.w (the partitioning distance) before its node is linked: a NaN's bits, which no
-// distance has. insert.comp writes the real value once, after the CAS that links the node, so a
-// concurrent reader sees either this or the final value (see insert.comp).
-#define MT_DELTA_PENDING 0xFFFFFFFFu
+// MtNode.b.w (the partitioning distance) before its node is linked: the bits of -1.0, which no
+// distance has (every delta is uDelta0 / 2^k > 0). insert.comp writes the real value once, after
+// the CAS that links the node, so a concurrent reader sees either this or the final value (see
+// insert.comp), and compares the raw word, before any float conversion. Not a NaN's bits: what
+// uintBitsToFloat gives for a NaN encoding is undefined, and a store may change a NaN's payload;
+// -1.0 is a normal number, stored and converted exactly everywhere.
+#define MT_DELTA_PENDING 0xBF800000u
 
 // Cluster flags (MtCluster.flags).
 #define MT_FLAG_CAPSULE 1u

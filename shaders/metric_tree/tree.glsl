@@ -43,16 +43,37 @@ layout(std430, binding = MT_COUNTER_BINDING) coherent buffer MtCounters { uint m
 // A SIMD CPU back end (llvmpipe) gathers a texel fetch for all its lanes at once but loads a
 // storage buffer lane by lane; a GPU reads both through its caches.
 layout(binding = MT_NODE_UNIT) uniform usamplerBuffer uNodeTexels;
-MtNode mtNode(uint i) {
+// Test faults (framework/gl/Shader.h), in the insertion only: every delta read is the sentinel, as
+// a reader the final write has not reached yet would see it (the memory model allows that for a
+// whole dispatch), and a NaN encoding converts to 0.0, as uintBitsToFloat may (undefined for NaNs).
+vec4 mtBitsToFloat(uvec4 w) {
+    vec4 f = uintBitsToFloat(w);
+#if SHADOWLAB_FAULT_NAN_BITS_UNDEFINED && MT_INSERT_PASS
+    for (int k = 0; k < 4; ++k)
+        if ((w[k] & 0x7F800000u) == 0x7F800000u && (w[k] & 0x007FFFFFu) != 0u) f[k] = 0.0;
+#endif
+    return f;
+}
+
+// Node i; `deltaWord`: its b.w as stored, to be compared with MT_DELTA_PENDING as a raw word.
+MtNode mtNode(uint i, out uint deltaWord) {
     int t = int(4u * i);
     uvec4 t0 = texelFetch(uNodeTexels, t), t1 = texelFetch(uNodeTexels, t + 1);
     uvec4 t2 = texelFetch(uNodeTexels, t + 2), t3 = texelFetch(uNodeTexels, t + 3);
+#if SHADOWLAB_FAULT_DELTA_UNSEEN && MT_INSERT_PASS
+    t1.w = MT_DELTA_PENDING;
+#endif
+    deltaWord = t1.w;
     MtNode n;
-    n.a = uintBitsToFloat(t0);
-    n.b = uintBitsToFloat(t1);
+    n.a = mtBitsToFloat(t0);
+    n.b = mtBitsToFloat(t1);
     n.child[0] = t2.x; n.child[1] = t2.y; n.child[2] = t2.z;
     n.minDist = t2.w; n.overlapMin = t3.x; n.overlapMax = t3.y; n.flags = t3.z; n.pad = t3.w;
     return n;
+}
+MtNode mtNode(uint i) {
+    uint deltaWord;
+    return mtNode(i, deltaWord);
 }
 
 const float kMtPi = 3.14159265358979;
