@@ -160,9 +160,9 @@ int querySubgroupSize() {
     auto r = out.read<uint32_t>(3);
     // The lanes a ballot holds, not gl_SubGroupSizeARB: that is only the largest size a subgroup
     // may have (ARB_shader_ballot section 7.4), and a driver may pick the width per shader. Seen
-    // here: llvmpipe on an AVX-512 CPU compiles a shader with no subgroup operation 16 lanes wide
-    // (gl_SubGroupSizeARB 16 there) and shaders with ballots 8 wide. Every shader that depends on
-    // the width checks it again itself.
+    // here: Mesa 22.3's shader cache leaves LP_NATIVE_VECTOR_WIDTH out of its key, so after one run
+    // at 512 bits a cached 16-lane binary of this shader ran beside freshly compiled 8-lane ones.
+    // Every shader that depends on the width checks it again itself.
     (void)r[0], (void)r[2];
     return int(r[1]);
 }
