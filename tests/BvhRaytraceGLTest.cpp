@@ -8,6 +8,8 @@
 
 #include <cstdio>
 #include <map>
+#include <string>
+#include <tuple>
 
 namespace shadowlab {
 namespace {
@@ -116,6 +118,102 @@ TEST_F(BvhRaytraceGLTest, ShortStackGivesTheSameImage) {
     AlgorithmRun tiny = run(areaShot(4, "grid"), {{"short_stack", true}, {"stack_size", 1}});
     EXPECT_GT(tiny.counters["stack_overflow_pixels"], 0.0);
     expectOverflowedPixelsShadowed(tiny, tiny.counters["stack_overflow_pixels"]);
+}
+
+// The wall time of the frame's `trace` stage (what llvmpipe's stage times are, see StageTimer.h).
+double traceMs(const AlgorithmRun& o) {
+    for (const StageTime& t : o.stages)
+        if (t.name == "trace") return t.cpuMs;
+    return -1;
+}
+
+// A light's samples split over dispatches give the image, heat map and counters of one dispatch,
+// bit for bit: at 64 samples one dispatch completes on llvmpipe too.
+TEST_F(BvhRaytraceGLTest, SplitDispatchesGiveTheSingleDispatchImage) {
+    const Shot s = areaShot(64, "stratified");
+    RunOptions options;
+    options.debugViews = {"nodes_visited"};
+    AlgorithmRun single = runAlgorithm(bvhRaytraceInfo(), s, {{"samples_per_dispatch", 64}}, options);
+    EXPECT_EQ(single.counters["sample_dispatches"], 1.0);
+    EXPECT_EQ(single.overflow, 0u);
+    for (int budget : {8, 5}) { // the default, and one that leaves a short last dispatch (4 samples)
+        SCOPED_TRACE("samples_per_dispatch " + std::to_string(budget));
+        AlgorithmRun split = runAlgorithm(bvhRaytraceInfo(), s, {{"samples_per_dispatch", budget}}, options);
+        EXPECT_EQ(split.counters["sample_dispatches"], double((64 + budget - 1) / budget));
+        EXPECT_EQ(split.visibility, single.visibility);
+        EXPECT_EQ(split.views["nodes_visited"], single.views["nodes_visited"]);
+        for (const char* c : {"rays", "traced_pixels", "nodes_visited_mean", "nodes_visited_max", "triangles_tested_mean"})
+            EXPECT_EQ(split.counters[c], single.counters[c]) << c;
+        EXPECT_EQ(split.overflow, 0u);
+    }
+}
+
+// The most samples a light may have (1,024) take ceil(1024 / samples_per_dispatch) dispatches, each
+// within the budget; any split gives the same image, exact against the reference. In one dispatch
+// llvmpipe's loop budget (65,535 iterations per invocation, docs/algorithms/line_space.md) cuts some
+// pixels short: they are reported and written shadowed, and every other pixel is the split's.
+TEST_F(BvhRaytraceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
+    const Shot s = areaShot(1024, "stratified");
+    RunOptions options;
+    options.resolution = 48;
+    AlgorithmRun split = runAlgorithm(bvhRaytraceInfo(), s, {}, options); // the default: 8 per dispatch
+    EXPECT_EQ(split.counters["sample_dispatches"], 128.0);
+    EXPECT_EQ(split.overflow, 0u);
+    EXPECT_EQ(split.counters["rays"], 1024.0 * split.counters["traced_pixels"]);
+    EXPECT_LE(split.accuracy.mismatchRatio, 1e-3);
+    EXPECT_LE(split.accuracy.rmse, 0.01);
+    AlgorithmRun uneven = runAlgorithm(bvhRaytraceInfo(), s, {{"samples_per_dispatch", 100}}, options);
+    EXPECT_EQ(uneven.counters["sample_dispatches"], 11.0); // the last one 24 samples
+    EXPECT_EQ(uneven.overflow, 0u);
+    EXPECT_EQ(uneven.visibility, split.visibility);
+    AlgorithmRun single = runAlgorithm(bvhRaytraceInfo(), s, {{"samples_per_dispatch", 1024}}, options);
+    size_t flagged = 0, differ = 0;
+    for (size_t i = 0; i < single.visibility.size(); ++i) {
+        if (single.overflowMask[i] > 0.5f) ++flagged;
+        else differ += single.visibility[i] != split.visibility[i];
+    }
+    std::printf("[bvh_raytrace] 1024 samples: trace %.1f ms in 128 dispatches, %.1f ms in 11, %.1f ms in one (%zu pixels cut "
+                "short: %.0f truncated, %.0f capped)\n",
+                traceMs(split), traceMs(uneven), traceMs(single), flagged, single.counters["truncated_pixels"],
+                single.counters["loop_capped_pixels"]);
+    EXPECT_EQ(double(flagged), double(single.overflow));
+    EXPECT_EQ(differ, 0u);
+}
+
+// A walk that cannot end (a fault site, test-only: every other pixel's rays are sent back into the
+// node they leave whenever they enter one inner child only) stops at its step cap: the frame
+// finishes, the pixels are counted and written shadowed, and every other pixel keeps its value. The
+// state survives the dispatches of a split area light.
+TEST_F(BvhRaytraceGLTest, AWalkThatCannotEndIsCappedAndWrittenShadowed) {
+    for (const auto& [name, shot, budget] : {std::tuple{"point", pointShot(), 8}, std::tuple{"area 16", areaShot(16, "grid"), 4}}) {
+        SCOPED_TRACE(name);
+        AlgorithmRun clean = run(shot, {{"samples_per_dispatch", budget}});
+        EXPECT_EQ(clean.overflow, 0u);
+        EXPECT_EQ(clean.counters["loop_capped_pixels"], 0.0);
+        AlgorithmRun o;
+        {
+            ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_BVH_CYCLE", "1"}});
+            o = run(shot, {{"samples_per_dispatch", budget}});
+        }
+        const double capped = o.counters["loop_capped_pixels"];
+        std::printf("[bvh_raytrace] corrupt link, %s light: %.0f pixels capped, %.0f dispatches\n", name, capped,
+                    o.counters["sample_dispatches"]);
+        EXPECT_GT(capped, 0.0);
+        EXPECT_EQ(o.overflow, uint64_t(capped));
+        expectOverflowedPixelsShadowed(o, capped);
+        size_t faultyLit = 0, elsewhere = 0, changed = 0;
+        for (int y = 0; y < kRes; ++y)
+            for (int x = 0; x < kRes; ++x) {
+                const size_t i = size_t(y) * kRes + size_t(x);
+                const bool faulty = (x + y) % 2 == 0, marked = o.overflowMask[i] > 0.5f;
+                faultyLit += faulty && o.lit[i];
+                elsewhere += marked && !faulty;
+                if (!marked) changed += o.visibility[i] != clean.visibility[i];
+            }
+        EXPECT_EQ(elsewhere, 0u) << "pixels capped outside the faulty ones";
+        EXPECT_EQ(changed, 0u) << "pixels not capped whose value differs from the clean run";
+        EXPECT_GT(capped, 0.2 * double(faultyLit));
+    }
 }
 
 TEST_F(BvhRaytraceGLTest, CountersAndMemoryDescribeTheTree) {

@@ -19,6 +19,8 @@
 #include <map>
 #include <optional>
 #include <ostream>
+#include <string>
+#include <vector>
 
 namespace shadowlab {
 namespace {
@@ -329,6 +331,142 @@ TEST_F(LineSpaceGLTest, LineSpacePoolSplitsOverStorageBlocks) {
     } catch (const std::exception& e) {
         EXPECT_NE(std::string(e.what()).find("MiB"), std::string::npos) << e.what();
         std::printf("[line_space] max_block_mib 1: %s\n", e.what());
+    }
+}
+
+// The wall time of the frame's `trace` stage (what llvmpipe's stage times are, see StageTimer.h).
+double traceMs(const AlgorithmRun& o) {
+    for (const StageTime& t : o.stages)
+        if (t.name == "trace") return t.cpuMs;
+    return -1;
+}
+
+// A light's samples split over dispatches give the image, heat map, counters and per-sample
+// classification of one dispatch, bit for bit (25 samples: one dispatch completes on llvmpipe too).
+TEST_F(LineSpaceGLTest, SplitDispatchesGiveTheSingleDispatchImage) {
+    const Shot s = areaShot(25);
+    for (const auto& variant : {std::map<std::string, ParamValue>{},
+                                std::map<std::string, ParamValue>{{"start_region", "node"}, {"last_level", "shaft"}}}) {
+        std::map<std::string, ParamValue> p = variant;
+        p["samples_per_dispatch"] = 25;
+        RunOptions options;
+        options.resolution = kLineSpaceRes;
+        options.debugViews = {"nodes_visited"};
+        p["classify"] = true;
+        AlgorithmRun single = runAlgorithm(lineSpaceInfo(), s, p, options);
+        EXPECT_EQ(single.counters["sample_dispatches"], 1.0);
+        EXPECT_EQ(single.overflow, 0u);
+        for (int budget : {2, 7}) { // the default (13 dispatches), and 4 with a short last one
+            SCOPED_TRACE(std::string(variant.empty() ? "defaults" : "Algorithm 1") + ", samples_per_dispatch " +
+                         std::to_string(budget));
+            p["samples_per_dispatch"] = budget;
+            AlgorithmRun split = runAlgorithm(lineSpaceInfo(), s, p, options);
+            EXPECT_EQ(split.counters["sample_dispatches"], double((25 + budget - 1) / budget));
+            EXPECT_EQ(split.visibility, single.visibility);
+            EXPECT_EQ(split.views["nodes_visited"], single.views["nodes_visited"]);
+            for (const char* c : {"rays", "traced_pixels", "nodes_visited_mean", "nodes_visited_max", "shafts_tested_mean",
+                                  "cells_stepped_mean", "leaf_cells_mean", "triangles_tested_mean", "occluded_share",
+                                  "classified_samples", "over_occluded_share", "under_occluded_share",
+                                  "under_occluded_start_node_share", "under_occluded_elsewhere"})
+                EXPECT_EQ(split.counters[c], single.counters[c]) << c;
+            EXPECT_EQ(split.overflow, 0u);
+        }
+    }
+}
+
+// The most samples a light may have (1,024) take ceil(1024 / samples_per_dispatch) dispatches, each
+// within the budget; any split gives the same image. In one dispatch llvmpipe's loop budget (65,535
+// iterations per invocation, "A driver limit" in docs/algorithms/line_space.md) cuts pixels short:
+// they are reported and written shadowed, and every other pixel is the split's.
+TEST_F(LineSpaceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
+    const Shot s = areaShot(1024);
+    RunOptions options;
+    options.resolution = 32;
+    options.debugViews = {"loop_capped"};
+    AlgorithmRun split = runAlgorithm(lineSpaceInfo(), s, {}, options); // the default: 2 per dispatch
+    EXPECT_EQ(split.counters["sample_dispatches"], 512.0);
+    EXPECT_EQ(split.overflow, 0u);
+    EXPECT_EQ(split.counters["rays"], 1024.0 * split.counters["traced_pixels"]);
+    AlgorithmRun uneven = runAlgorithm(lineSpaceInfo(), s, {{"samples_per_dispatch", 100}}, options);
+    EXPECT_EQ(uneven.counters["sample_dispatches"], 11.0); // the last one 24 samples
+    EXPECT_EQ(uneven.overflow, 0u);
+    EXPECT_EQ(uneven.visibility, split.visibility);
+    AlgorithmRun single = runAlgorithm(lineSpaceInfo(), s, {{"samples_per_dispatch", 1024}}, options);
+    const std::vector<float>& mask = single.views["loop_capped"];
+    size_t flagged = 0, differ = 0;
+    for (size_t i = 0; i < single.visibility.size(); ++i) {
+        if (mask[i] > 0.5f) ++flagged;
+        else differ += single.visibility[i] != split.visibility[i];
+    }
+    std::printf("[line_space] 1024 samples at 32²: rmse %.4f; trace %.1f ms in 512 dispatches, %.1f ms in 11, %.1f ms in one "
+                "(%zu pixels cut short: %.0f truncated, %.0f capped)\n",
+                split.accuracy.rmse, traceMs(split), traceMs(uneven), traceMs(single), flagged,
+                single.counters["truncated_pixels"], single.counters["loop_capped_pixels"]);
+    EXPECT_EQ(double(flagged), double(single.overflow));
+    EXPECT_EQ(differ, 0u);
+    EXPECT_LE(split.accuracy.rmse, 0.06); // as the soft-shadow table's rows
+}
+
+// A NaN step (a fault site, test-only: every other pixel's DDA steps are NaN, so no walk of its rays
+// moves past its first cell and no float comparison ends it) stops at the loop caps: the frame
+// finishes, the pixels are counted and written shadowed, and the other pixels keep their values. A
+// stalled walk can only end blocked (its cell's child entered again, as a node that is not the start
+// node, and its shaft found non-empty: how Algorithm 1 ends them all before the cap) or capped, so no
+// pixel comes out lighter. Every start region and last level, d = 1 (only the root's leaf walk, and
+// its cap), and a split area light, whose dispatches carry the state.
+TEST_F(LineSpaceGLTest, ANaNStepIsCappedAndWrittenShadowed) {
+    struct FaultCase {
+        const char* name;
+        Shot shot;
+        std::map<std::string, ParamValue> params;
+        bool capped; ///< the walks reach their caps (else they all end blocked first)
+    };
+    const FaultCase cases[] = {
+        {"point, defaults", smokePointShot(), {}, true},
+        {"point, distance", smokePointShot(), {{"start_region", "distance"}}, true},
+        {"point, Algorithm 1", smokePointShot(), {{"start_region", "node"}, {"last_level", "shaft"}}, false},
+        {"point, d = 1", smokePointShot(), {{"n", 4}, {"d", 1}}, true},
+        {"area 16, 4 per dispatch", areaShot(16), {{"samples_per_dispatch", 4}}, true},
+    };
+    for (const FaultCase& c : cases) {
+        SCOPED_TRACE(c.name);
+        std::map<std::string, ParamValue> p = c.params;
+        p["classify"] = false;
+        RunOptions options;
+        options.resolution = kLineSpaceRes;
+        options.debugViews = {"loop_capped"};
+        AlgorithmRun clean = runAlgorithm(lineSpaceInfo(), c.shot, p, options);
+        EXPECT_EQ(clean.overflow, 0u);
+        EXPECT_EQ(clean.counters["loop_capped_pixels"], 0.0);
+        AlgorithmRun o;
+        {
+            ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_NAN_STEP", "1"}});
+            o = runAlgorithm(lineSpaceInfo(), c.shot, p, options);
+        }
+        const double capped = o.counters["loop_capped_pixels"];
+        const std::vector<float>& mask = o.views["loop_capped"];
+        size_t faultyLit = 0, marked = 0, elsewhere = 0, notShadowed = 0, changed = 0, lighter = 0, darkened = 0;
+        for (int y = 0; y < kLineSpaceRes; ++y)
+            for (int x = 0; x < kLineSpaceRes; ++x) {
+                const size_t i = size_t(y) * kLineSpaceRes + size_t(x);
+                const bool faulty = (x + y) % 2 == 0, m = mask[i] > 0.5f;
+                faultyLit += faulty && o.lit[i];
+                marked += m;
+                elsewhere += m && !faulty;
+                lighter += o.visibility[i] > clean.visibility[i];
+                if (m) notShadowed += o.visibility[i] != 0.0f;
+                else if (!faulty) changed += o.visibility[i] != clean.visibility[i];
+                else darkened += o.visibility[i] < clean.visibility[i];
+            }
+        std::printf("[line_space] NaN step, %s: %.0f pixels capped, %zu others darker, of %zu faulty lit ones; overflow %llu\n",
+                    c.name, capped, darkened, faultyLit, static_cast<unsigned long long>(o.overflow));
+        if (c.capped) EXPECT_GT(capped, 0.5 * double(faultyLit));
+        EXPECT_EQ(o.overflow, uint64_t(capped));
+        EXPECT_EQ(double(marked), capped);
+        EXPECT_EQ(notShadowed, 0u) << "capped pixels not written shadowed";
+        EXPECT_EQ(lighter, 0u) << "pixels lit by mistake";
+        EXPECT_EQ(elsewhere, 0u) << "pixels capped outside the faulty ones";
+        EXPECT_EQ(changed, 0u) << "pixels outside the faulty ones whose value differs from the clean run";
     }
 }
 

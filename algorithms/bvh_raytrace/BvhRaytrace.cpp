@@ -8,8 +8,10 @@
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 
 namespace shadowlab {
 
@@ -33,6 +35,7 @@ struct BvhParams {
     int sahBins;         ///< split candidates per axis
     float traversalCost; ///< × triangle test
     float rayOffset;     ///< × scene radius
+    int samplesPerDispatch; ///< most light samples per pixel one dispatch traces
 };
 
 const ParamStruct<BvhParams>& bvhParams() {
@@ -53,7 +56,10 @@ const ParamStruct<BvhParams>& bvhParams() {
         // Aila & Laine's GPU ratio is near 1: a node fetch costs about what a triangle fetch does.
         .real("traversal_cost", &P::traversalCost, 1.0, 0.1, 10.0, "× triangle test",
               "SAH cost of visiting a node, relative to one ray-triangle test", ParamChange::Rebuild)
-        .apply(rayOffsetRow(&P::rayOffset));
+        .apply(rayOffsetRow(&P::rayOffset))
+        // 8: the slowest case measured here, 1,024 samples at 4K, ~27 ms per sample and pixel on a GPU
+        // (docs/algorithms/bvh_raytrace.md, "Dispatches"), makes ~0.22 s a dispatch, 9x under 2 s.
+        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 8));
     return s;
 }
 
@@ -91,6 +97,8 @@ public:
         nodeCount_ = tree.nodes.size();
         depth_ = tree.depth;
         leaves_ = tree.leaves;
+        // A correct walk takes at most nodes + 2 * leaves + 1 loop passes (trace.comp, trace()).
+        stepCap_ = uint32_t(std::min<uint64_t>(uint64_t(nodeCount_) + 2 * uint64_t(leaves_) + 1, UINT32_MAX));
         sahCost_ = tree.sahCost;
         if (scene.dynamic()) {
             tree_ = std::move(tree);
@@ -126,18 +134,38 @@ public:
 
     void computeVisibility(const FrameInputs& f) override {
         const int sampleCount = uploadLightSamples(samples_, f.light);
+        const int budget = p_.samplesPerDispatch;
+        dispatches_ = (sampleCount + budget - 1) / budget;
+        const glm::ivec2 res = f.gbuffer.resolution();
+        if (dispatches_ > 1 && accumRes_ != res) { // the state between dispatches (layout.glsl)
+            accum_ = makeTexture2D(options_.instrumentation ? GL_RG32UI : GL_R32UI, res.x, res.y);
+            accumRes_ = res;
+        }
 
+        // One stage over every dispatch: the frame's cost, however it is split.
         f.timer.begin("trace");
         counters_.clear();
         setLightUniforms(trace_, f.light);
         trace_.set("uRayOffset", rayOffsetLength(p_.rayOffset, *scene_));
         trace_.set("uSampleCount", sampleCount);
+        trace_.set("uStepCap", unsigned(stepCap_));
         glBindTextureUnit(BVH_NODE_UNIT, nodeTexels_.id());
         glBindTextureUnit(BVH_TRI_UNIT, triTexels_.id());
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
-        if (options_.instrumentation) runPixelPass(f, trace_, {&nodesVisited_, &overflow_});
-        else runPixelPass(f, trace_, {});
+        bindPixelPassInputs(f);
+        if (options_.instrumentation) bindDebugImage(1, nodesVisited_), bindDebugImage(2, overflow_);
+        // A single dispatch never touches the accumulation image.
+        glBindImageTexture(BVH_ACCUM_UNIT, dispatches_ > 1 ? accum_.id() : 0, 0, GL_FALSE, 0, GL_READ_WRITE,
+                           options_.instrumentation ? GL_RG32UI : GL_R32UI);
+        for (int first = 0; first < sampleCount; first += budget) {
+            trace_.set("uSampleFirst", first);
+            trace_.set("uSampleEnd", std::min(sampleCount, first + budget));
+            trace_.dispatch2D(res.x, res.y, 8, 8);
+            // The next dispatch reads the state this one wrote and adds to its counters.
+            if (first + budget < sampleCount) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        finishPixelPass();
         f.timer.end();
         counters_.markStale();
     }
@@ -151,6 +179,8 @@ public:
         std::vector<Counter> out = {{"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
                                     {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
                                     {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
+                                    {"loop_capped_pixels", double(c[BVH_C_CAPPED_PIXELS])},
+                                    {"sample_dispatches", double(dispatches_)},
                                     {"bvh_nodes", double(nodeCount_)},
                                     {"bvh_leaves", double(leaves_)},
                                     {"bvh_depth", double(depth_)},
@@ -177,11 +207,11 @@ public:
     /// information in addition"). Per-pixel debug images and the sample list are not counted.
     size_t memoryBytes() const override { return nodes_.size() + triangles_.size(); }
 
-    /// Pixels with a ray whose stack overflowed, or whose sample loop the driver cut short (both
-    /// written shadowed): 0 means the image is exact.
+    /// Pixels with a ray whose stack overflowed or whose walk reached its step cap, or whose sample
+    /// loop the driver cut short (all written shadowed): 0 means the image is exact.
     uint64_t overflowCount() const override {
         const auto& c = counters_.read();
-        return uint64_t(c[BVH_C_OVERFLOW_PIXELS]) + c[BVH_C_TRUNCATED_PIXELS];
+        return uint64_t(c[BVH_C_OVERFLOW_PIXELS]) + c[BVH_C_TRUNCATED_PIXELS] + c[BVH_C_CAPPED_PIXELS];
     }
 
 private:
@@ -202,6 +232,10 @@ private:
     std::vector<glm::vec3> posed_;   ///< the posed scene positions the last refit used
     GpuCounters<BVH_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
+    GlTexture accum_;                ///< per-pixel state between a frame's dispatches (only if it has several)
+    glm::ivec2 accumRes_{0, 0};
+    int dispatches_ = 0;             ///< of the last frame
+    uint32_t stepCap_ = 1;           ///< most loop passes of one ray's walk
     size_t nodeCount_ = 0, leaves_ = 0;
     int depth_ = 0;
     double sahCost_ = 0, buildMs_ = 0;

@@ -14,6 +14,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 
@@ -28,6 +29,7 @@ struct LineSpaceParams {
     std::string startRegion, lastLevel;  ///< "exact" | "distance" | "node"; "leaves" | "shaft"
     float startCells, startMaxCells;     ///< leaf widths
     bool rebuildEveryFrame;              ///< allows moving scenes: the whole precomputation each frame
+    int samplesPerDispatch;              ///< most light samples per pixel one dispatch traces
 };
 
 const ParamStruct<LineSpaceParams>& lineSpaceParams() {
@@ -80,7 +82,10 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
         .boolean("rebuild_every_frame", &P::rebuildEveryFrame, false,
                  "allow a scene with moving parts: rebuild the N-tree and its line spaces from the posed triangles "
                  "every frame they move (the `rebuild` stage; the disk cache is bypassed)",
-                 ParamChange::Update);
+                 ParamChange::Update)
+        // 2: at the defaults a ray costs ~4.4x a bvh_raytrace one, ~117 ms per sample and pixel at
+        // 4K on a GPU: ~0.23 s a dispatch, 8x under 2 s (docs/algorithms/line_space.md, "Dispatches").
+        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 2));
     return s;
 }
 
@@ -122,8 +127,11 @@ public:
         const bool occupancy = mode != ls::StartMode::Node || lastLeaves(), exact = mode == ls::StartMode::Exact;
         leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer();
         ls::LeafLists lists;
+        uint64_t longestList = 0; // triangles of the largest leaf list (exact)
         if (exact) {
             lists = ls::buildLeafLists(cpu, tree_);
+            for (size_t i = 1; i < lists.prefix.size(); ++i)
+                longestList = std::max<uint64_t>(longestList, lists.prefix[i] - lists.prefix[i - 1]);
             // The shader numbers a leaf by the occupancy bits below it: one occupied leaf without a list
             // (or the reverse) would shift every later list, so the two must agree exactly.
             size_t occupied = 0;
@@ -181,6 +189,16 @@ public:
             bitChunks_ = usedChunks;
             compile();
         }
+        // The loop caps of the trace (the reasoning is at its loops): a node's DDA visits at most
+        // 3N - 2 cells, one more pass leaves it; a ray walks each node above the last level at most
+        // once, and at most (3N - 2)^l nodes of level l.
+        const uint64_t cells = uint64_t(3 * n - 2);
+        uint64_t walked = 0, perLevel = 1, geometric = 0;
+        for (const ls::NodeGpu& node : tree_.nodes) walked += int(node.level) < d - 1;
+        for (int l = 0; l < d - 1; ++l, perLevel *= cells) geometric += perLevel;
+        auto clampCap = [](uint64_t v) { return uint32_t(std::clamp<uint64_t>(v, 1, UINT32_MAX)); };
+        walkCap_ = clampCap((cells + 1) * std::min(walked, geometric));
+        leafWalkCap_ = clampCap((cells + 1) * (1 + longestList));
         counters_.allocate();
         // The GPU holds the pools now; the CPU keeps only the node pool (start-node boxes for classify).
         tree_.tree = {};
@@ -193,6 +211,7 @@ public:
         resolution_ = resolution;
         if (!options_.instrumentation) return; // timing mode: no debug image
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+        loopCapped_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
 
     void paramsChanged(const ParamValues& p, ParamChange change) override {
@@ -206,17 +225,27 @@ public:
     void computeVisibility(const FrameInputs& f) override {
         const bool classify = p_.classify;
         const int sampleCount = uploadLightSamples(samples_, f.light);
+        const int budget = p_.samplesPerDispatch;
+        dispatches_ = (sampleCount + budget - 1) / budget;
+        const glm::ivec2 res = f.gbuffer.resolution();
+        if (dispatches_ > 1 && accumRes_ != res) { // the state between dispatches (layout.glsl)
+            accum_ = makeTexture2D(options_.instrumentation ? GL_RG32UI : GL_R32UI, res.x, res.y);
+            accumRes_ = res;
+        }
         const size_t classifyBytes = size_t(resolution_.x) * size_t(resolution_.y) * ls::classifyStride(size_t(sampleCount)) * 4;
         if (classify && classifyBytes > classifyBuf_.size()) classifyBuf_ = GlBuffer(classifyBytes, nullptr, 0);
         if (classify && !classifyProgram_)
             classifyProgram_ = ShaderProgram::compute("line_space/trace.comp", defines(true));
         const ShaderProgram& p = classify ? classifyProgram_ : trace_;
 
+        // One stage over every dispatch: the frame's cost, however it is split.
         f.timer.begin("trace");
         counters_.clear();
         setLightUniforms(p, f.light);
         p.set("uRayOffset", rayOffset());
         p.set("uSampleCount", sampleCount);
+        p.set("uWalkCap", unsigned(walkCap_));
+        p.set("uLeafWalkCap", unsigned(leafWalkCap_));
         p.set("uNodeCount", unsigned(tree_.nodes.size()));
         p.set("uNodesPerChunk", unsigned(nodesPerChunk_));
         const ls::StartRegion region = startRegion();
@@ -229,8 +258,19 @@ public:
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_COUNTER_BINDING);
         if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
-        if (options_.instrumentation) runPixelPass(f, p, {&nodesVisited_});
-        else runPixelPass(f, p, {});
+        bindPixelPassInputs(f);
+        if (options_.instrumentation) bindDebugImage(1, nodesVisited_), bindDebugImage(2, loopCapped_);
+        // A single dispatch never touches the accumulation image.
+        glBindImageTexture(LS_ACCUM_UNIT, dispatches_ > 1 ? accum_.id() : 0, 0, GL_FALSE, 0, GL_READ_WRITE,
+                           options_.instrumentation ? GL_RG32UI : GL_R32UI);
+        for (int first = 0; first < sampleCount; first += budget) {
+            p.set("uSampleFirst", first);
+            p.set("uSampleEnd", std::min(sampleCount, first + budget));
+            p.dispatch2D(res.x, res.y, 8, 8);
+            // The next dispatch reads the state this one wrote and adds to its counters and classify bits.
+            if (first + budget < sampleCount) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        finishPixelPass();
         f.timer.end();
         counters_.markStale();
         classes_.reset();
@@ -247,6 +287,8 @@ public:
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
         // The structure and what is measured in both modes; timing mode compiles the rest out.
         std::vector<Counter> out = {{"truncated_pixels", double(c[LS_C_TRUNCATED])},
+                                    {"loop_capped_pixels", double(c[LS_C_CAPPED])},
+                                    {"sample_dispatches", double(dispatches_)},
                                     {"subdivided_nodes", double(tree_.nodes.size())},
                                     {"build_ms", tree_.buildMs},
                                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
@@ -282,7 +324,7 @@ public:
 
     std::vector<DebugView> debugViews() const override {
         if (!options_.instrumentation) return {};
-        return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}};
+        return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}, {"loop_capped", loopCapped_.id(), 1.0f, "flag"}};
     }
 
     /// The three pools (the paper's Table 1 size), plus the occupancy pool when the start region
@@ -297,10 +339,10 @@ public:
 
     /// Traversal stack overflows (one frame per level always suffices, so 0 unless the pools are
     /// corrupt; such a ray is counted occluded) plus pixels whose sample loop the driver cut short
-    /// (written shadowed): never lit by mistake.
+    /// or with a ray whose walk reached its loop cap (both written shadowed): never lit by mistake.
     uint64_t overflowCount() const override {
         const auto& c = counters_.read();
-        return uint64_t(c[LS_C_OVERFLOW]) + c[LS_C_TRUNCATED];
+        return uint64_t(c[LS_C_OVERFLOW]) + c[LS_C_TRUNCATED] + c[LS_C_CAPPED];
     }
 
     /// The storage block size build() splits the line-space pool by, in MiB, on this device.
@@ -409,7 +451,11 @@ private:
     std::array<GlTexture, kTexelUnits> texels_; ///< the pools as buffer textures (makeTexels): how the trace reads them
     size_t nodesPerChunk_ = 1;
     int bitChunks_ = 1; ///< line-space pool blocks the compiled programs read (LS_BIT_CHUNK_COUNT)
-    GlTexture nodesVisited_;
+    GlTexture nodesVisited_, loopCapped_;
+    GlTexture accum_;           ///< per-pixel state between a frame's dispatches (only if it has several)
+    glm::ivec2 accumRes_{0, 0};
+    int dispatches_ = 0;        ///< of the last frame
+    uint32_t walkCap_ = 1, leafWalkCap_ = 1; ///< most passes of a ray's walk and of one leaf walk
     // classify: the frame to classify, the exact tracer (built on first use) and the result.
     CpuGBuffer pendingG_;
     Light pendingLight_;

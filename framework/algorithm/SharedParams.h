@@ -38,6 +38,22 @@ template <class T> auto stackSizeRow(int T::*member, int def) {
     };
 }
 
+/// `samples_per_dispatch`: the most light samples per pixel one compute dispatch traces. A frame
+/// with more (an area light's samples) runs ceil(samples / this) dispatches over the image, each
+/// adding its samples to a per-pixel accumulation image; the last writes visibility, bit-identical
+/// to a single dispatch. A GPU driver kills a dispatch that runs past its watchdog (about 2 s on
+/// Windows), and an area light's 1,024 samples at 4K in one dispatch would; each algorithm's
+/// default keeps one dispatch far under it (the arithmetic is on its page in docs/algorithms/).
+/// 1,024 is the most samples a light may have (configlimits::kAreaSamplesMax).
+template <class T> auto samplesPerDispatchRow(int T::*member, int def) {
+    return [member, def](ParamStruct<T>& s) {
+        s.integer("samples_per_dispatch", member, def, 1, 1024, "samples",
+                  "most light samples per pixel traced by one compute dispatch; more samples take several "
+                  "dispatches (same image), so none runs into a GPU driver's watchdog",
+                  ParamChange::Update);
+    };
+}
+
 /// `cache`: reuse the algorithm's per-scene preprocessing from the disk cache
 /// ($XDG_CACHE_HOME or ~/.cache, /shadowlab/<folder>), keyed and checked by the scene's content.
 template <class T> auto cacheRow(bool T::*member, const std::string& folder) {

@@ -35,7 +35,17 @@
 #define BVH_C_OVERFLOW_PIXELS 8   // pixels with at least one such ray (written shadowed)
 #define BVH_C_PIXELS 9            // pixels that traced rays (covered, facing and reached by the light)
 #define BVH_C_TRUNCATED_PIXELS 10 // pixels whose sample loop the driver cut short (written shadowed)
-// Word 11 is reserved.
+#define BVH_C_CAPPED_PIXELS 11    // pixels with a ray whose traversal reached its step cap (written shadowed)
+
+// A frame whose light has more samples than samples_per_dispatch runs several dispatches; between
+// them each traced pixel keeps its state in the accumulation image (image unit BVH_ACCUM_UNIT,
+// R32UI, RG32UI when instrumented: y = nodes visited so far): the unblocked samples so far in the
+// low bits, and a flag per way a ray can fail, any of which writes the pixel shadowed.
+#define BVH_ACCUM_UNIT 3
+#define BVH_ACC_COUNT_MASK 0x0FFFFFFFu // unblocked samples (at most 1,024 per light: far below the mask)
+#define BVH_ACC_OVERFLOW 0x10000000u   // a ray's stack overflowed
+#define BVH_ACC_CAPPED 0x20000000u     // a ray's traversal reached its step cap
+#define BVH_ACC_TRUNCATED 0x40000000u  // the driver cut a dispatch's sample loop short
 
 // Child reference of an absent child (only the root of a tree of fewer than two leaves has one).
 #define BVH_ABSENT 0xFFFFFFFFu

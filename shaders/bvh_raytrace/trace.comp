@@ -4,6 +4,10 @@
 // on the CPU: Aila & Laine's while-while traversal (inner nodes until a leaf is found, then the
 // leaves), near child first, a fixed stack whose overflow is reported, any-hit early exit.
 // Triangles are read in leaf order (no index indirection). Visibility = fraction of unblocked samples.
+// One dispatch traces the samples [uSampleFirst, uSampleEnd) of every pixel (at most
+// samples_per_dispatch of them, so that no dispatch runs into a GPU driver's watchdog); a light with
+// more samples takes several dispatches, which carry each pixel's state in the accumulation image
+// (layout.glsl), and the last one writes visibility: the image a single dispatch would write.
 #include "common/instrumentation.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
@@ -39,10 +43,25 @@ layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 #if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map: nodes per pixel
-layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where a ray's stack overflowed
+layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the pixel was written shadowed for a failed ray
+layout(rg32ui, binding = BVH_ACCUM_UNIT) uniform uimage2D uAccum;   // between dispatches: x state (layout.glsl), y nodes visited
+#else
+layout(r32ui, binding = BVH_ACCUM_UNIT) uniform uimage2D uAccum;    // between dispatches: the state (layout.glsl)
 #endif
 uniform float uRayOffset; // world units, the reference's
-uniform int uSampleCount; // entries of lightSamples (1 for point and spot lights)
+uniform int uSampleCount; // entries of lightSamples (1 for point, spot and directional lights)
+uniform int uSampleFirst, uSampleEnd; // the samples this dispatch traces, [first, end)
+uniform uint uStepCap;    // most loop passes of one ray's traversal: nodes + 2 * leaves + 1 (see trace)
+
+// Tests only (framework/gl/Shader.h, setShaderFaultDefines): a corrupt child link that sends the
+// rays of every other pixel back into the node they are leaving, whenever they enter one inner
+// child only: a walk that makes no progress, as a bad tree in memory would make it.
+#ifndef SHADOWLAB_FAULT_BVH_CYCLE
+#define SHADOWLAB_FAULT_BVH_CYCLE 0
+#endif
+#if SHADOWLAB_FAULT_BVH_CYCLE
+bool gFaultPixel = false;
+#endif
 
 const float kInf = uintBitsToFloat(0x7F800000u);
 
@@ -77,7 +96,7 @@ bool hitBox(vec3 lo, vec3 hi, Ray r, out float tnear) {
 }
 
 struct Trace {
-    bool occluded, overflow;
+    bool occluded, overflow, capped;
     uint visited, tested;
 };
 
@@ -121,19 +140,33 @@ bool isLeaf(uint ref) { return ref != NONE && (ref & BVH_LEAF) != 0u; }
 #define POP_INTO(v) v = sp > 0 ? stack[--sp] : NONE
 #endif
 
+// Every pass of the three loops costs one step. In a tree a ray enters each inner node at most once
+// and each leaf at most once, and each pass of the outer loop tests a leaf or ends the walk, so a
+// correct walk takes at most nodes + 2 * leaves + 1 steps: uStepCap. GLSL does not promise that a
+// loop ends (a GPU runs an endless one until the driver's watchdog resets it): a walk that reaches
+// the cap stops with work left, and so does one that a driver's own loop limit (llvmpipe's) ends;
+// either is `capped`, its ray blocked and its pixel written shadowed. The walk's progress is integer
+// (node indices, the stack pointer), never a float comparison that a NaN could leave false forever:
+// a NaN ray misses every box and ends at once.
 Trace trace(Ray r) {
-    Trace res = Trace(false, false, 0u, 0u);
+    Trace res = Trace(false, false, false, 0u, 0u);
     uint stack[STACK_SPILL];
 #if BVH_SHORT_STACK
     uvec4 st0 = uvec4(NONE), st1 = uvec4(NONE), st2 = uvec4(NONE), st3 = uvec4(NONE);
 #endif
     int sp = 0;
     uint node = 0u, leaf = NONE; // the inner node to visit next, and a leaf postponed for the leaf loop
-    while (node != NONE || leaf != NONE) {
+    uint steps = 0u;
+    while ((node != NONE || leaf != NONE) && steps < uStepCap) {
+        ++steps;
         // Inner loop: descend until this ray holds a leaf (or has nothing left), so that the rays of
         // neighbouring invocations (lanes in lockstep) test their triangles together below.
-        while (node != NONE && !isLeaf(node) && leaf == NONE) {
+        while (node != NONE && !isLeaf(node) && leaf == NONE && steps < uStepCap) {
+            ++steps;
             ++res.visited;
+#if SHADOWLAB_FAULT_BVH_CYCLE
+            uint current = node;
+#endif
             BvhNode n = bvhNode(node);
             float tn0, tn1;
             bool h0 = n.child0 != BVH_ABSENT && hitBox(n.lo0, n.hi0, r, tn0);
@@ -145,15 +178,20 @@ Trace trace(Ray r) {
                 if (sp == BVH_STACK_SIZE) { res.overflow = true; return res; }
                 PUSH(first0 ? c1 : c0);
                 node = first0 ? c0 : c1;
+            } else if (h0 || h1) {
+                node = h0 ? c0 : c1;
+#if SHADOWLAB_FAULT_BVH_CYCLE
+                if (gFaultPixel && !isLeaf(node)) node = current;
+#endif
             } else {
-                if (h0 || h1) node = h0 ? c0 : c1;
-                else POP_INTO(node);
+                POP_INTO(node);
             }
             // A leaf is postponed: its triangles are tested in the leaf loop.
             if (isLeaf(node)) { leaf = node; POP_INTO(node); }
         }
         // Leaf loop: the postponed leaf, and any leaves that come next off the stack.
-        while (isLeaf(leaf)) {
+        while (isLeaf(leaf) && steps < uStepCap) {
+            ++steps;
             uint first = (leaf & ~BVH_LEAF) >> 4u, count = (leaf & 15u) + 1u;
             for (uint i = 0u; i < count; ++i) {
                 ++res.tested;
@@ -163,43 +201,56 @@ Trace trace(Ray r) {
             if (isLeaf(node)) { leaf = node; POP_INTO(node); }
         }
     }
+    res.capped = node != NONE || leaf != NONE; // work left: the cap (or the driver) ended the walk
     return res;
 }
 
 #if SHADOWLAB_INSTRUMENTATION
-shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels, sTruncated;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels, sTruncated, sCapped;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(bvhCounters, lo, value)
 #endif
 
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = sTruncated = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = sTruncated = sCapped = 0u;
     barrier();
 #endif
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+#if SHADOWLAB_FAULT_BVH_CYCLE
+    gFaultPixel = ((px.x + px.y) & 1) == 0;
+#endif
+    bool firstDispatch = uSampleFirst == 0, lastDispatch = uSampleEnd >= uSampleCount;
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)
-        uint visited = 0u, overflowRays = 0u;
-        bool truncated = false;
+        uint visitedAll = 0u;   // nodes fetched by this pixel's rays, this dispatch and the earlier ones
+        bool failed = false;    // a ray could not be traced to its end: the pixel is written shadowed
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
             if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
                 vec3 o = p + n * uRayOffset; // the same (unnormalised) normal as the reference
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
-                int count = directional ? 1 : uSampleCount;
-                float unblocked = 0.0;
-                uint tested = 0u, maxVisited = 0u, done = 0u;
-                for (int s = 0; s < count; ++s) {
+                int count = directional ? 1 : uSampleCount, first = uSampleFirst, end = directional ? 1 : uSampleEnd;
+                // The state the earlier dispatches left: unblocked samples and failure flags.
+                uint state = 0u;
+                if (!firstDispatch) {
+                    uvec4 a = imageLoad(uAccum, px);
+                    state = a.x;
+#if SHADOWLAB_INSTRUMENTATION
+                    visitedAll = a.y;
+#endif
+                }
+                uint unblocked = 0u, visited = 0u, tested = 0u, maxVisited = 0u, done = 0u, overflowRays = 0u, cappedRays = 0u;
+                for (int s = first; s < end; ++s) {
                     Ray r;
                     if (directional) {
                         r = makeRay(o, -uLightDirection, kInf);
                     } else {
                         vec3 d = lightSamples[s].xyz - o;
                         float dist = length(d);
-                        if (!(dist > 0.0)) { unblocked += 1.0; ++done; continue; } // origin on the sample
+                        if (!(dist > 0.0)) { ++unblocked; ++done; continue; } // origin on the sample
                         r = makeRay(o, d / dist, max(0.0, dist - uRayOffset));
                     }
                     Trace t = trace(r);
@@ -207,52 +258,68 @@ void main() {
                     tested += t.tested;
                     maxVisited = max(maxVisited, t.visited);
                     if (t.overflow) ++overflowRays;
-                    else if (!t.occluded) unblocked += 1.0;
+                    else if (t.capped) ++cappedRays;
+                    else if (!t.occluded) ++unblocked;
                     ++done;
                 }
+                visitedAll += visited;
                 // Fewer samples done than taken: llvmpipe's code generator (gallivm) stops the loops of
                 // an invocation after a fixed budget of iterations, silently. Treated like an overflow.
-                if (done != uint(count)) { truncated = true; ++overflowRays; }
-                // An overflowed ray counts as blocked, and its pixel is written fully shadowed, so a
-                // stack too small shows as dark pixels and in overflowCount(), never as light.
-                visibility = overflowRays > 0u ? 0.0 : unblocked / float(count);
+                if (done != uint(end - first)) state |= BVH_ACC_TRUNCATED;
+                // An overflowed or capped ray counts as blocked, and its pixel is written fully
+                // shadowed, so a stack too small or a walk that cannot end shows as dark pixels and in
+                // overflowCount(), never as light.
+                if (overflowRays > 0u) state |= BVH_ACC_OVERFLOW;
+                if (cappedRays > 0u) state |= BVH_ACC_CAPPED;
+                state += unblocked;
+                bool truncated = (state & BVH_ACC_TRUNCATED) != 0u, capped = (state & BVH_ACC_CAPPED) != 0u;
+                failed = (state & ~BVH_ACC_COUNT_MASK) != 0u;
+                if (lastDispatch) visibility = failed ? 0.0 : float(state & BVH_ACC_COUNT_MASK) / float(count);
+                else imageStore(uAccum, px, uvec4(state, visitedAll, 0u, 0u));
+                // Per ray: every dispatch adds its own; per pixel: the last one, from the state.
 #if SHADOWLAB_INSTRUMENTATION
-                atomicAdd(sPixels, 1u);
-                atomicAdd(sRays, uint(count));
+                atomicAdd(sRays, uint(end - first));
                 atomicAdd(sVisited, visited);
                 atomicMax(sVisitedMax, maxVisited);
                 atomicAdd(sTested, tested);
-                if (truncated) atomicAdd(sTruncated, 1u);
-                else if (overflowRays > 0u) { atomicAdd(sOverflowRays, overflowRays); atomicAdd(sOverflowPixels, 1u); }
+                if (overflowRays > 0u) atomicAdd(sOverflowRays, overflowRays);
+                if (lastDispatch) {
+                    atomicAdd(sPixels, 1u);
+                    if (truncated) atomicAdd(sTruncated, 1u);
+                    else if (capped) atomicAdd(sCapped, 1u);
+                    else if (failed) atomicAdd(sOverflowPixels, 1u);
+                }
 #else
-                // Timing mode still counts every overflowed or truncated pixel.
-                if (truncated) atomicAdd(bvhCounters[BVH_C_TRUNCATED_PIXELS], 1u);
-                else if (overflowRays > 0u) {
-                    atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], overflowRays);
-                    atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], 1u);
+                // Timing mode still counts every overflowed, capped or truncated pixel.
+                if (overflowRays > 0u) atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], overflowRays);
+                if (lastDispatch && failed) {
+                    if (truncated) atomicAdd(bvhCounters[BVH_C_TRUNCATED_PIXELS], 1u);
+                    else if (capped) atomicAdd(bvhCounters[BVH_C_CAPPED_PIXELS], 1u);
+                    else atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], 1u);
                 }
 #endif
             }
         }
-        imageStore(uVisibility, px, vec4(visibility));
+        if (lastDispatch) {
+            imageStore(uVisibility, px, vec4(visibility));
 #if SHADOWLAB_INSTRUMENTATION
-        imageStore(uNodesVisited, px, vec4(float(visited)));
-        imageStore(uOverflow, px, vec4(overflowRays > 0u ? 1.0 : 0.0));
+            imageStore(uNodesVisited, px, vec4(float(visitedAll)));
+            imageStore(uOverflow, px, vec4(failed ? 1.0 : 0.0));
 #endif
+        }
     }
 #if SHADOWLAB_INSTRUMENTATION
     barrier();
-    if (gl_LocalInvocationIndex == 0u && sPixels != 0u) {
-        atomicAdd(bvhCounters[BVH_C_PIXELS], sPixels);
+    if (gl_LocalInvocationIndex == 0u && sRays != 0u) {
+        if (sPixels != 0u) atomicAdd(bvhCounters[BVH_C_PIXELS], sPixels);
         addWide(BVH_C_RAYS_LO, sRays);
         addWide(BVH_C_VISITED_LO, sVisited);
         atomicMax(bvhCounters[BVH_C_VISITED_MAX], sVisitedMax);
         addWide(BVH_C_TRIS_LO, sTested);
         if (sTruncated != 0u) atomicAdd(bvhCounters[BVH_C_TRUNCATED_PIXELS], sTruncated);
-        if (sOverflowRays != 0u) {
-            atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], sOverflowRays);
-            atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], sOverflowPixels);
-        }
+        if (sCapped != 0u) atomicAdd(bvhCounters[BVH_C_CAPPED_PIXELS], sCapped);
+        if (sOverflowRays != 0u) atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], sOverflowRays);
+        if (sOverflowPixels != 0u) atomicAdd(bvhCounters[BVH_C_OVERFLOW_PIXELS], sOverflowPixels);
     }
 #endif
 }

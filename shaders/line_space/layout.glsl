@@ -44,7 +44,7 @@
 #define LS_OCC_WORDS_PER_NODE(n) (((n) * (n) * (n) + 31) / 32)
 
 // Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words.
-#define LS_COUNTER_WORDS 18
+#define LS_COUNTER_WORDS 19
 #define LS_C_RAYS_LO 0          // shadow rays (lit pixels × samples)
 #define LS_C_RAYS_HI 1
 #define LS_C_VISITED_LO 2       // nodes entered, summed over rays
@@ -63,3 +63,13 @@
 #define LS_C_TRIS_LO 15         // triangles tested by the exact start region, summed over rays
 #define LS_C_TRIS_HI 16
 #define LS_C_TRUNCATED 17       // pixels whose sample loop the driver cut short (written shadowed)
+#define LS_C_CAPPED 18          // pixels with a ray whose walk reached its loop cap (written shadowed)
+
+// A frame whose light has more samples than samples_per_dispatch runs several dispatches; between
+// them each traced pixel keeps its state in the accumulation image (image unit LS_ACCUM_UNIT, R32UI,
+// RG32UI when instrumented: y = nodes visited so far): the unblocked samples so far in the low bits,
+// and a flag per way a pixel can fail, either of which writes it shadowed.
+#define LS_ACCUM_UNIT 3
+#define LS_ACC_COUNT_MASK 0x0FFFFFFFu // unblocked samples (at most 1,024 per light: far below the mask)
+#define LS_ACC_CAPPED 0x20000000u     // a ray's walk reached its loop cap
+#define LS_ACC_TRUNCATED 0x40000000u  // the driver cut a dispatch's sample loop short

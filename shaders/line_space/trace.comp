@@ -19,6 +19,18 @@
 //     LS_LAST_LEAVES the leaves the ray crosses in that node decide, by the node's occupancy mask.
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
 // LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE, LS_LAST_LEAVES.
+//
+// One dispatch traces the samples [uSampleFirst, uSampleEnd) of every pixel (at most
+// samples_per_dispatch of them, so that no dispatch runs into a GPU driver's watchdog); a light with
+// more samples takes several dispatches, which carry each pixel's state in the accumulation image
+// (layout.glsl), and the last one writes visibility: the image a single dispatch would write.
+//
+// Every loop is bounded by an integer count derived from the structure (uWalkCap, uLeafWalkCap):
+// the DDAs end by float comparisons (t > tEnd, cellEnd > t1) and by the cell leaving the node, and a
+// NaN step would leave the comparison false and the cell where it is forever (every comparison with
+// a NaN is false). GLSL does not promise that a loop ends; a GPU runs an endless one until its
+// driver's watchdog resets the device. A ray whose walk reaches its cap is blocked and its pixel
+// written shadowed and counted (LS_C_CAPPED, overflowCount()), never lit by mistake.
 #include "common/instrumentation.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
@@ -80,9 +92,17 @@ layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 #if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map: nodes per pixel
+layout(r32f, binding = 2) writeonly uniform image2D uLoopCapped;   // 1 where a loop cap wrote the pixel shadowed
+layout(rg32ui, binding = LS_ACCUM_UNIT) uniform uimage2D uAccum;   // between dispatches: x state (layout.glsl), y nodes visited
+#else
+layout(r32ui, binding = LS_ACCUM_UNIT) uniform uimage2D uAccum;    // between dispatches: the state (layout.glsl)
 #endif
 uniform float uRayOffset; // world units, the reference's
-uniform int uSampleCount; // entries of lightSamples (1 for point and spot lights)
+uniform int uSampleCount; // entries of lightSamples (1 for point, spot and directional lights)
+uniform int uSampleFirst, uSampleEnd; // the samples this dispatch traces, [first, end)
+// Most passes of one ray's walk over the tree (main) and of one leaf walk (leafWalk); LineSpace.cpp
+// derives them from the tree, the reasoning is at each loop.
+uniform uint uWalkCap, uLeafWalkCap;
 uniform uint uNodeCount;  // 0: no geometry, nothing occludes
 uniform uint uNodesPerChunk; // nodes per line-space pool chunk (see layout.glsl)
 uniform vec3 uLeafCell;      // world size of a leaf cell (level d)
@@ -97,6 +117,19 @@ const uint WORDS = uint(LS_WORDS_PER_NODE(LS_N));
 const uint OCC_WORDS = uint(LS_OCC_WORDS_PER_NODE(LS_N));
 const uint LS_NONE = 0xFFFFFFFFu;
 const float kInf = uintBitsToFloat(0x7F800000u);
+
+// Set when a leaf walk reaches its cap (read per ray in main).
+bool gCapped = false;
+
+// Tests only (framework/gl/Shader.h, setShaderFaultDefines): the DDA steps of every other pixel are
+// NaN, as an overflowing or degenerate ray might make them on a GPU: no walk of those rays makes
+// progress.
+#ifndef SHADOWLAB_FAULT_NAN_STEP
+#define SHADOWLAB_FAULT_NAN_STEP 0
+#endif
+#if SHADOWLAB_FAULT_NAN_STEP
+bool gFaultPixel = false;
+#endif
 
 struct Ray {
     vec3 o, d, invD;
@@ -177,11 +210,18 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
     ivec3 c = cellOf(r.o + r.d * t0, lo, cellSize);
     ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
     vec3 tNext = (lo + vec3(c + up) * cellSize - r.o) * r.invD;
+#if SHADOWLAB_FAULT_NAN_STEP
+    if (gFaultPixel) tNext = vec3(uintBitsToFloat(0x7FC00000u));
+#endif
     uint base = index * OCC_WORDS;
     float tEnter = t0; // where the walk entered leaf c
     uint next = 0u, end = 0u; // the current leaf's triangles still to test (exact)
     bool step = false;        // leaf c is done: step the DDA
-    while (true) {
+    // Each pass tests one triangle or visits one leaf. Every step moves the cell one leaf along one
+    // axis, never back, so at most 3N - 2 leaves are visited before the cell leaves the node (one
+    // more pass finds it outside); each occupied leaf adds at most its list's length of triangle
+    // tests (exact). uLeafWalkCap = (3N - 1) * (1 + the longest leaf list).
+    for (uint pass = 0u; pass < uLeafWalkCap; ++pass) {
 #if LS_START_MODE == LS_START_EXACT
         if (next < end) {
             ++trianglesTested;
@@ -215,7 +255,10 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
 #endif
         }
     }
-    return false;
+    // The cap (or a driver's own loop limit, llvmpipe's) ended the walk before it did: blocked,
+    // and the pixel written shadowed.
+    gCapped = true;
+    return true;
 }
 #endif
 
@@ -313,6 +356,9 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
     // The cell boundary ahead on each axis, with the float expression the build used for boxes.
     vec3 ahead = n.lo + vec3(cIn + ivec3(greaterThanEqual(r.d, vec3(0.0)))) * cellSize;
     f.tNext = (ahead - r.o) * r.invD;
+#if SHADOWLAB_FAULT_NAN_STEP
+    if (gFaultPixel) f.tNext = vec3(uintBitsToFloat(0x7FC00000u));
+#endif
     return ENTER_DESCEND;
 }
 
@@ -338,27 +384,33 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #endif
 
 #if SHADOWLAB_INSTRUMENTATION
-shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated, sCapped;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 #endif
 
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = sCapped = 0u;
     barrier();
 #endif
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+#if SHADOWLAB_FAULT_NAN_STEP
+    gFaultPixel = ((px.x + px.y) & 1) == 0;
+#endif
+    bool firstDispatch = uSampleFirst == 0, lastDispatch = uSampleEnd >= uSampleCount;
     ivec2 size = imageSize(uVisibility);
     if (all(lessThan(px, size))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)
-        uint visited = 0u;
+        uint visitedAll = 0u;   // nodes entered by this pixel's rays, this dispatch and the earlier ones
+        bool failed = false;    // a loop was cut short: the pixel is written shadowed
 #if LS_CLASSIFY
         uint stride = 1u + (uint(uSampleCount) + 31u) / 32u;
         uint base = uint(px.y * size.x + px.x) * stride;
         uint pixelStartNode = LS_NONE;
-        for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0u;
+        if (firstDispatch)
+            for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0u;
 #endif
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
@@ -366,8 +418,17 @@ void main() {
             if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
                 vec3 o = p + n * uRayOffset;
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
-                int count = directional ? 1 : uSampleCount;
-                uint unblocked = 0u, cells = 0u, occluded = 0u, maxVisited = 0u, overflow = 0u;
+                int count = directional ? 1 : uSampleCount, first = uSampleFirst, end = directional ? 1 : uSampleEnd;
+                // The state the earlier dispatches left: unblocked samples and failure flags.
+                uint state = 0u;
+                if (!firstDispatch) {
+                    uvec4 a = imageLoad(uAccum, px);
+                    state = a.x;
+#if SHADOWLAB_INSTRUMENTATION
+                    visitedAll = a.y;
+#endif
+                }
+                uint unblocked = 0u, visited = 0u, cells = 0u, occluded = 0u, maxVisited = 0u, overflow = 0u, cappedRays = 0u;
                 sumShafts = 0u;
                 leafCells = 0u;
                 trianglesTested = 0u;
@@ -379,7 +440,7 @@ void main() {
                 // in parent0..2.
                 Frame cur = Frame(0u, ivec3(0), 0, vec3(0.0), vec3(1.0), vec3(0.0), kInf, 0.0, false);
                 Frame parent0 = cur, parent1 = cur, parent2 = cur; // only LS_PARENTS of them are used
-                for (int s = 0; s < count; ++s) {
+                for (int s = first; s < end; ++s) {
                     Ray r;
                     r.o = o;
                     if (directional) {
@@ -399,6 +460,7 @@ void main() {
                     ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
                     ivec3 childStep = stepDir * ivec3(1, LS_N, LS_N * LS_N);
                     rayVisited = 0u;
+                    gCapped = false;
                     bool blocked = false;
 #if LS_START_MODE != LS_START_NODE
                     float tS = startRegionEnd(nu, r.d);
@@ -411,18 +473,30 @@ void main() {
                     Frame f;
                     int e = uNodeCount == 0u ? ENTER_SKIP : enter(0u, true, LS_DEPTH == 1, false, tS, r, f);
                     if (e == ENTER_OCCLUDED) blocked = true;
+                    // The walk ends as the method ends it (the ray free past the root, occluded, or
+                    // an overflow) or not at all: then its cap, or the driver, stopped it.
+                    bool finished = e != ENTER_DESCEND;
                     if (e == ENTER_DESCEND) {
                         cur = f;
                         int level = 0;
-                        while (true) {
+                        // Each pass of the inner loop visits one child cell of the walked node or
+                        // leaves a finished walk. A node's DDA moves its cell one step along one axis
+                        // per cell, never back, so it visits at most 3N - 2 cells before the cell
+                        // leaves the node (t = inf): with the pass that leaves it, 3N - 1 passes per
+                        // walked node. A ray walks each node above the last level at most once, and
+                        // at most (3N - 2)^l of level l (one per cell its parent crosses): uWalkCap =
+                        // (3N - 1) * min(nodes above the last level, the sum of (3N - 2)^l).
+                        uint passes = 0u;
+                        while (!finished && passes < uWalkCap) {
                             // Step the DDA to the next non-empty child, leaving finished walks: a
                             // loop of its own, so that neighbouring invocations (vector lanes in
                             // lockstep) reach the node test below together.
                             uint node = LS_NONE;
                             bool nodeStart = false;
-                            while (true) {
+                            while (passes < uWalkCap) {
+                                ++passes;
                                 if (cur.t > cur.tEnd) { // walked past the node (or the segment's end)
-                                    if (level == 0) break;
+                                    if (level == 0) { finished = true; break; } // past the root: the ray is free
                                     --level;
                                     POP(level, cur);
                                     continue;
@@ -448,18 +522,23 @@ void main() {
                                 uint child = lsTree(cur.children + uint(cell));
                                 if (child != LS_EMPTY) { node = child; break; } // Algorithm 1, line 8: empty children are skipped
                             }
-                            if (node == LS_NONE) break; // walked past the root: the ray is free
+                            if (node == LS_NONE) break; // walked past the root (finished), or the cap
                             e = enter(node, false, level + 1 == LS_DEPTH - 1, nodeStart, tS, r, f);
-                            if (e == ENTER_OCCLUDED) { blocked = true; break; }
+                            if (e == ENTER_OCCLUDED) { blocked = true; finished = true; break; }
                             if (e == ENTER_DESCEND) {
                                 // One frame per level above the last suffices by construction. Checked
                                 // anyway, so a corrupt tree shows as reported overflow, never as light.
-                                if (level >= LS_PARENTS) { ++overflow; blocked = true; break; }
+                                if (level >= LS_PARENTS) { ++overflow; blocked = true; finished = true; break; }
                                 PUSH(level, cur);
                                 ++level;
                                 cur = f;
                             }
                         }
+                    }
+                    // A walk cut short (here or in a leaf walk) could have met a blocker further on.
+                    if (!finished || gCapped) {
+                        blocked = true;
+                        ++cappedRays;
                     }
                     visited += rayVisited;
                     maxVisited = max(maxVisited, rayVisited);
@@ -473,6 +552,7 @@ void main() {
                     }
                 }
                 uint shafts = sumShafts;
+                visitedAll += visited;
 #if LS_CLASSIFY
                 // The start node depends only on the origin: every sample reports the same one.
                 if (startNode != LS_NONE) pixelStartNode = startNode;
@@ -481,17 +561,21 @@ void main() {
                 // was cut short: llvmpipe's code generator (gallivm) stops the loops of an invocation
                 // after a fixed budget of iterations, silently, and a sample never traced would count
                 // as lit. Such a pixel is written shadowed and reported (overflowCount()), like an
-                // overflow, never as light.
-                bool truncated = unblocked + occluded != uint(count);
-                visibility = truncated ? 0.0 : float(unblocked) / float(count);
+                // overflow, never as light; so is one with a ray whose walk reached its cap.
+                if (unblocked + occluded != uint(end - first)) state |= LS_ACC_TRUNCATED;
+                if (cappedRays > 0u) state |= LS_ACC_CAPPED;
+                state += unblocked;
+                bool truncated = (state & LS_ACC_TRUNCATED) != 0u;
+                failed = (state & ~LS_ACC_COUNT_MASK) != 0u;
+                if (lastDispatch) visibility = failed ? 0.0 : float(state & LS_ACC_COUNT_MASK) / float(count);
+                else imageStore(uAccum, px, uvec4(state, visitedAll, 0u, 0u));
 #if LS_CLASSIFY
-                if (truncated)
+                if (lastDispatch && failed)
                     for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0xFFFFFFFFu; // every sample blocked
 #endif
+                // Per ray: every dispatch adds its own; per pixel: the last one, from the state.
 #if SHADOWLAB_INSTRUMENTATION
-                if (truncated) atomicAdd(sTruncated, 1u);
-                atomicAdd(sPixels, 1u);
-                atomicAdd(sRays, uint(count));
+                atomicAdd(sRays, uint(end - first));
                 atomicAdd(sVisited, visited);
                 atomicMax(sVisitedMax, maxVisited);
                 atomicAdd(sShafts, shafts);
@@ -500,25 +584,33 @@ void main() {
                 atomicAdd(sTris, trianglesTested);
                 atomicAdd(sOccluded, occluded);
                 if (overflow != 0u) atomicAdd(sOverflow, overflow);
+                if (lastDispatch) {
+                    atomicAdd(sPixels, 1u);
+                    if (truncated) atomicAdd(sTruncated, 1u);
+                    else if (failed) atomicAdd(sCapped, 1u);
+                }
 #else
-                // Timing mode still counts every overflowed or truncated pixel.
-                if (truncated) atomicAdd(lsCounters[LS_C_TRUNCATED], 1u);
+                // Timing mode still counts every overflowed, capped or truncated pixel.
                 if (overflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], overflow);
+                if (lastDispatch && failed) atomicAdd(lsCounters[truncated ? LS_C_TRUNCATED : LS_C_CAPPED], 1u);
 #endif
             }
         }
 #if LS_CLASSIFY
-        lsClassify[base] = pixelStartNode;
+        if (firstDispatch || pixelStartNode != LS_NONE) lsClassify[base] = pixelStartNode;
 #endif
-        imageStore(uVisibility, px, vec4(visibility));
+        if (lastDispatch) {
+            imageStore(uVisibility, px, vec4(visibility));
 #if SHADOWLAB_INSTRUMENTATION
-        imageStore(uNodesVisited, px, vec4(float(visited)));
+            imageStore(uNodesVisited, px, vec4(float(visitedAll)));
+            imageStore(uLoopCapped, px, vec4(failed ? 1.0 : 0.0));
 #endif
+        }
     }
 #if SHADOWLAB_INSTRUMENTATION
     barrier();
-    if (gl_LocalInvocationIndex == 0u && sPixels != 0u) {
-        atomicAdd(lsCounters[LS_C_PIXELS], sPixels);
+    if (gl_LocalInvocationIndex == 0u && sRays != 0u) {
+        if (sPixels != 0u) atomicAdd(lsCounters[LS_C_PIXELS], sPixels);
         addWide(LS_C_RAYS_LO, sRays);
         addWide(LS_C_VISITED_LO, sVisited);
         atomicMax(lsCounters[LS_C_VISITED_MAX], sVisitedMax);
@@ -529,6 +621,7 @@ void main() {
         addWide(LS_C_OCCLUDED_LO, sOccluded);
         if (sOverflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], sOverflow);
         if (sTruncated != 0u) atomicAdd(lsCounters[LS_C_TRUNCATED], sTruncated);
+        if (sCapped != 0u) atomicAdd(lsCounters[LS_C_CAPPED], sCapped);
     }
 #endif
 }
