@@ -201,15 +201,17 @@ TEST_F(BvhRaytraceGLTest, AWalkThatCannotEndIsCappedAndWrittenShadowed) {
         EXPECT_GT(capped, 0.0);
         EXPECT_EQ(o.overflow, uint64_t(capped));
         expectOverflowedPixelsShadowed(o, capped);
-        size_t faultyLit = 0, elsewhere = 0, changed = 0;
+        size_t faultyLit = 0, elsewhere = 0, changed = 0, lighter = 0;
         for (int y = 0; y < kRes; ++y)
             for (int x = 0; x < kRes; ++x) {
                 const size_t i = size_t(y) * kRes + size_t(x);
                 const bool faulty = (x + y) % 2 == 0, marked = o.overflowMask[i] > 0.5f;
                 faultyLit += faulty && o.lit[i];
                 elsewhere += marked && !faulty;
+                lighter += o.visibility[i] > clean.visibility[i];
                 if (!marked) changed += o.visibility[i] != clean.visibility[i];
             }
+        EXPECT_EQ(lighter, 0u) << "pixels lit by mistake";
         EXPECT_EQ(elsewhere, 0u) << "pixels capped outside the faulty ones";
         EXPECT_EQ(changed, 0u) << "pixels not capped whose value differs from the clean run";
         EXPECT_GT(capped, 0.2 * double(faultyLit));
