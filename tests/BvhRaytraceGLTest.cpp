@@ -136,7 +136,7 @@ TEST_F(BvhRaytraceGLTest, SplitDispatchesGiveTheSingleDispatchImage) {
     AlgorithmRun single = runAlgorithm(bvhRaytraceInfo(), s, {{"samples_per_dispatch", 64}}, options);
     EXPECT_EQ(single.counters["sample_dispatches"], 1.0);
     EXPECT_EQ(single.overflow, 0u);
-    for (int budget : {8, 5}) { // the default, and one that leaves a short last dispatch (4 samples)
+    for (int budget : {16, 5}) { // the default, and one that leaves a short last dispatch (4 samples)
         SCOPED_TRACE("samples_per_dispatch " + std::to_string(budget));
         AlgorithmRun split = runAlgorithm(bvhRaytraceInfo(), s, {{"samples_per_dispatch", budget}}, options);
         EXPECT_EQ(split.counters["sample_dispatches"], double((64 + budget - 1) / budget));
@@ -156,8 +156,8 @@ TEST_F(BvhRaytraceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
     const Shot s = areaShot(1024, "stratified");
     RunOptions options;
     options.resolution = 48;
-    AlgorithmRun split = runAlgorithm(bvhRaytraceInfo(), s, {}, options); // the default: 8 per dispatch
-    EXPECT_EQ(split.counters["sample_dispatches"], 128.0);
+    AlgorithmRun split = runAlgorithm(bvhRaytraceInfo(), s, {}, options); // the default: 16 per dispatch
+    EXPECT_EQ(split.counters["sample_dispatches"], 64.0);
     EXPECT_EQ(split.overflow, 0u);
     EXPECT_EQ(split.counters["rays"], 1024.0 * split.counters["traced_pixels"]);
     EXPECT_LE(split.accuracy.mismatchRatio, 1e-3);
@@ -172,7 +172,7 @@ TEST_F(BvhRaytraceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
         if (single.overflowMask[i] > 0.5f) ++flagged;
         else differ += single.visibility[i] != split.visibility[i];
     }
-    std::printf("[bvh_raytrace] 1024 samples: trace %.1f ms in 128 dispatches, %.1f ms in 11, %.1f ms in one (%zu pixels cut "
+    std::printf("[bvh_raytrace] 1024 samples: trace %.1f ms in 64 dispatches, %.1f ms in 11, %.1f ms in one (%zu pixels cut "
                 "short: %.0f truncated, %.0f capped)\n",
                 traceMs(split), traceMs(uneven), traceMs(single), flagged, single.counters["truncated_pixels"],
                 single.counters["loop_capped_pixels"]);
@@ -185,7 +185,7 @@ TEST_F(BvhRaytraceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
 // finishes, the pixels are counted and written shadowed, and every other pixel keeps its value. The
 // state survives the dispatches of a split area light.
 TEST_F(BvhRaytraceGLTest, AWalkThatCannotEndIsCappedAndWrittenShadowed) {
-    for (const auto& [name, shot, budget] : {std::tuple{"point", pointShot(), 8}, std::tuple{"area 16", areaShot(16, "grid"), 4}}) {
+    for (const auto& [name, shot, budget] : {std::tuple{"point", pointShot(), 16}, std::tuple{"area 16", areaShot(16, "grid"), 4}}) {
         SCOPED_TRACE(name);
         AlgorithmRun clean = run(shot, {{"samples_per_dispatch", budget}});
         EXPECT_EQ(clean.overflow, 0u);

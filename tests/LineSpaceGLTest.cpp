@@ -356,7 +356,7 @@ TEST_F(LineSpaceGLTest, SplitDispatchesGiveTheSingleDispatchImage) {
         AlgorithmRun single = runAlgorithm(lineSpaceInfo(), s, p, options);
         EXPECT_EQ(single.counters["sample_dispatches"], 1.0);
         EXPECT_EQ(single.overflow, 0u);
-        for (int budget : {2, 7}) { // the default (13 dispatches), and 4 with a short last one
+        for (int budget : {4, 7}) { // the default (7 dispatches), and 4 with a short last one
             SCOPED_TRACE(std::string(variant.empty() ? "defaults" : "Algorithm 1") + ", samples_per_dispatch " +
                          std::to_string(budget));
             p["samples_per_dispatch"] = budget;
@@ -383,8 +383,8 @@ TEST_F(LineSpaceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
     RunOptions options;
     options.resolution = 32;
     options.debugViews = {"loop_capped"};
-    AlgorithmRun split = runAlgorithm(lineSpaceInfo(), s, {}, options); // the default: 2 per dispatch
-    EXPECT_EQ(split.counters["sample_dispatches"], 512.0);
+    AlgorithmRun split = runAlgorithm(lineSpaceInfo(), s, {}, options); // the default: 4 per dispatch
+    EXPECT_EQ(split.counters["sample_dispatches"], 256.0);
     EXPECT_EQ(split.overflow, 0u);
     EXPECT_EQ(split.counters["rays"], 1024.0 * split.counters["traced_pixels"]);
     AlgorithmRun uneven = runAlgorithm(lineSpaceInfo(), s, {{"samples_per_dispatch", 100}}, options);
@@ -398,7 +398,7 @@ TEST_F(LineSpaceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
         if (mask[i] > 0.5f) ++flagged;
         else differ += single.visibility[i] != split.visibility[i];
     }
-    std::printf("[line_space] 1024 samples at 32²: rmse %.4f; trace %.1f ms in 512 dispatches, %.1f ms in 11, %.1f ms in one "
+    std::printf("[line_space] 1024 samples at 32²: rmse %.4f; trace %.1f ms in 256 dispatches, %.1f ms in 11, %.1f ms in one "
                 "(%zu pixels cut short: %.0f truncated, %.0f capped)\n",
                 split.accuracy.rmse, traceMs(split), traceMs(uneven), traceMs(single), flagged,
                 single.counters["truncated_pixels"], single.counters["loop_capped_pixels"]);

@@ -57,9 +57,10 @@ const ParamStruct<BvhParams>& bvhParams() {
         .real("traversal_cost", &P::traversalCost, 1.0, 0.1, 10.0, "× triangle test",
               "SAH cost of visiting a node, relative to one ray-triangle test", ParamChange::Rebuild)
         .apply(rayOffsetRow(&P::rayOffset))
-        // 8: the slowest case measured here, 1,024 samples at 4K, ~27 ms per sample and pixel on a GPU
-        // (docs/algorithms/bvh_raytrace.md, "Dispatches"), makes ~0.22 s a dispatch, 9x under 2 s.
-        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 8));
+        // 16: one sample of every pixel of a 4K frame costs ~8 ms on a GPU (~0.8 s on llvmpipe here,
+        // ~100x slower), ~15 ms on a 2 M-triangle scene: at most ~0.25 s a dispatch, 8x under 2 s
+        // (docs/algorithms/bvh_raytrace.md, "Dispatches"). The default light (16 samples) takes one.
+        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 16));
     return s;
 }
 

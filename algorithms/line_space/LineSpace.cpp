@@ -83,9 +83,10 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
                  "allow a scene with moving parts: rebuild the N-tree and its line spaces from the posed triangles "
                  "every frame they move (the `rebuild` stage; the disk cache is bypassed)",
                  ParamChange::Update)
-        // 2: at the defaults a ray costs ~4.4x a bvh_raytrace one, ~117 ms per sample and pixel at
-        // 4K on a GPU: ~0.23 s a dispatch, 8x under 2 s (docs/algorithms/line_space.md, "Dispatches").
-        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 2));
+        // 4: at the defaults one sample of every pixel of a 4K frame costs ~60 ms on a GPU (~6 s on
+        // llvmpipe here, ~100x slower), ~77 ms on a 2 M-triangle scene: at most ~0.3 s a dispatch, 6x
+        // under 2 s (docs/algorithms/line_space.md, "Dispatches").
+        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 4));
     return s;
 }
 
