@@ -25,6 +25,7 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
     host.resize({res, res});
     host.setScene(gpu);
     StageTimer timer;
+    timer.setSynchronous(options.synchronousStages);
     AlgorithmRun o;
     o.gbuffer = gbuffer.readBack();
     const FrameView frame{gbuffer, [&]() -> const CpuGBuffer& { return o.gbuffer; }, shot.camera, shot.light, 0};
@@ -48,6 +49,19 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
         o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
     }
     return o;
+}
+
+Shot withLight(Shot shot, LightType type) {
+    const glm::vec3 from = shot.light.position, to = shot.scene.bounds.center();
+    Light l;
+    l.type = type;
+    l.position = from;
+    l.target = to;
+    l.coneDeg = 40.0f;
+    l.size = glm::vec2(0.2f * shot.scene.bounds.radius());
+    l.samples = 4;  // a few: the brute-force template traces each against every triangle
+    shot.light = l;
+    return shot;
 }
 
 void printCase(std::ostream& os, const char* name, const std::map<std::string, ParamValue>& params) {

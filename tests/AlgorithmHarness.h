@@ -43,6 +43,10 @@ struct RunOptions {
     int resolution = kRes;
     /// Off: the host's timing mode (AlgorithmOptions::instrumentation), statistics compiled out.
     bool instrumentation = true;
+    /// Each stage waits for the GL (StageTimer::setSynchronous), so its CPU time is its wall time, as
+    /// the runner times a CPU rasteriser: an implementation that defers work to a later submission
+    /// (zink) would otherwise show only the time to issue it.
+    bool synchronousStages = false;
     /// Debug views read back into AlgorithmRun::views where the algorithm offers them.
     std::vector<std::string> debugViews;
     /// Called after the frame, before the reference, while the algorithm still exists and its
@@ -54,6 +58,11 @@ struct RunOptions {
 /// options.resolution² pixels (kRes² by default).
 AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std::map<std::string, ParamValue>& overrides,
                           const RunOptions& options = {});
+
+/// `shot` lit by a light of `type` placed where the shot's light is, aimed at its scene's centre (a
+/// 40° spot, an area light a fifth of the scene's radius wide with 4 samples): how the registry-driven
+/// tables (ConformanceGLTest, PortabilityGLTest) run every light an algorithm supports on one shot.
+Shot withLight(Shot shot, LightType type);
 
 /// Prints `name` and its parameter overrides, for gtest's names of parameterised cases.
 void printCase(std::ostream& os, const char* name, const std::map<std::string, ParamValue>& params);
