@@ -136,12 +136,7 @@ public:
     void computeVisibility(const FrameInputs& f) override {
         const int sampleCount = uploadLightSamples(samples_, f.light);
         const int budget = p_.samplesPerDispatch;
-        dispatches_ = (sampleCount + budget - 1) / budget;
         const glm::ivec2 res = f.gbuffer.resolution();
-        if (dispatches_ > 1 && accumRes_ != res) { // the state between dispatches (layout.glsl)
-            accum_ = makeTexture2D(options_.instrumentation ? GL_RG32UI : GL_R32UI, res.x, res.y);
-            accumRes_ = res;
-        }
 
         // One stage over every dispatch: the frame's cost, however it is split.
         f.timer.begin("trace");
@@ -156,16 +151,9 @@ public:
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
         bindPixelPassInputs(f);
         if (options_.instrumentation) bindDebugImage(1, nodesVisited_), bindDebugImage(2, overflow_);
-        // A single dispatch never touches the accumulation image.
-        glBindImageTexture(BVH_ACCUM_UNIT, dispatches_ > 1 ? accum_.id() : 0, 0, GL_FALSE, 0, GL_READ_WRITE,
-                           options_.instrumentation ? GL_RG32UI : GL_R32UI);
-        for (int first = 0; first < sampleCount; first += budget) {
-            trace_.set("uSampleFirst", first);
-            trace_.set("uSampleEnd", std::min(sampleCount, first + budget));
-            trace_.dispatch2D(res.x, res.y, 8, 8);
-            // The next dispatch reads the state this one wrote and adds to its counters.
-            if (first + budget < sampleCount) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-        }
+        // The state between dispatches (layout.glsl); a single dispatch never touches it.
+        batches_.begin(sampleCount, budget, res, options_.instrumentation, BVH_ACCUM_UNIT);
+        batches_.dispatch(trace_, res);
         finishPixelPass();
         f.timer.end();
         counters_.markStale();
@@ -181,7 +169,7 @@ public:
                                     {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
                                     {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
                                     {"loop_capped_pixels", double(c[BVH_C_CAPPED_PIXELS])},
-                                    {"sample_dispatches", double(dispatches_)},
+                                    {"sample_dispatches", double(batches_.dispatches())},
                                     {"bvh_nodes", double(nodeCount_)},
                                     {"bvh_leaves", double(leaves_)},
                                     {"bvh_depth", double(depth_)},
@@ -233,9 +221,7 @@ private:
     std::vector<glm::vec3> posed_;   ///< the posed scene positions the last refit used
     GpuCounters<BVH_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
-    GlTexture accum_;                ///< per-pixel state between a frame's dispatches (only if it has several)
-    glm::ivec2 accumRes_{0, 0};
-    int dispatches_ = 0;             ///< of the last frame
+    SampleBatches batches_; ///< the light's samples over dispatches, and their state between them
     uint32_t stepCap_ = 1;           ///< most loop passes of one ray's walk
     size_t nodeCount_ = 0, leaves_ = 0;
     int depth_ = 0;

@@ -227,12 +227,7 @@ public:
         const bool classify = p_.classify;
         const int sampleCount = uploadLightSamples(samples_, f.light);
         const int budget = p_.samplesPerDispatch;
-        dispatches_ = (sampleCount + budget - 1) / budget;
         const glm::ivec2 res = f.gbuffer.resolution();
-        if (dispatches_ > 1 && accumRes_ != res) { // the state between dispatches (layout.glsl)
-            accum_ = makeTexture2D(options_.instrumentation ? GL_RG32UI : GL_R32UI, res.x, res.y);
-            accumRes_ = res;
-        }
         const size_t classifyBytes = size_t(resolution_.x) * size_t(resolution_.y) * ls::classifyStride(size_t(sampleCount)) * 4;
         if (classify && classifyBytes > classifyBuf_.size()) classifyBuf_ = GlBuffer(classifyBytes, nullptr, 0);
         if (classify && !classifyProgram_)
@@ -261,16 +256,9 @@ public:
         if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
         bindPixelPassInputs(f);
         if (options_.instrumentation) bindDebugImage(1, nodesVisited_), bindDebugImage(2, loopCapped_);
-        // A single dispatch never touches the accumulation image.
-        glBindImageTexture(LS_ACCUM_UNIT, dispatches_ > 1 ? accum_.id() : 0, 0, GL_FALSE, 0, GL_READ_WRITE,
-                           options_.instrumentation ? GL_RG32UI : GL_R32UI);
-        for (int first = 0; first < sampleCount; first += budget) {
-            p.set("uSampleFirst", first);
-            p.set("uSampleEnd", std::min(sampleCount, first + budget));
-            p.dispatch2D(res.x, res.y, 8, 8);
-            // The next dispatch reads the state this one wrote and adds to its counters and classify bits.
-            if (first + budget < sampleCount) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-        }
+        // The state between dispatches (layout.glsl); a single dispatch never touches it.
+        batches_.begin(sampleCount, budget, res, options_.instrumentation, LS_ACCUM_UNIT);
+        batches_.dispatch(p, res);
         finishPixelPass();
         f.timer.end();
         counters_.markStale();
@@ -289,7 +277,7 @@ public:
         // The structure and what is measured in both modes; timing mode compiles the rest out.
         std::vector<Counter> out = {{"truncated_pixels", double(c[LS_C_TRUNCATED])},
                                     {"loop_capped_pixels", double(c[LS_C_CAPPED])},
-                                    {"sample_dispatches", double(dispatches_)},
+                                    {"sample_dispatches", double(batches_.dispatches())},
                                     {"subdivided_nodes", double(tree_.nodes.size())},
                                     {"build_ms", tree_.buildMs},
                                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
@@ -453,9 +441,7 @@ private:
     size_t nodesPerChunk_ = 1;
     int bitChunks_ = 1; ///< line-space pool blocks the compiled programs read (LS_BIT_CHUNK_COUNT)
     GlTexture nodesVisited_, loopCapped_;
-    GlTexture accum_;           ///< per-pixel state between a frame's dispatches (only if it has several)
-    glm::ivec2 accumRes_{0, 0};
-    int dispatches_ = 0;        ///< of the last frame
+    SampleBatches batches_; ///< the light's samples over dispatches, and their state between them
     uint32_t walkCap_ = 1, leafWalkCap_ = 1; ///< most passes of a ray's walk and of one leaf walk
     // classify: the frame to classify, the exact tracer (built on first use) and the result.
     CpuGBuffer pendingG_;

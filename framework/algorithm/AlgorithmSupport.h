@@ -4,6 +4,7 @@
 #include "framework/algorithm/ShadowAlgorithm.h"
 #include "framework/gl/Shader.h"
 
+#include <algorithm>
 #include <initializer_list>
 #include <type_traits>
 
@@ -71,6 +72,45 @@ inline int uploadLightSamples(GlBuffer& buffer, const Light& light) {
     buffer.upload(samples.data(), bytes);
     return int(samples.size());
 }
+
+/// A light's samples traced by a per-pixel pass over several dispatches of at most `budget`
+/// samples per pixel each, so that none runs into a GPU driver's watchdog (docs/architecture.md,
+/// "GPU portability"). Between dispatches each pixel keeps its state in an accumulation image
+/// (R32UI, RG32UI instrumented), allocated only when a frame takes more than one dispatch; the
+/// shader reads the batch from uSampleFirst / uSampleEnd (bvh_raytrace, line_space).
+class SampleBatches {
+public:
+    /// The frame's batches; (re)allocates the image when needed and binds it (or nothing, with a
+    /// single dispatch) at image unit `unit`.
+    void begin(int sampleCount, int budget, glm::ivec2 resolution, bool instrumentation, GLuint unit) {
+        samples_ = sampleCount;
+        budget_ = budget;
+        dispatches_ = (sampleCount + budget - 1) / budget;
+        const GLenum format = instrumentation ? GL_RG32UI : GL_R32UI;
+        if (dispatches_ > 1 && resolution_ != resolution) {
+            accum_ = makeTexture2D(format, resolution.x, resolution.y);
+            resolution_ = resolution;
+        }
+        glBindImageTexture(unit, dispatches_ > 1 ? accum_.id() : 0, 0, GL_FALSE, 0, GL_READ_WRITE, format);
+    }
+    /// Runs `program` once per batch over `resolution` in 8×8 groups; the next dispatch reads the
+    /// state the last one wrote and adds to its counters.
+    void dispatch(const ShaderProgram& program, glm::ivec2 resolution) const {
+        for (int first = 0; first < samples_; first += budget_) {
+            program.set("uSampleFirst", first);
+            program.set("uSampleEnd", std::min(samples_, first + budget_));
+            program.dispatch2D(resolution.x, resolution.y, 8, 8);
+            if (first + budget_ < samples_) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+    }
+    /// Dispatches of the last frame (the counter sample_dispatches).
+    int dispatches() const { return dispatches_; }
+
+private:
+    GlTexture accum_;
+    glm::ivec2 resolution_{0, 0};
+    int samples_ = 0, budget_ = 1, dispatches_ = 0;
+};
 
 /// A whole per-pixel pass: the inputs above, the debug images on units 1, 2, ... in order, the
 /// program in 8×8 groups over the image (its local size), then the barrier.
