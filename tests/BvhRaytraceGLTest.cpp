@@ -184,7 +184,7 @@ TEST_F(BvhRaytraceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
 // node they leave whenever they enter one inner child only) stops at its step cap: the frame
 // finishes, the pixels are counted and written shadowed, and every other pixel keeps its value. The
 // state survives the dispatches of a split area light.
-TEST_F(BvhRaytraceGLTest, AWalkThatCannotEndIsCappedAndWrittenShadowed) {
+TEST_F(BvhRaytraceGLTest, FaultWalkThatCannotEndIsCappedAndWrittenShadowed) {
     for (const auto& [name, shot, budget] : {std::tuple{"point", pointShot(), 16}, std::tuple{"area 16", areaShot(16, "grid"), 4}}) {
         SCOPED_TRACE(name);
         AlgorithmRun clean = run(shot, {{"samples_per_dispatch", budget}});

@@ -414,7 +414,7 @@ TEST_F(LineSpaceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
 // node, and its shaft found non-empty: how Algorithm 1 ends them all before the cap) or capped, so no
 // pixel comes out lighter. Every start region and last level, d = 1 (only the root's leaf walk, and
 // its cap), and a split area light, whose dispatches carry the state.
-TEST_F(LineSpaceGLTest, ANaNStepIsCappedAndWrittenShadowed) {
+TEST_F(LineSpaceGLTest, FaultNanStepIsCappedAndWrittenShadowed) {
     struct FaultCase {
         const char* name;
         Shot shot;
