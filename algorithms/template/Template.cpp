@@ -21,6 +21,7 @@ struct TemplateParams {
     bool largestFirst; ///< Rebuild: the triangle order uploaded in setScene()
     int groupSide;     ///< Recompile: a shader #define
     float rayOffset;   ///< Update: a uniform (the shared row, as the reference defines it)
+    int samplesPerDispatch; ///< Update: how a frame is split over dispatches (GPU portability)
 };
 
 /// 2. The schema: key, member, default, range, unit, doc and change kind, written once. Configs,
@@ -32,7 +33,10 @@ const ParamStruct<TemplateParams>& templateParams() {
                  "test triangles in order of decreasing area: big occluders end most rays early", ParamChange::Rebuild)
         .integer("group_side", &P::groupSide, 8, 4, 16, "px", "side of the square workgroup of the per-pixel pass",
                  ParamChange::Recompile)
-        .apply(rayOffsetRow(&P::rayOffset));
+        .apply(rayOffsetRow(&P::rayOffset))
+        // One sample costs a test against every triangle: 1 per dispatch keeps a dispatch one pass
+        // over the scene however many samples the light has (docs/architecture.md, rule 9).
+        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 1));
     return s;
 }
 
@@ -89,7 +93,10 @@ public:
         bindPixelPassInputs(f);
         if (options_.instrumentation) bindDebugImage(1, tests_);
         const glm::ivec2 r = f.gbuffer.resolution();
-        trace_.dispatch2D(r.x, r.y, p_.groupSide, p_.groupSide);
+        // The light's samples over dispatches of at most samples_per_dispatch each (one when they
+        // fit), each pixel's count carried between them in the accumulation image.
+        batches_.begin(samples, p_.samplesPerDispatch, r, options_.instrumentation, TEMPLATE_ACCUM_UNIT);
+        batches_.dispatch(trace_, r, {p_.groupSide, p_.groupSide});
         finishPixelPass();
         f.timer.end();
         counters_.markStale();
@@ -101,14 +108,17 @@ public:
         const auto& c = counters_.read();
         const double pixels = c[TEMPLATE_C_PIXELS];
         return {{"triangle_tests_mean", pixels > 0 ? double(counters_.wide(TEMPLATE_C_TESTS_LO)) / pixels : 0.0},
-                {"traced_pixels", pixels}};
+                {"traced_pixels", pixels},
+                {"sample_dispatches", double(batches_.dispatches())}};
     }
     std::vector<DebugView> debugViews() const override {
         if (!options_.instrumentation) return {};
         return {{"triangle_tests", tests_.id(), 0.0f, "tests"}};
     }
     size_t memoryBytes() const override { return order_.size() + counters_.size(); }
-    // No fixed-size structure (no stack, no pool), so nothing can overflow: overflowCount() stays 0.
+    // No fixed-size structure (no stack, no pool) and every loop ends at a count, so nothing can
+    // overflow: overflowCount() stays 0. (The accumulation image is a few bytes per pixel, and only
+    // when a frame takes several dispatches.)
 
 private:
     void compile() {
@@ -123,6 +133,7 @@ private:
     GlBuffer order_, samples_;
     GpuCounters<TEMPLATE_COUNTER_WORDS> counters_;
     GlTexture tests_;
+    SampleBatches batches_; ///< the light's samples over dispatches, and their state between them
 };
 
 } // namespace

@@ -77,7 +77,7 @@ inline int uploadLightSamples(GlBuffer& buffer, const Light& light) {
 /// samples per pixel each, so that none runs into a GPU driver's watchdog (docs/architecture.md,
 /// "GPU portability"). Between dispatches each pixel keeps its state in an accumulation image
 /// (R32UI, RG32UI instrumented), allocated only when a frame takes more than one dispatch; the
-/// shader reads the batch from uSampleFirst / uSampleEnd (bvh_raytrace, line_space).
+/// shader reads the batch from uSampleFirst / uSampleEnd (bvh_raytrace, line_space, template).
 class SampleBatches {
 public:
     /// The frame's batches; (re)allocates the image when needed and binds it (or nothing, with a
@@ -93,13 +93,13 @@ public:
         }
         glBindImageTexture(unit, dispatches_ > 1 ? accum_.id() : 0, 0, GL_FALSE, 0, GL_READ_WRITE, format);
     }
-    /// Runs `program` once per batch over `resolution` in 8×8 groups; the next dispatch reads the
-    /// state the last one wrote and adds to its counters.
-    void dispatch(const ShaderProgram& program, glm::ivec2 resolution) const {
+    /// Runs `program` once per batch over `resolution` in groups of `group` (the program's local
+    /// size); the next dispatch reads the state the last one wrote and adds to its counters.
+    void dispatch(const ShaderProgram& program, glm::ivec2 resolution, glm::ivec2 group = {8, 8}) const {
         for (int first = 0; first < samples_; first += budget_) {
             program.set("uSampleFirst", first);
             program.set("uSampleEnd", std::min(samples_, first + budget_));
-            program.dispatch2D(resolution.x, resolution.y, 8, 8);
+            program.dispatch2D(resolution.x, resolution.y, group.x, group.y);
             if (first + budget_ < samples_) glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
         }
     }

@@ -6,3 +6,8 @@
 #define TEMPLATE_C_TESTS_LO 1
 #define TEMPLATE_C_TESTS_HI 2
 #define TEMPLATE_COUNTER_WORDS 3
+// A light with more samples than samples_per_dispatch takes several dispatches (SampleBatches,
+// framework/algorithm/AlgorithmSupport.h); between them each traced pixel keeps its unblocked
+// samples so far in the accumulation image at this image unit (R32UI; RG32UI when instrumented:
+// y = triangle tests so far).
+#define TEMPLATE_ACCUM_UNIT 2

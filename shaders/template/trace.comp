@@ -2,6 +2,11 @@
 // template: one invocation per pixel casts the reference's shadow rays (origin p + n * offset, one
 // per light sample) against every triangle, in the order setScene() uploaded, and stops at the first
 // hit. O(pixels × triangles): a correct baseline for small scenes and a starting point to copy.
+// It follows the GPU-portability checklist (docs/architecture.md): one dispatch traces the samples
+// [uSampleFirst, uSampleEnd) of every pixel (at most samples_per_dispatch), so that no dispatch runs
+// into a driver's watchdog at any light.samples; a light with more takes several dispatches, which
+// carry each pixel's count in the accumulation image, and the last writes visibility. Every loop is
+// bounded by a count (triangles, samples), so nothing here can overflow or run away.
 #include "common/instrumentation.glsl"
 #include "common/light.glsl"
 #include "common/scene.glsl"
@@ -19,9 +24,13 @@ layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 #if SHADOWLAB_INSTRUMENTATION // statistics: compiled out in timing mode
 layout(r32f, binding = 1) writeonly uniform image2D uTests; // debug view: triangle tests per pixel
+layout(rg32ui, binding = TEMPLATE_ACCUM_UNIT) uniform uimage2D uAccum; // between dispatches: x unblocked, y tests
+#else
+layout(r32ui, binding = TEMPLATE_ACCUM_UNIT) uniform uimage2D uAccum;  // between dispatches: unblocked samples
 #endif
 uniform float uRayOffset;    // world units, the reference's
 uniform int uSampleCount;    // light samples (1 for point and spot lights)
+uniform int uSampleFirst, uSampleEnd; // the samples this dispatch traces, [first, end)
 uniform uint uTriangleCount;
 
 const float kInf = uintBitsToFloat(0x7F800000u);
@@ -41,37 +50,47 @@ void addWide(int lo, uint value) COUNTER_ADD_WIDE(counters, lo, value)
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(px, imageSize(uVisibility)))) return;
+    bool firstDispatch = uSampleFirst == 0, lastDispatch = uSampleEnd >= uSampleCount;
     vec4 pos = texelFetch(uPosition, px, 0);
     float visibility = 1.0; // background: nothing to shadow (the reference's convention)
-    uint tests = 0u;
+    uint tests = 0u, testsAll = 0u; // this dispatch's triangle tests; with the earlier ones'
     if (pos.w >= 0.5) {
         vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
         visibility = 0.0; // not reached by the light (the metrics skip these pixels)
         if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
             vec3 o = p + n * uRayOffset;
-            int count = lightIsDirectional() ? 1 : uSampleCount;
-            float unblocked = 0.0;
-            for (int s = 0; s < count; ++s) {
+            bool directional = lightIsDirectional();
+            int count = directional ? 1 : uSampleCount, end = directional ? 1 : uSampleEnd;
+            uint unblocked = 0u; // samples the earlier dispatches found unblocked, then this one's
+            if (!firstDispatch) {
+                uvec4 a = imageLoad(uAccum, px);
+                unblocked = a.x;
+                testsAll = a.y; // 0 in timing mode (R32UI reads y as 0)
+            }
+            for (int s = uSampleFirst; s < end; ++s) {
                 WatertightRay r;
-                if (lightIsDirectional()) {
+                if (directional) {
                     r = watertightRay(o, -uLightDirection, kInf);
                 } else {
                     vec3 d = lightSamples[s].xyz - o;
                     float dist = length(d);
-                    if (!(dist > 0.0)) { unblocked += 1.0; continue; } // origin on the sample
+                    if (!(dist > 0.0)) { ++unblocked; continue; } // origin on the sample
                     r = watertightRay(o, d / dist, max(0.0, dist - uRayOffset));
                 }
-                if (!occluded(r, tests)) unblocked += 1.0;
+                if (!occluded(r, tests)) ++unblocked;
             }
-            visibility = unblocked / float(count);
+            testsAll += tests;
+            if (lastDispatch) visibility = float(unblocked) / float(count);
+            else imageStore(uAccum, px, uvec4(unblocked, testsAll, 0u, 0u));
 #if SHADOWLAB_INSTRUMENTATION
-            atomicAdd(counters[TEMPLATE_C_PIXELS], 1u);
+            if (lastDispatch) atomicAdd(counters[TEMPLATE_C_PIXELS], 1u);
             addWide(TEMPLATE_C_TESTS_LO, tests);
 #endif
         }
     }
+    if (!lastDispatch) return;
     imageStore(uVisibility, px, vec4(visibility));
 #if SHADOWLAB_INSTRUMENTATION
-    imageStore(uTests, px, vec4(float(tests)));
+    imageStore(uTests, px, vec4(float(testsAll)));
 #endif
 }
