@@ -117,8 +117,8 @@ public:
     }
     size_t memoryBytes() const override { return order_.size() + counters_.size(); }
     // No fixed-size structure (no stack, no pool) and every loop ends at a count, so nothing can
-    // overflow: overflowCount() stays 0. (The accumulation image is a few bytes per pixel, and only
-    // when a frame takes several dispatches.)
+    // overflow: overflowCount() stays 0. Not in memoryBytes(), as in bvh_raytrace and line_space:
+    // the accumulation image (per pixel, only when a frame takes several dispatches).
 
 private:
     void compile() {
