@@ -18,6 +18,8 @@ namespace {
 struct PsvParams {
     bool wedge, randomOrder, frontFaceCulling, depthSkip, transparency;
     std::string wedgeBound; ///< "exact" | "distance" | "vertices"
+    std::string traversal;  ///< "auto" | "stack" | "stackless" | "hybrid"
+    int hybridStack; ///< hybrid traversal's stack, nodes
     int seed;        ///< of the insertion order
     int stackSize;   ///< query stack, nodes
     float rayOffset; ///< × scene radius
@@ -52,6 +54,15 @@ const ParamStruct<PsvParams>& psvParams() {
         // node crossed in the build, a compare per capping node in the query; docs/algorithms/psv.md).
         .boolean("depth_skip", &P::depthSkip, false,
                  "skip a capping node's subtree when the point is nearer the light than all of it (Mora et al. 2016); off = the 2015 paper",
+                 ParamChange::Recompile)
+        .choice("traversal", &P::traversal, "auto", {"auto", "stack", "stackless", "hybrid"},
+                "query walk (Mora et al. 2016): an explicit stack (the 2015 paper; may overflow), none "
+                "(stackless: each triangle's escape node, written by the build, leads back up), or a "
+                "short stack that walks stacklessly where it is full (hybrid); the same image; auto: "
+                "see docs/algorithms/psv.md",
+                ParamChange::Recompile)
+        .integer("hybrid_stack", &P::hybridStack, 8, 1, 256, "nodes",
+                 "hybrid traversal: stack entries before an intersection child is walked stacklessly",
                  ParamChange::Recompile)
         .apply(stackSizeRow(&P::stackSize, 32))
         .boolean("transparency", &P::transparency, false,
@@ -148,6 +159,8 @@ public:
                 {"culled_edge_on", double(c[PSV_C_CULLED_EDGE_ON])},
                 {"culled_occluded", double(c[PSV_C_CULLED_OCCLUDED])},
                 {"insert_depth_max", double(c[PSV_C_INSERT_DEPTH_MAX])},
+                {"close_calls", double(c[PSV_C_CLOSE_CALLS])},
+                {"stackless_walks", double(c[PSV_C_STACKLESS_WALKS])},
                 {"build_errors", double(c[PSV_C_BUILD_ERRORS])}};
     }
 
@@ -155,6 +168,8 @@ public:
         if (!options_.instrumentation) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
     }
+
+    std::vector<std::pair<std::string, std::string>> resolvedParams() const override { return {{"traversal", traversal()}}; }
 
     /// The tree (4n + 1 nodes of 32 bytes) plus the 96-byte counter block: exactly 128 (n + 1) bytes.
     /// Not counted: the per-pixel debug images (nodes_visited, stack_overflow), which every image
@@ -168,8 +183,18 @@ public:
     }
 
 private:
+    /// `auto`: see docs/algorithms/psv.md, "Traversals". X-ray shadows need the stack walk.
+    std::string traversal() const {
+        if (p_.traversal != "auto") return p_.traversal;
+        return p_.transparency ? "stack" : "stack";
+    }
+
     void compile() {
         auto flag = [](bool on) { return on ? std::string("1") : std::string("0"); };
+        const std::string walk = traversal();
+        if (p_.transparency && walk != "stack")
+            throw RuntimeError("psv: traversal = " + walk + " cannot take transparency (a capping plane's negative "
+                               "child would be a second pending side of one node): use traversal = stack");
         const ShaderDefines defines = {{"PSV_WEDGE", flag(p_.wedge)},
                                        {"PSV_WEDGE_BOUND", p_.wedgeBound == "vertices" ? "2" : p_.wedgeBound == "distance" ? "1" : "0"},
                                        {"PSV_RANDOM_ORDER", flag(p_.randomOrder)},
@@ -177,6 +202,8 @@ private:
                                        {"PSV_DEPTH_SKIP", flag(p_.depthSkip)},
                                        {"PSV_TRANSPARENCY", flag(p_.transparency)},
                                        {"PSV_STACK_SIZE", std::to_string(p_.stackSize)},
+                                       {"PSV_TRAVERSAL", walk == "stackless" ? "1" : walk == "hybrid" ? "2" : "0"},
+                                       {"PSV_HYBRID_STACK", std::to_string(p_.hybridStack)},
                                        instrumentationDefine(options_)};
         frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
         build_ = ShaderProgram::compute("psv/build.comp", defines);
@@ -206,6 +233,9 @@ private:
             p->set("uPermHalfBits", unsigned(permutation_.halfBits));
         }
         query_.set("uRayOffset", rayOffset);
+        // Half the tolerance: a plane value computed this close to 0 is within the tolerance in
+        // fact, which is what lets the query skip the subtrees on both sides (query.comp).
+        query_.set("uCloseCall", 0.5f * tolerance);
     }
 
     /// One invocation per triangle, as a 2D grid when n needs more than 65535 groups of 64.

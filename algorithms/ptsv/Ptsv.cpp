@@ -260,6 +260,7 @@ public:
                                     {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
         if (!options_.instrumentation) return out;
         out.insert(out.end(), {{"test_and_set", wide(PTSV_C_TESTS_LO)},
+                               {"close_calls", double(c[PTSV_C_CLOSE_CALLS])},
                                {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
                                {"iterations_max_pass1", double(c[PTSV_C_ITER_MAX_1])},
                                {"iterations_mean_pass1", jobs1 > 0 ? c[PTSV_C_ITER_SUM_1] / jobs1 : 0.0},
@@ -480,6 +481,9 @@ private:
             // the 16-bit normal's length is within 1e-3 of 1.
             p->set("uImplicitPad", rayOffset * 1.01f);
             p->set("uInvView", glm::inverse(view));
+            p->set("uRayOffset", rayOffset);
+            // Half the tolerance, as psv: a sample this close to a plane is decided by the ray test.
+            p->set("uCloseCall", 0.5f * tolerance);
         }
     }
 

@@ -8,6 +8,7 @@
 #define MT_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
 #include "common/light.glsl"
 #include "common/counters.glsl"
+#include "common/shadow_ray.glsl"
 #include "metric_tree/tree.glsl"
 #include "common/pixel_order.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -88,24 +89,6 @@ void mtTriangle(uint t, out vec3 v0, out vec3 v1, out vec3 v2) {
 #endif
 }
 
-// Segment o + t d, t in (0, tMax), against a triangle; both faces, like the reference. Barycentric
-// bounds are widened by 1e-6 so that a ray through an edge shared by two triangles hits one of them.
-bool mtHitTriangle(vec3 o, vec3 d, float tMax, vec3 v0, vec3 v1, vec3 v2) {
-    vec3 e1 = v1 - v0, e2 = v2 - v0;
-    vec3 pv = cross(d, e2);
-    float det = dot(e1, pv);
-    if (det == 0.0) return false; // the ray is parallel to the triangle's plane
-    float inv = 1.0 / det;
-    vec3 tv = o - v0;
-    float u = dot(tv, pv) * inv;
-    if (u < -1e-6 || u > 1.0 + 1e-6) return false;
-    vec3 qv = cross(tv, e1);
-    float w = dot(d, qv) * inv;
-    if (w < -1e-6 || u + w > 1.0 + 1e-6) return false;
-    float t = dot(e2, qv) * inv;
-    return t > 0.0 && t < tMax;
-}
-
 // Whether the shadow ray (q + t dir, t in (0, tMax)) crosses the slab between the cluster's two
 // planes (paper step 2); always with slabs off.
 bool mtCrossesSlabs(MtCluster c, vec3 q, vec3 dir, float tMax) {
@@ -131,6 +114,8 @@ Result query(vec3 q) {
     // The shadow ray: to the light (t in (0, 1)), or towards it forever for a directional light.
     vec3 dir = lightIsDirectional() ? -uLightDirection : uLightPosition - q;
     float tMax = lightIsDirectional() ? kMtInf : 1.0;
+    // Triangles are decided by the reference's own ray and test: the same decision, pixel for pixel.
+    WatertightRay ray = shadowRayToLight(q, uRayOffset);
     vec3 p = mtToLightSpace(q);
 #if MT_DEPTH_SKIP
     float depth = mtLightDepth(q);
@@ -187,7 +172,7 @@ Result query(vec3 q) {
             ++r.triangles;
             vec3 v0, v1, v2;
             mtTriangle(triangle, v0, v1, v2);
-            hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
+            hit = watertightHit(ray, v0, v1, v2);
         }
         if (hit) { r.visibility = 0.0; break; }
         if (trianglesEnd != 0u) ++r.fruitless;
@@ -212,7 +197,7 @@ void addWide(uint lo, uint value) {
 #if MT_QUERY_TILE
 // A cluster the tile's walk reached, for one pixel: the per-pixel query's cone test, then slabs
 // and triangles; true on a hit.
-bool testCluster(uint node, vec3 q, vec3 p, vec3 dir, float tMax, inout Result r) {
+bool testCluster(uint node, vec3 q, vec3 p, vec3 dir, float tMax, WatertightRay ray, inout Result r) {
     ++r.visited;
     int t = int(4u * node);
     vec4 a = uintBitsToFloat(texelFetch(uNodeTexels, t)), b = uintBitsToFloat(texelFetch(uNodeTexels, t + 1));
@@ -225,7 +210,7 @@ bool testCluster(uint node, vec3 q, vec3 p, vec3 dir, float tMax, inout Result r
         ++r.triangles;
         vec3 v0, v1, v2;
         mtTriangle(tri, v0, v1, v2);
-        hit = mtHitTriangle(q, dir, tMax, v0, v1, v2);
+        hit = watertightHit(ray, v0, v1, v2);
     }
     if (!hit) ++r.fruitless;
     return hit;
@@ -324,10 +309,11 @@ Result tileQuery(bool needs, vec3 q) {
     if (sTileFallback[tile]) return query(q);
     vec3 dir = lightIsDirectional() ? -uLightDirection : uLightPosition - q;
     float tMax = lightIsDirectional() ? kMtInf : 1.0;
+    WatertightRay ray = shadowRayToLight(q, uRayOffset);
     vec3 p = sPoint[i];
     uint count = sCandidateCount[tile];
     bool hit = false;
-    for (uint k = 0u; k < count && !hit; ++k) hit = testCluster(sCandidates[tile][k], q, p, dir, tMax, r);
+    for (uint k = 0u; k < count && !hit; ++k) hit = testCluster(sCandidates[tile][k], q, p, dir, tMax, ray, r);
     if (hit) r.visibility = 0.0;
     return r;
 }

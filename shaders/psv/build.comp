@@ -51,12 +51,20 @@ uint insertTriangle(uint t, out uint tested) {
     PsvWedgeTriangle wedgeTriangle = psvWedgeTriangle(v0, v1, v2);
 #endif
     uint node = 0u, slot = SLOT_POS; // the sentinel's `pos` holds the root
+    // The stackless walks' escape: the last node whose intersection child this descent took. A
+    // child field is set once, so the path this thread walks is the path to its frustum for good.
+    uint escape = 0u;
     uvec4 fields = psvFields(0u);
     while (true) {
+        if (slot == SLOT_INTER) escape = node;
         uint child = psvChild(fields, slot);
         if (child == 0u) {
             child = psvLinkChild(node, slot, root);
-            if (child == 0u) return PSV_C_INSERTED;
+            if (child == 0u) {
+                // Read by the query only, after this dispatch (nothing in the build reads it).
+                psvNodes[root + PSV_ESCAPE_NODE].minDepth = escape;
+                return PSV_C_INSERTED;
+            }
         }
         // Every link points at the first node of a frustum; anything else is a corrupt tree.
         if (child >= nodeCount || child % PSV_NODES_PER_TRIANGLE != 1u) return PSV_C_BUILD_ERRORS;

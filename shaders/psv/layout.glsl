@@ -30,7 +30,9 @@
 #define PSV_C_VISITED_HI 8        // ... and high 32 bits (carry added by whoever wraps LO)
 #define PSV_C_VISITED_MAX 9       // most nodes visited by one pixel
 #define PSV_C_STACK_OVERFLOW 10   // pixels whose traversal stack overflowed (written as shadowed)
-// Words 11..23 are reserved (kept so the block size, hence memory_bytes, stays fixed).
+#define PSV_C_CLOSE_CALLS 11      // triangles decided by the reference's ray test (plane too close to call)
+#define PSV_C_STACKLESS_WALKS 12  // stackless walks: 1 per pixel (stackless), 1 per full stack (hybrid)
+// Words 13..23 are reserved (kept so the block size, hence memory_bytes, stays fixed).
 
 // Below this light transmission a transparent query stops: the same cut-off as the reference
 // (EmbreeTracer::kOpaqueTransmission).

@@ -1,12 +1,30 @@
 #version 450
-// PSV query: Algorithm 2 of the paper, one invocation per pixel. It locates the G-buffer point in
-// the TOP tree with an explicit stack and writes its visibility: 1 lit, 0 shadowed, and with
-// PSV_TRANSPARENCY the product of (1 - opacity) of every frustum that contains it.
+// PSV query, one invocation per pixel: it locates the G-buffer point in the TOP tree and writes its
+// visibility: 1 lit, 0 shadowed, and with PSV_TRANSPARENCY the product of (1 - opacity) of every
+// frustum that contains it. Three walks of the same nodes (PSV_TRAVERSAL):
+//   0 stack (Gerhards et al. 2015, Algorithm 2): intersection children wait on an explicit stack;
+//     a full stack stops the pixel, written shadowed and counted.
+//   1 stackless (Mora et al. 2016): an intersection child is walked first, and where a subtree
+//     ends the walk jumps to its triangle's escape node (build.comp writes it), the deepest
+//     ancestor it was reached from through an intersection child, and takes that node's other
+//     side. No stack, so nothing to overflow.
+//   2 hybrid (Mora et al. 2016): the stack walk with a short stack (PSV_HYBRID_STACK); an
+//     intersection child that finds it full is walked stacklessly at once, up to its owner.
+// All three visit the same nodes and decide every triangle alike, so their images are identical.
+//
+// Exactness. A plane value within uCloseCall of 0 is too close to call (the rounding of the plane
+// and of the reference's ray test could disagree there). Such a triangle is decided by the
+// reference's own ray and watertight test (psvCloseCall), and only the nodes that can still hold q
+// are walked: at a shadow plane q goes down the frustum's negative side, since a triangle below
+// the positive child lies more than uTolerance from the plane and so does its whole frustum (the
+// plane passes through the light); at the capping plane, a point that is not inside all four
+// planes by more than uCloseCall goes to the ray test.
 #define PSV_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "common/counters.glsl"
 #include "psv/tree.glsl"
+#include "common/shadow_ray.glsl"
 #include "common/pixel_order.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -14,71 +32,192 @@ layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 uniform float uRayOffset; // world units: the reference's shadow-ray origin offset along the normal
+// World units: a plane value this small is too close to call (half the build's tolerance, so the
+// true value is within uTolerance, which the skipped subtrees keep from every plane).
+uniform float uCloseCall;
+
+#ifndef PSV_TRAVERSAL
+#define PSV_TRAVERSAL 0
+#endif
+#if PSV_TRAVERSAL != 0 && PSV_TRANSPARENCY
+#error "the stackless walks keep one pending side per node: x-ray shadows need the stack walk"
+#endif
 
 struct Result {
     float visibility;
-    uint visited;
+    uint visited, closeCalls, stacklessWalks;
     bool overflow;
 };
 
-Result query(vec3 q) {
-    Result r = Result(1.0, 0u, false);
-    uint stack[PSV_STACK_SIZE];
-    int sp = 0;
-#if PSV_DEPTH_SKIP
-    float depth = psvDepth(q);
-#endif
-#if PSV_WEDGE
-    float wedgeScale = psvWedgeScale(q);
-#endif
-    // Pushing onto a full stack would drop a subtree that may hold the occluder: stop and report.
-#define PSV_PUSH(node) { if (sp == PSV_STACK_SIZE) { r.overflow = true; break; } stack[sp++] = (node); }
-    uint node = psvNode(0u).pos;
-    while (true) {
-        if (node == 0u) {
-            if (sp == 0) break;
-            node = stack[--sp];
-        }
-        ++r.visited;
-        PsvNode n = psvNode(node);
-        float s = psvSigned(n.plane, q);
-        if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
-            // Only one side can hold frusta containing q; at s == 0 both sides would do, and the
-            // negative one keeps the edge shared by two triangles closed (their planes are exact
-            // opposites, so q is inside at least one of them).
-            uint next = s <= 0.0 ? node + 1u : n.pos;
-#if PSV_WEDGE
-            bool visitInter = n.inter != 0u && psvInWedge(s, wedgeScale, uintBitsToFloat(n.wedgeOrNeg));
-#else
-            bool visitInter = n.inter != 0u;
-#endif
-            if (visitInter) {
-                if (next == 0u) next = n.inter;
-                else PSV_PUSH(n.inter);
-            }
-            node = next;
-            continue;
-        }
-        // Capping plane: q is inside the frustum's three shadow planes.
-#if PSV_DEPTH_SKIP
-        // Mora et al. 2016: nothing in this subtree is nearer the light than q, so nothing in it
-        // can lie between q and the light.
-        if (depth <= uintBitsToFloat(n.minDepth)) { node = 0u; continue; }
-#endif
-        if (s < 0.0) { // behind the triangle: inside its shadow frustum
+// What the walk needs of the query point. The reference's ray is not kept here: it is built where
+// a close call needs it, so that its nine values do not stay live through the walk (registers).
+struct Query {
+    vec3 q;
+    float depth;      // psvDepth(q), for the depth skip
+    float wedgeScale; // psvWedgeScale(q)
+};
+
+// The light triangle t lets through to q (1 - opacity, 0 for opaque shadows).
+float psvTransmission(uint t) {
 #if PSV_TRANSPARENCY
-            uint triangle = node / PSV_NODES_PER_TRIANGLE - 1u;
-            r.visibility *= 1.0 - clamp(sceneMaterials[sceneTriangles[triangle].material].opacity, 0.0, 1.0);
-            if (r.visibility <= PSV_OPAQUE_TRANSMISSION) { r.visibility = 0.0; break; }
-            // Frusta behind this triangle (negative child) may hold q too; in front ones below.
-            if (n.wedgeOrNeg != 0u) PSV_PUSH(n.wedgeOrNeg);
+    return 1.0 - clamp(sceneMaterials[sceneTriangles[t].material].opacity, 0.0, 1.0);
 #else
-            r.visibility = 0.0;
-            break;
+    return 0.0;
+#endif
+}
+
+// Whether triangle t shadows q, asked where the walk found q behind (or too close to) t's capping
+// plane, after going down the negative side (or too close to) its three shadow planes. Its four
+// planes decide where q is inside each by more than uCloseCall; elsewhere the reference's ray test
+// decides (the same ray, the same watertight test, so the same answer). `clearly` tells which.
+bool psvShadows(Query Q, uint t, out bool clearly) {
+    uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
+    clearly = psvSigned(psvPlane(base), Q.q) < -uCloseCall && psvSigned(psvPlane(base + 1u), Q.q) < -uCloseCall &&
+              psvSigned(psvPlane(base + 2u), Q.q) < -uCloseCall && psvSigned(psvPlane(base + 3u), Q.q) < -uCloseCall;
+    if (clearly) return true;
+    return watertightHit(shadowRayToLight(Q.q, uRayOffset), sceneVertex(t, 0u), sceneVertex(t, 1u), sceneVertex(t, 2u));
+}
+
+#if PSV_DEPTH_SKIP
+// Mora et al. 2016: nothing in a capping node's subtree is nearer the light than q, so nothing in
+// it can lie between q and the light.
+#define PSV_SKIPS_DEPTH(Q, n) (Q.depth <= uintBitsToFloat(n.minDepth))
+#else
+#define PSV_SKIPS_DEPTH(Q, n) false
+#endif
+#if PSV_WEDGE
+#define PSV_VISITS_INTER(Q, n, s) (n.inter != 0u && psvInWedge(s, Q.wedgeScale, uintBitsToFloat(n.wedgeOrNeg)))
+#else
+#define PSV_VISITS_INTER(Q, n, s) (n.inter != 0u)
+#endif
+
+// The walks below have two loops: the inner one goes from node to node and stops at a capping
+// plane that q is behind or too close to; the outer one decides that triangle (psvShadows) and
+// goes on. Deciding it inside the node loop would cost every node: a SIMD back end (llvmpipe)
+// runs a branch's body for the whole group whenever one lane takes it.
+
+#if PSV_TRAVERSAL != 0
+// Walks the subtree entered at `node` without a stack, until it is done: false when it reached
+// `owner` (the node whose intersection child it is; 0 for the whole tree) with q still lit, true
+// when q is in shadow. Each node is entered once from above and, if its intersection child was
+// walked first, once more from an escape (`second`), when the walk takes the side it did not take
+// first. That choice is made again from the same plane value (the same code on the same operands),
+// so the walk visits exactly the nodes the stack walk visits.
+bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
+    bool second = false;
+    while (true) {
+        uint cap = 0u; // a capping node q is behind or too close to, decided outside the node loop
+        while (true) {
+            if (node == owner) return false;
+            ++r.visited;
+            PsvNode n = psvNode(node);
+            float s = psvSigned(n.plane, Q.q);
+            uint side; // the child on q's side of the plane (0: none)
+            if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
+                side = s <= uCloseCall ? node + 1u : n.pos;
+                if (!second && PSV_VISITS_INTER(Q, n, s)) { node = n.inter; continue; }
+            } else { // capping plane
+                if (!second && PSV_SKIPS_DEPTH(Q, n)) side = 0u;
+                else if (!second && s <= uCloseCall) { cap = node; break; }
+                else side = !second && n.inter != 0u ? n.inter : n.pos;
+            }
+            second = side == 0u;
+            node = second ? psvEscape((node - 1u) / PSV_NODES_PER_TRIANGLE) : side;
+        }
+        uint t = (cap - 1u) / PSV_NODES_PER_TRIANGLE;
+        bool clearly;
+        bool shadows = psvShadows(Q, t, clearly);
+        if (!clearly) ++r.closeCalls;
+        if (shadows) { r.visibility = 0.0; return true; }
+        // Lit by it: on to the subtree in front, as for a point in front of the plane. (The subtree
+        // behind it lies inside its frustum and more than uTolerance behind it: not q's.)
+        PsvNode n = psvNode(cap);
+        uint side = n.inter != 0u ? n.inter : n.pos;
+        second = side == 0u;
+        node = second ? psvEscape(t) : side;
+    }
+    return false; // not reached
+}
+#endif
+
+#if PSV_TRAVERSAL == 1
+Result query(Query Q) {
+    Result r = Result(1.0, 0u, 0u, 1u, false);
+    psvWalkStackless(Q, psvNode(0u).pos, 0u, r);
+    return r;
+}
+#else
+Result query(Query Q) {
+    Result r = Result(1.0, 0u, 0u, 0u, false);
+#if PSV_TRAVERSAL == 2
+#define PSV_STACK_ENTRIES PSV_HYBRID_STACK
+    // A full stack: the node loop stops, the intersection child is walked stacklessly up to its
+    // owner (in the outer loop, like a capping decision), and the stack walk goes on with `node`.
+#define PSV_PUSH(owner, child) { if (sp == PSV_STACK_ENTRIES) { subtree = (child); subtreeOwner = (owner); } else stack[sp++] = (child); }
+#else
+#define PSV_STACK_ENTRIES PSV_STACK_SIZE
+    // Pushing onto a full stack would drop a subtree that may hold the occluder: stop and report.
+#define PSV_PUSH(owner, child) { if (sp == PSV_STACK_ENTRIES) { r.overflow = true; walking = false; break; } stack[sp++] = (child); }
+#endif
+    uint stack[PSV_STACK_ENTRIES];
+    int sp = 0;
+    uint node = psvNode(0u).pos;
+    bool walking = true;
+    while (walking) {
+        uint cap = 0u;                         // a capping node q is behind or too close to
+        uint subtree = 0u, subtreeOwner = 0u;  // hybrid: an intersection child the full stack left
+        while (true) {
+            if (node == 0u) {
+                if (sp == 0) { walking = false; break; }
+                node = stack[--sp];
+            }
+            ++r.visited;
+            PsvNode n = psvNode(node);
+            float s = psvSigned(n.plane, Q.q);
+            if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
+                uint next = s <= uCloseCall ? node + 1u : n.pos;
+                if (PSV_VISITS_INTER(Q, n, s)) {
+                    if (next == 0u) next = n.inter;
+                    else PSV_PUSH(node, n.inter);
+                }
+                node = next;
+#if PSV_TRAVERSAL == 2
+                if (subtree != 0u) break;
+#endif
+                continue;
+            }
+            if (PSV_SKIPS_DEPTH(Q, n)) { node = 0u; continue; }
+            if (s <= uCloseCall) { cap = node; break; }
+            if (n.inter != 0u) PSV_PUSH(node, n.inter);
+            node = n.pos;
+#if PSV_TRAVERSAL == 2
+            if (subtree != 0u) break;
 #endif
         }
-        if (n.inter != 0u) PSV_PUSH(n.inter);
-        node = n.pos;
+        if (cap != 0u) {
+            uint t = (cap - 1u) / PSV_NODES_PER_TRIANGLE;
+            bool clearly;
+            bool shadows = psvShadows(Q, t, clearly);
+            if (!clearly) ++r.closeCalls;
+            PsvNode n = psvNode(cap);
+            if (shadows) {
+                r.visibility *= psvTransmission(t);
+                if (r.visibility <= PSV_OPAQUE_TRANSMISSION) { r.visibility = 0.0; break; }
+#if PSV_TRANSPARENCY
+                // Frusta behind this triangle (negative child) may hold q too, where q is clearly
+                // inside it (elsewhere they lie more than uTolerance from q); in front ones below.
+                if (clearly && n.wedgeOrNeg != 0u) PSV_PUSH(cap, n.wedgeOrNeg);
+#endif
+            }
+            if (n.inter != 0u) PSV_PUSH(cap, n.inter);
+            node = n.pos;
+        }
+#if PSV_TRAVERSAL == 2
+        if (subtree != 0u) {
+            ++r.stacklessWalks;
+            if (psvWalkStackless(Q, subtree, subtreeOwner, r)) break;
+        }
+#endif
     }
 #undef PSV_PUSH
     // An overflowed pixel is never reported lit: it is written shadowed and counted (a wrong dark
@@ -86,35 +225,50 @@ Result query(vec3 q) {
     if (r.overflow) r.visibility = 0.0;
     return r;
 }
+#endif
 
 #if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map
 layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
-shared uint sTraversed, sVisited, sVisitedMax, sOverflow;
+shared uint sTraversed, sVisited, sVisitedMax, sOverflow, sCloseCalls, sStackless;
 #endif
 
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
-    if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = 0u;
+    if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = sCloseCalls = sStackless = 0u;
     barrier();
 #endif
     ivec2 px = pixelOfInvocation();
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)
-        Result r = Result(1.0, 0u, false);
+        Result r = Result(1.0, 0u, 0u, 0u, false);
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // facing away from the light
             if (dot(n, toLight(p)) > 0.0) {
                 // The reference's ray origin: the same offset along the same (unnormalised) normal.
-                r = query(p + n * uRayOffset);
+                Query Q;
+                Q.q = p + n * uRayOffset;
+#if PSV_DEPTH_SKIP
+                Q.depth = psvDepth(Q.q);
+#else
+                Q.depth = 0.0;
+#endif
+#if PSV_WEDGE
+                Q.wedgeScale = psvWedgeScale(Q.q);
+#else
+                Q.wedgeScale = 1.0;
+#endif
+                r = query(Q);
                 visibility = r.visibility;
 #if SHADOWLAB_INSTRUMENTATION
                 atomicAdd(sTraversed, 1u);
                 atomicAdd(sVisited, r.visited);
                 atomicMax(sVisitedMax, r.visited);
                 if (r.overflow) atomicAdd(sOverflow, 1u);
+                if (r.closeCalls != 0u) atomicAdd(sCloseCalls, r.closeCalls);
+                if (r.stacklessWalks != 0u) atomicAdd(sStackless, r.stacklessWalks);
 #else
                 // Timing mode still counts every overflowed pixel (never a silent wrong image).
                 if (r.overflow) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], 1u);
@@ -134,6 +288,8 @@ void main() {
         COUNTER_ADD_WIDE(psvCounters, PSV_C_VISITED_LO, sVisited)
         atomicMax(psvCounters[PSV_C_VISITED_MAX], sVisitedMax);
         if (sOverflow != 0u) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], sOverflow);
+        if (sCloseCalls != 0u) atomicAdd(psvCounters[PSV_C_CLOSE_CALLS], sCloseCalls);
+        if (sStackless != 0u) atomicAdd(psvCounters[PSV_C_STACKLESS_WALKS], sStackless);
     }
 #endif
 }

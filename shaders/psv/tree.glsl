@@ -87,6 +87,13 @@ struct PsvFrustum {
 // Triangle t's status as frusta.comp decided it: the minDepth field of its first node.
 uint psvStoredStatus(uint t) { return texelFetch(uPsvNodeTexels, int(2u * (PSV_NODES_PER_TRIANGLE * t + 1u) + 1u)).w; }
 
+// Triangle t's escape node (Mora et al. 2016), for the stackless walks: the deepest node on the
+// path from the root to t's frustum where that path went down an intersection child (0: none).
+// build.comp writes it once t is linked, in the minDepth field of t's second node (unused by a
+// shadow plane), so it costs no memory.
+#define PSV_ESCAPE_NODE 1u // t's escape lives in node 4t + 1 + PSV_ESCAPE_NODE
+uint psvEscape(uint t) { return texelFetch(uPsvNodeTexels, int(2u * (PSV_NODES_PER_TRIANGLE * t + 1u + PSV_ESCAPE_NODE) + 1u)).w; }
+
 PsvFrustum psvDecideFrustum(vec3 v0, vec3 v1, vec3 v2) {
     PsvFrustum f;
     f.status = PSV_CASTER_OK;

@@ -67,3 +67,4 @@
 #define PTSV_C_SHADOWED 20       // receivers written shadowed by the resolve pass
 #define PTSV_C_SUBGROUP_MISMATCH 22 // ballot workgroups on subgroups of another width than compiled: jobs not run (overflow)
 #define PTSV_C_VOTE_RECOVERED 23 // votes or broadcasts that missed a lane (no reconvergence): decided alone, exact
+#define PTSV_C_CLOSE_CALLS 24    // sample tests too close to call by the planes: decided by the reference's ray test

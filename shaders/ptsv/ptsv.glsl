@@ -122,12 +122,6 @@ uint ptsvKeyAt(uint slot) { return ptsvSlotAt(slot).w; }
 // Written as float(status) by setup.comp: an exact small integer, never a denormal.
 uint ptsvStatus(uint triangle) { return uint(ptsvPlane(triangle, 7u).x); }
 
-// The exact per-sample test (the test of test-and-set): inside the three edge planes (closed) and
-// strictly behind the (biased) triangle plane, i.e. the segment from q to the light crosses it.
-bool ptsvInVolume(vec4 e0, vec4 e1, vec4 e2, vec4 cap, vec3 q) {
-    return ptsvSigned(e0, q) <= 0.0 && ptsvSigned(e1, q) <= 0.0 && ptsvSigned(e2, q) <= 0.0 && ptsvSigned(cap, q) < 0.0;
-}
-
 // Smallest and largest value of a plane over a world-space box (the n- and p-vertices).
 vec2 ptsvBoxRange(vec4 plane, vec3 bmin, vec3 bmax) {
     vec3 nv = mix(bmax, bmin, greaterThanEqual(plane.xyz, vec3(0.0)));

@@ -55,6 +55,7 @@
 #include "common/counters.glsl"
 #define PTSV_TEXEL_READS 1
 #include "ptsv/ptsv.glsl"
+#include "common/shadow_ray.glsl"
 #if PTSV_PER_INVOCATION
 // Every invocation walks a job of its own: no votes, and no subgroup width to depend on.
 layout(local_size_x = PTSV_INVOCATION_GROUP) in;
@@ -82,6 +83,8 @@ uniform uint uJobCapacity;  // entries of the job list
 uniform float uTolerance;   // world units: plane values this close to 0 count as touching
 uniform float uImplicitPad; // world units: how far a sample's q may lie outside its implicit node
 uniform mat4 uInvView;      // view → world (implicit bounds test in view space)
+uniform float uRayOffset;   // world units: the reference's shadow-ray origin offset (q is offset already)
+uniform float uCloseCall;   // world units: a sample's plane value this small is too close to call
 
 // ---- Votes ---------------------------------------------------------------------------------------
 #if !PTSV_PER_INVOCATION // (a per-invocation job votes with no one)
@@ -176,7 +179,7 @@ const vec4 kZero7[7] = vec4[7](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(
 vec4 gPlane[7] = kZero7; // world space: edges 0..2, triangle plane 3, culling planes 4..6
 vec4 gView[7] = kZero7;  // the same in view space (implicit bounds)
 uint gTriangle = 0u;
-uint gTests = 0u, gNodeTests = 0u, gLeafVisits = 0u, gAccepted = 0u, gIterations = 0u;
+uint gTests = 0u, gCloseCalls = 0u, gNodeTests = 0u, gLeafVisits = 0u, gAccepted = 0u, gIterations = 0u;
 uint gIterMax = 0u, gIterSum = 0u, gJobs = 0u; // this batch's jobs, added up once at the workgroup's end
 bool gTruncated = false; // a loop ended without its exit condition: the driver's iteration cap
 
@@ -237,27 +240,49 @@ bvec3 classifyHalf(uint childId, int depth, uint side) {
 }
 #endif
 
-// Tests the samples of cluster `key`'s tile against the volume and marks the shadowed ones.
+// Where sample q lies against the current triangle's shadow volume, by its four planes: 1 inside,
+// 0 outside, 2 too close to call (one plane value within uCloseCall of 0, where the rounding of
+// the plane and of the reference's ray test could disagree).
+uint volumeSide(vec3 q) {
+    vec4 v = vec4(ptsvSigned(gPlane[0], q), ptsvSigned(gPlane[1], q), ptsvSigned(gPlane[2], q), ptsvSigned(gPlane[3], q));
+    if (any(greaterThan(v, vec4(uCloseCall)))) return 0u;
+    return all(lessThan(v, vec4(-uCloseCall))) ? 1u : 2u;
+}
+
+// Tests the samples of cluster `key`'s tile against the volume and marks the shadowed ones. A
+// sample too close to call is decided by the reference's ray test, outside the sample loop: a SIMD
+// back end (llvmpipe) runs a branch's body for the whole group, so inside it would cost every test.
 void testSamples(uint key) {
     ++gIterations;
     uvec3 lo, hi;
     ptsvNodeRange(key, uLevels, lo, hi);
     uint first = (lo.y * uint(uTilesX) + lo.x) * ptsvTileSamples();
     uint s = lane;
-    for (; s < ptsvTileSamples(); s += SAMPLE_STEP) {
-        uvec4 slot = ptsvSlotAt(first + s); // q and key in one fetch
-        uint k = slot.w;
+    while (s < ptsvTileSamples()) {
+        uint closeSlot = 0xFFFFFFFFu;
+        vec3 closeQ = vec3(0.0);
+        for (; s < ptsvTileSamples(); s += SAMPLE_STEP) {
+            uvec4 slot = ptsvSlotAt(first + s); // q and key in one fetch
+            uint k = slot.w;
 #if PTSV_LEAF_CLUSTER_ONLY
-        if (k != key) continue;
+            if (k != key) continue;
 #else
-        if (k >= PTSV_KEY_AWAY) continue;
+            if (k >= PTSV_KEY_AWAY) continue;
 #endif
-        ++gTests;
+            ++gTests;
 #if PTSV_HEAT_MAP
-        atomicAdd(ptsvHeat[first + s], 1u);
+            atomicAdd(ptsvHeat[first + s], 1u);
 #endif
-        if (ptsvInVolume(gPlane[0], gPlane[1], gPlane[2], gPlane[3], uintBitsToFloat(slot.xyz)))
-            ptsvShadow[first + s] = 1u;
+            vec3 q = uintBitsToFloat(slot.xyz);
+            uint side = volumeSide(q);
+            if (side == 1u) ptsvShadow[first + s] = 1u;
+            if (side == 2u) { closeSlot = first + s; closeQ = q; s += SAMPLE_STEP; break; }
+        }
+        if (closeSlot == 0xFFFFFFFFu) break;
+        ++gCloseCalls;
+        if (watertightHit(shadowRayToLight(closeQ, uRayOffset), sceneVertex(gTriangle, 0u), sceneVertex(gTriangle, 1u),
+                          sceneVertex(gTriangle, 2u)))
+            ptsvShadow[closeSlot] = 1u;
     }
     if (s < ptsvTileSamples()) gTruncated = true;
     if (LEADER) ++gLeafVisits;
@@ -523,6 +548,7 @@ void main() {
 #if SHADOWLAB_INSTRUMENTATION
     if (gTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_TESTS_LO, gTests)
     if (gNodeTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_NODE_TESTS_LO, gNodeTests)
+    if (gCloseCalls != 0u) atomicAdd(ptsvCounters[PTSV_C_CLOSE_CALLS], gCloseCalls);
     if (LEADER) {
         if (gAccepted != 0u) atomicAdd(ptsvCounters[PTSV_C_ACCEPTED], gAccepted);
         if (gLeafVisits != 0u) atomicAdd(ptsvCounters[PTSV_C_LEAF_VISITS], gLeafVisits);
