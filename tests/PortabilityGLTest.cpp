@@ -115,7 +115,12 @@ const std::map<std::string, std::vector<Variant>>& variants() {
           {"exact_wedge", {{"wedge_bound", str("exact")}}},
           {"depth_skip", {{"depth_skip", true}}},
           {"scene_order", {{"random_order", false}}},
-          {"transparency", {{"transparency", true}, {"stack_size", 64}}}}},
+          {"transparency", {{"transparency", true}, {"stack_size", 64}}},
+          {"stack", {{"traversal", str("stack")}}},
+          {"stackless", {{"traversal", str("stackless")}}},
+          {"stackless_depth_skip", {{"traversal", str("stackless")}, {"depth_skip", true}}},
+          {"hybrid", {{"traversal", str("hybrid")}}},
+          {"hybrid_stack_1", {{"traversal", str("hybrid")}, {"hybrid_stack", 1}}}}},
         {"bvh_raytrace", {{"defaults", {}}, {"short_stack", {{"short_stack", true}}}}},
         {"ptsv",
          {{"auto", {}, false, ptsvAuto},
@@ -143,7 +148,7 @@ const std::map<std::string, std::vector<Variant>>& variants() {
 
 /// The keys whose every value is a kernel path of its own (PortabilityTableTest).
 const std::map<std::string, std::vector<std::string>> kPathKeys = {
-    {"psv", {"wedge", "depth_skip", "random_order", "transparency"}},
+    {"psv", {"wedge", "depth_skip", "random_order", "transparency", "traversal"}},
     {"bvh_raytrace", {"short_stack"}},
     {"ptsv", {"traversal", "vote", "two_pass", "bounds"}},
     {"metric_tree", {"query", "tile"}},

@@ -95,6 +95,27 @@ const AccuracyCase kAccuracy[] = {
     {"seed_7", thousandsOfTriangles, {{"seed", 7}}, 1e-4, 1e-2},
     // x-ray (opacities 0.5 and 0.3, and an opaque cylinder): RMSE is the real check here.
     {"transparency", transparentCasters, {{"transparency", true}, {"stack_size", 64}}, 1e-4, 1e-2},
+    // The Deep PSV walks (Mora et al. 2016), held to the same bound: they visit the same nodes.
+    {"stackless", thousandsOfTriangles, {{"traversal", std::string("stackless")}}, 1e-4, 1e-2},
+    {"stackless_shell", omniInsideShell, {{"traversal", std::string("stackless")}}, 1e-4, 1e-2},
+    {"stackless_directional", directionalObjects, {{"traversal", std::string("stackless")}}, 1e-4, 1e-2},
+    // Triangles piercing one another: capping planes with intersection children (a walk that
+    // skips them leaks light here).
+    {"stackless_intersecting", intersectingTriangles, {{"traversal", std::string("stackless")}}, 1e-4, 1e-2},
+    {"stackless_camera_inside", cameraInsideShadow, {{"traversal", std::string("stackless")}}, 1e-4, 1e-2},
+    {"stackless_depth_skip", thousandsOfTriangles, {{"traversal", std::string("stackless")}, {"depth_skip", true}}, 1e-4, 1e-2},
+    {"stackless_no_wedge", thousandsOfTriangles, {{"traversal", std::string("stackless")}, {"wedge", false}}, 1e-4, 1e-2},
+    {"stackless_ffc", omniInsideShell, {{"traversal", std::string("stackless")}, {"front_face_culling", true}}, 1e-4, 1e-2},
+    {"hybrid", thousandsOfTriangles, {{"traversal", std::string("hybrid")}}, 1e-4, 1e-2},
+    {"hybrid_shell", omniInsideShell, {{"traversal", std::string("hybrid")}}, 1e-4, 1e-2},
+    {"hybrid_intersecting", intersectingTriangles, {{"traversal", std::string("hybrid")}}, 1e-4, 1e-2},
+    // A one-entry stack: nearly every intersection child is walked stacklessly from its owner.
+    {"hybrid_stack_1", thousandsOfTriangles, {{"traversal", std::string("hybrid")}, {"hybrid_stack", 1}, {"wedge", false}}, 1e-4, 1e-2},
+    // Spot light: the triangles wholly outside the cone are culled (exact: a lit point's shadow ray
+    // runs inside the cone), the rest as for a point light at the apex.
+    {"spot", smokeSpotShot, {}, 1e-4, 1e-2},
+    {"spot_stackless", smokeSpotShot, {{"traversal", std::string("stackless")}}, 1e-4, 1e-2},
+    {"hybrid_depth_skip", directionalObjects, {{"traversal", std::string("hybrid")}, {"depth_skip", true}}, 1e-4, 1e-2},
 };
 
 class PsvAccuracyGLTest : public PsvGLTest, public ::testing::WithParamInterface<AccuracyCase> {};
@@ -185,6 +206,56 @@ TEST_F(PsvGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
         if (o.lit[i] && o.reference[i] < 0.5f) EXPECT_LT(o.visibility[i], 0.5f) << "pixel " << i << " lit by overflow";
 }
 
+// A deep tree for a small stack: with 4 entries the stack walk overflows on many pixels (written
+// shadowed, counted); the stackless walk has nothing to overflow and the hybrid walks stacklessly
+// where its 4 entries are full, so both are exact on every pixel.
+TEST_F(PsvGLTest, StacklessWalksAreExactWhereTheStackOverflows) {
+    const Shot s = thousandsOfTriangles();
+    const std::map<std::string, ParamValue> deep = {{"wedge", false}};
+    auto with = [&](std::map<std::string, ParamValue> extra) {
+        std::map<std::string, ParamValue> p = deep;
+        p.insert(extra.begin(), extra.end());
+        return p;
+    };
+    Outcome stack = run(s, with({{"traversal", std::string("stack")}, {"stack_size", 4}}));
+    Outcome stackless = run(s, with({{"traversal", std::string("stackless")}}));
+    Outcome hybrid = run(s, with({{"traversal", std::string("hybrid")}, {"hybrid_stack", 4}}));
+    std::printf("[psv] stack of 4: %.0f overflowing pixels, mismatch %.4f%%; stackless %.5f%% (%.1f nodes/px); hybrid of 4: "
+                "%.5f%% (%.0f stackless walks)\n",
+                stack.counters["stack_overflow_pixels"], 100 * stack.accuracy.mismatchRatio, 100 * stackless.accuracy.mismatchRatio,
+                stackless.counters["nodes_visited_mean"], 100 * hybrid.accuracy.mismatchRatio, hybrid.counters["stackless_walks"]);
+    ASSERT_GT(stack.counters["stack_overflow_pixels"], 100.0) << "the case must overflow a stack of 4";
+    EXPECT_GT(stack.accuracy.mismatchRatio, 0.0);
+    for (const Outcome* o : {&stackless, &hybrid}) {
+        EXPECT_EQ(o->accuracy.mismatchRatio, 0.0);
+        EXPECT_EQ(o->overflow, 0u);
+        EXPECT_EQ(o->counters.at("stack_overflow_pixels"), 0.0);
+    }
+    EXPECT_GT(hybrid.counters["stackless_walks"], 100.0) << "the hybrid's stack must fill";
+    // The same nodes are visited by all three walks (the stackless one enters a node twice where it
+    // walked its intersection child first, and counts both visits).
+    Outcome wide = run(s, with({{"traversal", std::string("stack")}, {"stack_size", 256}}));
+    EXPECT_EQ(wide.visibility, stackless.visibility);
+    EXPECT_EQ(wide.visibility, hybrid.visibility);
+}
+
+// x-ray shadows keep a capping plane's negative child pending besides its other side, which one
+// escape per triangle cannot express: the stackless walks refuse transparency by name.
+TEST_F(PsvGLTest, StacklessWalksRefuseTransparency) {
+    for (const char* walk : {"stackless", "hybrid"}) {
+        try {
+            run(transparentCasters(), {{"transparency", true}, {"traversal", std::string(walk)}}, false);
+            ADD_FAILURE() << walk << " with transparency should be refused";
+        } catch (const std::exception& e) {
+            EXPECT_NE(std::string(e.what()).find("traversal = stack"), std::string::npos) << e.what();
+        }
+    }
+    // auto picks the stack walk for x-ray shadows.
+    Outcome o = run(transparentCasters(), {{"transparency", true}, {"stack_size", 64}});
+    EXPECT_EQ(o.overflow, 0u);
+    EXPECT_LE(o.accuracy.rmse, 1e-2);
+}
+
 // The tree built by concurrent compare-and-swap, checked against the TOP tree's definition: every
 // caster linked exactly once, every child on the side of its parent's plane that its link says,
 // wedges covering every point of the triangles below them, depth bounds below every triangle.
@@ -226,7 +297,7 @@ void expectValidTopTree(const Shot& s, const Outcome& o) {
     EXPECT_EQ(unique.size(), all.size()) << "a frustum is linked twice";
     EXPECT_EQ(double(all.size()), o.counters.at("casters_inserted"));
     EXPECT_EQ(o.counters.at("casters_inserted") + o.counters.at("culled_occluded") + o.counters.at("culled_edge_on") +
-                  o.counters.at("culled_front_facing"), double(n));
+                  o.counters.at("culled_front_facing") + o.counters.at("culled_outside_cone"), double(n));
     EXPECT_EQ(o.counters.at("build_errors"), 0.0);
 
     size_t failures = 0; // stop after a few: one bad node would otherwise print thousands of lines
@@ -267,6 +338,19 @@ void expectValidTopTree(const Shot& s, const Outcome& o) {
             }
         }
     }
+    // Each triangle's escape (stackless walks): the deepest node its path from the root leaves
+    // through an intersection child, 0 for none.
+    std::function<void(uint32_t, uint32_t)> escapes = [&](uint32_t root, uint32_t lastInter) {
+        const uint32_t t = (root - 1) / 4;
+        expect(nodes[root + 1].minDepth == lastInter, "escape is not the deepest intersection ancestor", root + 1, t);
+        for (uint32_t i = 0; i < 4; ++i) {
+            const psv::NodeGpu& nd = nodes[root + i];
+            if (nd.pos) escapes(nd.pos, lastInter);
+            if (nd.inter) escapes(nd.inter, root + i);
+            if (i == 3 && nd.wedgeOrNeg) escapes(nd.wedgeOrNeg, lastInter);
+        }
+    };
+    if (nodes[0].pos) escapes(nodes[0].pos, 0);
     std::printf("[psv] %s light: %zu frusta linked, %.0f occluded dropped, insertion depth %.0f\n",
                 directional ? "directional" : "point", all.size(), o.counters.at("culled_occluded"),
                 o.counters.at("insert_depth_max"));
@@ -280,6 +364,12 @@ TEST_F(PsvGLTest, ConcurrentBuildYieldsAValidTopTree) {
         for (const char* wedge : {"distance", "exact"})
             expectValidTopTree(s, run(s, {{"depth_skip", true}, {"wedge_bound", std::string(wedge)}}, false));
     }
+    // A spot light culls the triangles outside its cone: every triangle is still accounted for.
+    Shot spot = smokeSpotShot();
+    spot.light.coneDeg = 12.0f;
+    Outcome o = run(spot, {}, false);
+    EXPECT_GT(o.counters.at("culled_outside_cone"), 100.0) << "the cone should leave triangles out";
+    expectValidTopTree(spot, o);
     // Transparency keeps the triangles behind capping planes (negative children): checked too.
     Shot x = transparentCasters();
     expectValidTopTree(x, run(x, {{"transparency", true}, {"depth_skip", true}}, false));

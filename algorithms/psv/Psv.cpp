@@ -134,8 +134,7 @@ public:
         f.timer.end();
 
         // Light culling: a point light sees every direction and a directional light the whole
-        // scene, so a light-view frustum culls nothing for the lights psv supports (a spot light
-        // would cull the triangles outside its cone).
+        // scene; a spot light's cone culls the triangles wholly outside it (frusta.comp).
         f.timer.begin("traverse");
         if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
         else runPixelPass(f, query_, {});
@@ -157,6 +156,7 @@ public:
                 {"casters_inserted", double(c[PSV_C_INSERTED])},
                 {"culled_front_facing", double(c[PSV_C_CULLED_FACING])},
                 {"culled_edge_on", double(c[PSV_C_CULLED_EDGE_ON])},
+                {"culled_outside_cone", double(c[PSV_C_CULLED_CONE])},
                 {"culled_occluded", double(c[PSV_C_CULLED_OCCLUDED])},
                 {"insert_depth_max", double(c[PSV_C_INSERT_DEPTH_MAX])},
                 {"close_calls", double(c[PSV_C_CLOSE_CALLS])},
@@ -218,7 +218,7 @@ private:
         // shadow planes pass through it); 4e-6 of it is well above float error, and only costs
         // extra intersection-child visits for triangles that close to a plane.
         float magnitude = glm::length(center) + radius;
-        if (light.type == LightType::Point) magnitude = std::max(magnitude, glm::length(light.position));
+        if (light.type != LightType::Directional) magnitude = std::max(magnitude, glm::length(light.position));
         const float tolerance = 4e-6f * magnitude;
         const glm::vec3 depthOrigin = center - light.direction() * (2.0f * radius);
         const float rayOffset = p_.rayOffset * radius;
@@ -256,8 +256,8 @@ private:
 
 AlgorithmInfo psvInfo() {
     return makeAlgorithmInfo<Psv>("psv",
-                                    "partitioned shadow volumes: per-frame TOP tree of shadow frusta (compute), per-pixel stack query",
-                                    {LightType::Point, LightType::Directional}, true, &psvSchema);
+                                    "partitioned shadow volumes: per-frame TOP tree of shadow frusta (compute), per-pixel stack, stackless or hybrid query",
+                                    {LightType::Point, LightType::Spot, LightType::Directional}, true, &psvSchema);
 }
 
 } // namespace shadowlab

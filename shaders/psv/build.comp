@@ -40,6 +40,7 @@ uint insertTriangle(uint t, out uint tested) {
     uint status = psvStoredStatus(t);
     if (status == uint(PSV_CASTER_EDGE_ON)) return PSV_C_CULLED_EDGE_ON;
     if (status == uint(PSV_CASTER_FACING)) return PSV_C_CULLED_FACING;
+    if (status == uint(PSV_CASTER_OUTSIDE_CONE)) return PSV_C_CULLED_CONE;
     if (status != uint(PSV_CASTER_OK)) return PSV_C_BUILD_ERRORS;
     vec3 v0 = sceneVertex(t, 0u), v1 = sceneVertex(t, 1u), v2 = sceneVertex(t, 2u);
     uint root = PSV_NODES_PER_TRIANGLE * t + 1u;
@@ -108,14 +109,14 @@ uint insertTriangle(uint t, out uint tested) {
 #endif
 #if SHADOWLAB_INSTRUMENTATION
 shared uint sOutcomes[5]; // PSV_C_INSERTED .. PSV_C_BUILD_ERRORS
-shared uint sTestedMax;
+shared uint sTestedMax, sCone;
 #endif
 
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
     // Counters are summed per work group first: one global atomic per group and outcome.
     if (gl_LocalInvocationIndex < 5u) sOutcomes[gl_LocalInvocationIndex] = 0u;
-    if (gl_LocalInvocationIndex == 0u) sTestedMax = 0u;
+    if (gl_LocalInvocationIndex == 0u) sTestedMax = sCone = 0u;
     barrier();
 #endif
     uint k = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x;
@@ -123,7 +124,8 @@ void main() {
         uint tested;
         uint outcome = insertTriangle(psvPermute(k), tested);
 #if SHADOWLAB_INSTRUMENTATION
-        atomicAdd(sOutcomes[outcome], 1u);
+        if (outcome == PSV_C_CULLED_CONE) atomicAdd(sCone, 1u);
+        else atomicAdd(sOutcomes[outcome], 1u);
         atomicMax(sTestedMax, tested);
 #else
         // Timing mode: only errors are counted (they must stay 0 and are reported in both modes).
@@ -135,5 +137,6 @@ void main() {
     if (gl_LocalInvocationIndex < 5u && sOutcomes[gl_LocalInvocationIndex] != 0u)
         atomicAdd(psvCounters[gl_LocalInvocationIndex], sOutcomes[gl_LocalInvocationIndex]);
     if (gl_LocalInvocationIndex == 0u) atomicMax(psvCounters[PSV_C_INSERT_DEPTH_MAX], sTestedMax);
+    if (gl_LocalInvocationIndex == 0u && sCone != 0u) atomicAdd(psvCounters[PSV_C_CULLED_CONE], sCone);
 #endif
 }

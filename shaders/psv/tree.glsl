@@ -82,6 +82,7 @@ struct PsvFrustum {
 #define PSV_CASTER_OK 0
 #define PSV_CASTER_EDGE_ON 1
 #define PSV_CASTER_FACING 2
+#define PSV_CASTER_OUTSIDE_CONE 3 // spot light: wholly outside its cone
 #define PSV_REJECT_ALL vec4(0.0, 0.0, 0.0, 1.0) // a plane with everything outside it (+1)
 
 // Triangle t's status as frusta.comp decided it: the minDepth field of its first node.
@@ -94,9 +95,23 @@ uint psvStoredStatus(uint t) { return texelFetch(uPsvNodeTexels, int(2u * (PSV_N
 #define PSV_ESCAPE_NODE 1u // t's escape lives in node 4t + 1 + PSV_ESCAPE_NODE
 uint psvEscape(uint t) { return texelFetch(uPsvNodeTexels, int(2u * (PSV_NODES_PER_TRIANGLE * t + 1u + PSV_ESCAPE_NODE) + 1u)).w; }
 
+// Spot light: whether a triangle lies wholly outside the cone, by its bounding sphere (centroid,
+// farthest vertex) with margins that only keep more triangles. Such a triangle shadows nothing the
+// spot lights: the shadow ray of a lit point runs from the apex along a ray inside the cone.
+bool psvOutsideCone(vec3 v0, vec3 v1, vec3 v2) {
+    vec3 c = (v0 + v1 + v2) / 3.0;
+    float r = max(length(v0 - c), max(length(v1 - c), length(v2 - c))) * (1.0 + 1e-5) + uTolerance;
+    vec3 d = c - uLightPosition;
+    float dist = length(d);
+    if (!(dist > r)) return false; // the sphere holds the apex
+    float theta = acos(clamp(dot(d, uLightDirection) / dist, -1.0, 1.0));
+    return theta > acos(clamp(uLightCosCone, -1.0, 1.0)) + asin(r / dist) + 1e-4;
+}
+
 PsvFrustum psvDecideFrustum(vec3 v0, vec3 v1, vec3 v2) {
     PsvFrustum f;
     f.status = PSV_CASTER_OK;
+    if (uLightType == LIGHT_SPOT && psvOutsideCone(v0, v1, v2)) { f.status = PSV_CASTER_OUTSIDE_CONE; return f; }
     vec3 n = cross(v1 - v0, v2 - v0);
     float len = length(n);
     n = len > 0.0 ? n / len : vec3(0.0);
