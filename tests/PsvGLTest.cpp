@@ -196,7 +196,7 @@ TEST_F(PsvGLTest, FaultStatusDecidedTwiceNeverLinksUnwrittenNodes) {
 }
 
 TEST_F(PsvGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
-    Outcome o = run(thousandsOfTriangles(), {{"stack_size", 1}, {"wedge", false}});
+    Outcome o = run(thousandsOfTriangles(), {{"traversal", std::string("stack")}, {"stack_size", 1}, {"wedge", false}});
     const double pixels = o.counters["stack_overflow_pixels"];
     std::printf("[psv] stack_size 1: %.0f overflowing pixels, overflowCount %llu\n", pixels, (unsigned long long)o.overflow);
     ASSERT_GT(pixels, 0.0);

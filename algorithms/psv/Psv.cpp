@@ -55,13 +55,18 @@ const ParamStruct<PsvParams>& psvParams() {
         .boolean("depth_skip", &P::depthSkip, false,
                  "skip a capping node's subtree when the point is nearer the light than all of it (Mora et al. 2016); off = the 2015 paper",
                  ParamChange::Recompile)
+        // auto: stackless on every device (docs/algorithms/psv.md, "Traversals": it cannot overflow
+        // and was the fastest measured); the stack walk for x-ray shadows, which need it.
         .choice("traversal", &P::traversal, "auto", {"auto", "stack", "stackless", "hybrid"},
                 "query walk (Mora et al. 2016): an explicit stack (the 2015 paper; may overflow), none "
                 "(stackless: each triangle's escape node, written by the build, leads back up), or a "
                 "short stack that walks stacklessly where it is full (hybrid); the same image; auto: "
                 "see docs/algorithms/psv.md",
                 ParamChange::Recompile)
-        .integer("hybrid_stack", &P::hybridStack, 8, 1, 256, "nodes",
+        // 16 by measurement: on llvmpipe the hybrid is the faster the fewer times it switches (4, 8,
+        // 16, 32 entries: 1.41, 1.46, 1.21, 1.13 x the stack walk's traversal, engine scene, 512²),
+        // and 16 still halves the stack walk's 32 registers' worth of stack, the hybrid's point.
+        .integer("hybrid_stack", &P::hybridStack, 16, 1, 256, "nodes",
                  "hybrid traversal: stack entries before an intersection child is walked stacklessly",
                  ParamChange::Recompile)
         .apply(stackSizeRow(&P::stackSize, 32))
@@ -183,10 +188,10 @@ public:
     }
 
 private:
-    /// `auto`: see docs/algorithms/psv.md, "Traversals". X-ray shadows need the stack walk.
+    /// `auto`: stackless, or the stack walk for x-ray shadows (docs/algorithms/psv.md, "Traversals").
     std::string traversal() const {
         if (p_.traversal != "auto") return p_.traversal;
-        return p_.transparency ? "stack" : "stack";
+        return p_.transparency ? "stack" : "stackless";
     }
 
     void compile() {
