@@ -86,7 +86,13 @@ TEST_F(DeviceInfoGLTest, ThreadsAndBlockSizesResolveToTheDevice) {
     EXPECT_EQ(resolved("reference", {{"threads", 3}}).at("threads"), "3");
     EXPECT_EQ(resolved("line_space").at("max_block_mib"), std::to_string(maxShaderStorageBlockBytes() >> 20));
     EXPECT_EQ(resolved("line_space", {{"max_block_mib", 1}}).at("max_block_mib"), "1");
-    EXPECT_TRUE(resolved("psv").empty()); // nothing depends on the device
+}
+
+// psv's auto walk: stackless on every device, the stack walk for x-ray shadows.
+TEST_F(DeviceInfoGLTest, PsvAutoTraversalIsStacklessBesidesTransparency) {
+    EXPECT_EQ(resolved("psv").at("traversal"), "stackless");
+    EXPECT_EQ(resolved("psv", {{"transparency", true}}).at("traversal"), "stack");
+    EXPECT_EQ(resolved("psv", {{"traversal", std::string("hybrid")}}).at("traversal"), "hybrid");
 }
 
 TEST_F(DeviceInfoGLTest, DeviceRecordDescribesTheContext) {
