@@ -239,6 +239,25 @@ TEST_F(PsvGLTest, StacklessWalksAreExactWhereTheStackOverflows) {
     EXPECT_EQ(wide.visibility, hybrid.visibility);
 }
 
+// A corrupt escape (every escape leading back into its own triangle) would walk forever: the visit
+// cap stops such a pixel, writes it shadowed and counts it, in both stackless walks, and no pixel
+// is ever written lit by it.
+TEST_F(PsvGLTest, FaultEscapeLoopIsCappedAndWrittenShadowed) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_ESCAPE_LOOP", "1"}});
+    for (const char* walk : {"stackless", "hybrid"}) {
+        SCOPED_TRACE(walk);
+        Outcome o = run(thousandsOfTriangles(), {{"traversal", std::string(walk)}, {"hybrid_stack", 1}});
+        const double capped = o.counters["loop_capped_pixels"];
+        std::printf("[psv] %s with looping escapes: %.0f capped pixels of %zu lit\n", walk, capped, o.accuracy.litPixels);
+        ASSERT_GT(capped, 100.0);
+        EXPECT_EQ(o.overflow, uint64_t(capped));
+        EXPECT_EQ(o.counters["stack_overflow_pixels"], 0.0);
+        expectOverflowedPixelsShadowed(o, capped);
+        for (size_t i = 0; i < o.visibility.size(); ++i)
+            if (o.lit[i] && o.reference[i] < 0.5f) EXPECT_LT(o.visibility[i], 0.5f) << "pixel " << i << " lit by the fault";
+    }
+}
+
 // x-ray shadows keep a capping plane's negative child pending besides its other side, which one
 // escape per triangle cannot express: the stackless walks refuse transparency by name.
 TEST_F(PsvGLTest, StacklessWalksRefuseTransparency) {

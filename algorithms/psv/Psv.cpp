@@ -153,10 +153,13 @@ public:
         const double visited = double(counters_.wide(PSV_C_VISITED_LO));
         const double traversed = c[PSV_C_TRAVERSED];
         if (!options_.instrumentation) // timing mode: what is still measured
-            return {{"stack_overflow_pixels", double(c[PSV_C_STACK_OVERFLOW])}, {"build_errors", double(c[PSV_C_BUILD_ERRORS])}};
+            return {{"stack_overflow_pixels", double(c[PSV_C_STACK_OVERFLOW])},
+                    {"loop_capped_pixels", double(c[PSV_C_LOOP_CAPPED])},
+                    {"build_errors", double(c[PSV_C_BUILD_ERRORS])}};
         return {{"nodes_visited_mean", traversed > 0 ? visited / traversed : 0.0},
                 {"nodes_visited_max", double(c[PSV_C_VISITED_MAX])},
                 {"stack_overflow_pixels", double(c[PSV_C_STACK_OVERFLOW])},
+                {"loop_capped_pixels", double(c[PSV_C_LOOP_CAPPED])},
                 {"traversed_pixels", traversed},
                 {"casters_inserted", double(c[PSV_C_INSERTED])},
                 {"culled_front_facing", double(c[PSV_C_CULLED_FACING])},
@@ -181,10 +184,11 @@ public:
     /// algorithm could add and which do not depend on the scene.
     size_t memoryBytes() const override { return nodes_.size() + counters_.size(); }
 
-    /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
+    /// Pixels whose query stack overflowed or whose stackless walk hit its escape cap (both written
+    /// shadowed) plus build errors (must be 0).
     uint64_t overflowCount() const override {
         const auto& c = counters_.read();
-        return uint64_t(c[PSV_C_STACK_OVERFLOW]) + c[PSV_C_BUILD_ERRORS];
+        return uint64_t(c[PSV_C_STACK_OVERFLOW]) + c[PSV_C_LOOP_CAPPED] + c[PSV_C_BUILD_ERRORS];
     }
 
 private:

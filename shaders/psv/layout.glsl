@@ -33,7 +33,8 @@
 #define PSV_C_CLOSE_CALLS 11      // triangles decided by the reference's ray test (plane too close to call)
 #define PSV_C_STACKLESS_WALKS 12  // stackless walks: 1 per pixel (stackless), 1 per full stack (hybrid)
 #define PSV_C_CULLED_CONE 13      // spot light: triangles wholly outside its cone
-// Words 14..23 are reserved (kept so the block size, hence memory_bytes, stays fixed).
+#define PSV_C_LOOP_CAPPED 14      // pixels whose stackless walk hit its escape cap (written shadowed)
+// Words 15..23 are reserved (kept so the block size, hence memory_bytes, stays fixed).
 
 // Below this light transmission a transparent query stops: the same cut-off as the reference
 // (EmbreeTracer::kOpaqueTransmission).

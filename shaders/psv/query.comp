@@ -46,8 +46,16 @@ uniform float uCloseCall;
 struct Result {
     float visibility;
     uint visited, closeCalls, stacklessWalks;
-    bool overflow;
+    bool overflow; // a full stack, or (stackless walks) the escape cap: written shadowed, counted
+    bool capped;   // the escape cap
 };
+
+// A stackless walk goes down links (the tree has no cycles: a frustum is linked below nodes already
+// in it) and up escapes; each node is entered at most once from an escape, so one walk takes at
+// most 4n + 1 escapes. One more can only be a corrupt escape: the walk ends at its owner with
+// `capped` set, and the pixel is written shadowed and counted (never a hang). The count and the
+// cap are data flow into the jump, not a branch of the node loop (llvmpipe pays for every branch).
+uint psvEscapeCap() { return PSV_NODES_PER_TRIANGLE * uTriangleCount + 1u; }
 
 // What the walk needs of the query point. The reference's ray is not kept here: it is built where
 // a close call needs it, so that its nine values do not stay live through the walk (registers).
@@ -69,12 +77,14 @@ float psvTransmission(uint t) {
 // Whether triangle t shadows q, asked where the walk found q behind (or too close to) t's capping
 // plane, after going down the negative side (or too close to) its three shadow planes. Its four
 // planes decide where q is inside each by more than uCloseCall; elsewhere the reference's ray test
-// decides (the same ray, the same watertight test, so the same answer). `clearly` tells which.
-bool psvShadows(Query Q, uint t, out bool clearly) {
+// decides (the same ray, the same watertight test, so the same answer), counted in closeCalls.
+// `clearly` tells which.
+bool psvShadows(Query Q, uint t, out bool clearly, inout Result r) {
     uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
     clearly = psvSigned(psvPlane(base), Q.q) < -uCloseCall && psvSigned(psvPlane(base + 1u), Q.q) < -uCloseCall &&
               psvSigned(psvPlane(base + 2u), Q.q) < -uCloseCall && psvSigned(psvPlane(base + 3u), Q.q) < -uCloseCall;
     if (clearly) return true;
+    ++r.closeCalls;
     return watertightHit(shadowRayToLight(Q.q, uRayOffset), sceneVertex(t, 0u), sceneVertex(t, 1u), sceneVertex(t, 2u));
 }
 
@@ -105,6 +115,16 @@ bool psvShadows(Query Q, uint t, out bool clearly) {
 // so the walk visits exactly the nodes the stack walk visits.
 bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
     bool second = false;
+    uint escapes = 0u, escapeCap = psvEscapeCap();
+    // The next node: `side`, or where it is none the escape of `triangle`; the owner past the cap.
+#define PSV_STEP(side, triangle)                                                \
+    {                                                                           \
+        second = (side) == 0u;                                                  \
+        escapes += second ? 1u : 0u;                                            \
+        bool over = escapes > escapeCap;                                        \
+        r.capped = r.capped || over;                                            \
+        node = over ? owner : (second ? psvEscape(triangle) : (side));          \
+    }
     while (true) {
         uint cap = 0u; // a capping node q is behind or too close to, decided outside the node loop
         while (true) {
@@ -121,34 +141,31 @@ bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
                 else if (!second && s <= uCloseCall) { cap = node; break; }
                 else side = !second && n.inter != 0u ? n.inter : n.pos;
             }
-            second = side == 0u;
-            node = second ? psvEscape((node - 1u) / PSV_NODES_PER_TRIANGLE) : side;
+            PSV_STEP(side, (node - 1u) / PSV_NODES_PER_TRIANGLE)
         }
         uint t = (cap - 1u) / PSV_NODES_PER_TRIANGLE;
         bool clearly;
-        bool shadows = psvShadows(Q, t, clearly);
-        if (!clearly) ++r.closeCalls;
-        if (shadows) { r.visibility = 0.0; return true; }
+        if (psvShadows(Q, t, clearly, r)) { r.visibility = 0.0; return true; }
         // Lit by it: on to the subtree in front, as for a point in front of the plane. (The subtree
         // behind it lies inside its frustum and more than uTolerance behind it: not q's.)
         PsvNode n = psvNode(cap);
-        uint side = n.inter != 0u ? n.inter : n.pos;
-        second = side == 0u;
-        node = second ? psvEscape(t) : side;
+        PSV_STEP(n.inter != 0u ? n.inter : n.pos, t)
     }
+#undef PSV_STEP
     return false; // not reached
 }
 #endif
 
 #if PSV_TRAVERSAL == 1
 Result query(Query Q) {
-    Result r = Result(1.0, 0u, 0u, 1u, false);
+    Result r = Result(1.0, 0u, 0u, 1u, false, false);
     psvWalkStackless(Q, psvNode(0u).pos, 0u, r);
+    if (r.capped) { r.overflow = true; r.visibility = 0.0; }
     return r;
 }
 #else
 Result query(Query Q) {
-    Result r = Result(1.0, 0u, 0u, 0u, false);
+    Result r = Result(1.0, 0u, 0u, 0u, false, false);
 #if PSV_TRAVERSAL == 2
 #define PSV_STACK_ENTRIES PSV_HYBRID_STACK
     // A full stack: the node loop stops, the intersection child is walked stacklessly up to its
@@ -197,8 +214,7 @@ Result query(Query Q) {
         if (cap != 0u) {
             uint t = (cap - 1u) / PSV_NODES_PER_TRIANGLE;
             bool clearly;
-            bool shadows = psvShadows(Q, t, clearly);
-            if (!clearly) ++r.closeCalls;
+            bool shadows = psvShadows(Q, t, clearly, r);
             PsvNode n = psvNode(cap);
             if (shadows) {
                 r.visibility *= psvTransmission(t);
@@ -220,6 +236,7 @@ Result query(Query Q) {
 #endif
     }
 #undef PSV_PUSH
+    r.overflow = r.overflow || r.capped;
     // An overflowed pixel is never reported lit: it is written shadowed and counted (a wrong dark
     // pixel is visible in the overflow view and in overflowCount(); a silent light leak is not).
     if (r.overflow) r.visibility = 0.0;
@@ -230,19 +247,19 @@ Result query(Query Q) {
 #if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map
 layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
-shared uint sTraversed, sVisited, sVisitedMax, sOverflow, sCloseCalls, sStackless;
+shared uint sTraversed, sVisited, sVisitedMax, sOverflow, sCloseCalls, sStackless, sCapped;
 #endif
 
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
-    if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = sCloseCalls = sStackless = 0u;
+    if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = sCloseCalls = sStackless = sCapped = 0u;
     barrier();
 #endif
     ivec2 px = pixelOfInvocation();
     if (all(lessThan(px, imageSize(uVisibility)))) {
         vec4 pos = texelFetch(uPosition, px, 0);
         float visibility = 1.0; // background: nothing to shadow (the reference's convention)
-        Result r = Result(1.0, 0u, 0u, 0u, false);
+        Result r = Result(1.0, 0u, 0u, 0u, false, false);
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // facing away from the light, or outside a spot's cone
@@ -266,12 +283,14 @@ void main() {
                 atomicAdd(sTraversed, 1u);
                 atomicAdd(sVisited, r.visited);
                 atomicMax(sVisitedMax, r.visited);
-                if (r.overflow) atomicAdd(sOverflow, 1u);
+                if (r.overflow && !r.capped) atomicAdd(sOverflow, 1u);
+                if (r.capped) atomicAdd(sCapped, 1u);
                 if (r.closeCalls != 0u) atomicAdd(sCloseCalls, r.closeCalls);
                 if (r.stacklessWalks != 0u) atomicAdd(sStackless, r.stacklessWalks);
 #else
                 // Timing mode still counts every overflowed pixel (never a silent wrong image).
-                if (r.overflow) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], 1u);
+                if (r.overflow && !r.capped) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], 1u);
+                if (r.capped) atomicAdd(psvCounters[PSV_C_LOOP_CAPPED], 1u);
 #endif
             }
         }
@@ -290,6 +309,7 @@ void main() {
         if (sOverflow != 0u) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], sOverflow);
         if (sCloseCalls != 0u) atomicAdd(psvCounters[PSV_C_CLOSE_CALLS], sCloseCalls);
         if (sStackless != 0u) atomicAdd(psvCounters[PSV_C_STACKLESS_WALKS], sStackless);
+        if (sCapped != 0u) atomicAdd(psvCounters[PSV_C_LOOP_CAPPED], sCapped);
     }
 #endif
 }

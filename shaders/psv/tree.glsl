@@ -93,19 +93,31 @@ uint psvStoredStatus(uint t) { return texelFetch(uPsvNodeTexels, int(2u * (PSV_N
 // build.comp writes it once t is linked, in the minDepth field of t's second node (unused by a
 // shadow plane), so it costs no memory.
 #define PSV_ESCAPE_NODE 1u // t's escape lives in node 4t + 1 + PSV_ESCAPE_NODE
-uint psvEscape(uint t) { return texelFetch(uPsvNodeTexels, int(2u * (PSV_NODES_PER_TRIANGLE * t + 1u + PSV_ESCAPE_NODE) + 1u)).w; }
+uint psvEscape(uint t) {
+#if SHADOWLAB_FAULT_ESCAPE_LOOP
+    // Test fault (framework/gl/Shader.h): every escape leads back into its own triangle's first
+    // node, as a corrupt escape would: a walk that never ends unless its cap stops it.
+    return PSV_NODES_PER_TRIANGLE * t + 1u;
+#endif
+    return texelFetch(uPsvNodeTexels, int(2u * (PSV_NODES_PER_TRIANGLE * t + 1u + PSV_ESCAPE_NODE) + 1u)).w;
+}
 
 // Spot light: whether a triangle lies wholly outside the cone, by its bounding sphere (centroid,
 // farthest vertex) with margins that only keep more triangles. Such a triangle shadows nothing the
 // spot lights: the shadow ray of a lit point runs from the apex along a ray inside the cone.
+// Outside means: the angle θ to the axis exceeds the cone's half angle γ plus the sphere's angular
+// radius α, tested as cos θ < cos(γ + α) with sqrt and products only (GLSL leaves acos and asin
+// far less precise). γ ≤ 89° (the config's limit) and α < 90° keep γ + α below π, where cos falls.
 bool psvOutsideCone(vec3 v0, vec3 v1, vec3 v2) {
     vec3 c = (v0 + v1 + v2) / 3.0;
     float r = max(length(v0 - c), max(length(v1 - c), length(v2 - c))) * (1.0 + 1e-5) + uTolerance;
     vec3 d = c - uLightPosition;
     float dist = length(d);
     if (!(dist > r)) return false; // the sphere holds the apex
-    float theta = acos(clamp(dot(d, uLightDirection) / dist, -1.0, 1.0));
-    return theta > acos(clamp(uLightCosCone, -1.0, 1.0)) + asin(r / dist) + 1e-4;
+    float cosTheta = dot(d, uLightDirection) / dist;
+    float sinAlpha = r / dist, cosAlpha = sqrt(max(0.0, 1.0 - sinAlpha * sinAlpha));
+    float cosGamma = clamp(uLightCosCone, 0.0, 1.0), sinGamma = sqrt(max(0.0, 1.0 - cosGamma * cosGamma));
+    return cosTheta < cosGamma * cosAlpha - sinGamma * sinAlpha - 1e-4;
 }
 
 PsvFrustum psvDecideFrustum(vec3 v0, vec3 v1, vec3 v2) {
