@@ -7,6 +7,7 @@
 #include "algorithms/ptsv/Ptsv.h"
 #include "algorithms/reference/Reference.h"
 #include "algorithms/shadow_map/ShadowMap.h"
+#include "algorithms/shadow_volumes/ShadowVolumes.h"
 
 #include <algorithm>
 
@@ -21,6 +22,7 @@ const std::vector<AlgorithmInfo>& algorithmRegistry() {
         lineSpaceInfo(),
         ptsvInfo(),
         metricTreeInfo(),
+        shadowVolumesInfo(),
     };
     return registry;
 }

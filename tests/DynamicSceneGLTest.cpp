@@ -40,6 +40,7 @@ Json exactAlgorithms() {
                         {{"algorithm", "metric_tree"}, {"params", {{"cache", false}}}},
                         {{"algorithm", "metric_tree"}, {"id", "metric_tree_recluster"}, {"params", {{"cache", false}, {"motion", "recluster"}}}},
                         {{"algorithm", "ptsv"}},
+                        {{"algorithm", "shadow_volumes"}},
                         {{"algorithm", "bvh_raytrace"}}});
 }
 

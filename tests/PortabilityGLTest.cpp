@@ -142,6 +142,13 @@ const std::map<std::string, std::vector<Variant>>& variants() {
           {"tile_8x2", {{"tile", str("8x2")}}, false, tilePixels(16)},
           {"tile_8x4", {{"tile", str("8x4")}}, false, tilePixels(32)},
           {"tile_8x8", {{"tile", str("8x8")}}, false, tilePixels(64)}}},
+        // light_facing volumes are exact on closed meshes only, and both shots hold open ones: the
+        // accuracy table runs them (ShadowVolumesGLTest.cpp), in every cell through SUITES.
+        {"shadow_volumes",
+         {{"zfail", {}},
+          {"zpass", {{"method", str("zpass")}}},
+          {"hardware_depth_test", {{"depth_test", str("hardware")}}},
+          {"hardware_zpass", {{"depth_test", str("hardware")}, {"method", str("zpass")}}}}},
     };
     return table;
 }
@@ -152,6 +159,7 @@ const std::map<std::string, std::vector<std::string>> kPathKeys = {
     {"bvh_raytrace", {"short_stack"}},
     {"ptsv", {"traversal", "vote", "two_pass", "bounds"}},
     {"metric_tree", {"query", "tile"}},
+    {"shadow_volumes", {"method", "depth_test"}},
 };
 
 struct Case {

@@ -1,6 +1,8 @@
 #include "tests/ShadowTestScenes.h"
 
+#include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
+#include "tests/TestSupport.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -96,6 +98,18 @@ Shot cameraInsideShadow() {
     s.scene.append(makeSphere(0.3f, 300, Material{}), translate({0.8f, 0.3f, 0.8f}));
     s.camera = lookAt({0.2f, 0.8f, 0.3f}, {3.0f, 0.0f, 3.0f});
     s.light = pointLight({0.3f, 5.0f, 0.2f});
+    return s;
+}
+
+Shot engineOnGround() {
+    Shot s;
+    Scene e = loadGltf(kEngineGlb);
+    const float k = 3.0f / e.bounds.radius();
+    const glm::vec3 c = e.bounds.center();
+    s.scene = ground(12.0f);
+    s.scene.append(e, translate({0, 1.6f, 0}) * scale(glm::vec3(k)) * translate(-c));
+    s.camera = lookAt({4.0f, 4.5f, 5.5f}, {0, 1.2f, 0});
+    s.light = pointLight({3.0f, 8.0f, 2.0f});
     return s;
 }
 

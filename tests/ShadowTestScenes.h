@@ -45,6 +45,10 @@ Shot cameraInsideShadow();
 /// A few thousand triangles of closed meshes (a sphere and a tilted torus) under a point light.
 Shot thousandsOfTriangles();
 
+/// The 2CylinderEngine (a real CAD model, 110k triangles with many open edges), scaled to a radius
+/// of 3 over a 12 × 12 ground, under a point light.
+Shot engineOnGround();
+
 /// `s` with a 2 × 2 wall added in a plane that holds its point light, beside the scene's centre:
 /// a triangle whose shadow volume is empty (status "edge-on"), which shadow-volume algorithms cull.
 Shot withEdgeOnWall(Shot s);

@@ -109,16 +109,19 @@ public:
         const double pixels = c[TEMPLATE_C_PIXELS];
         return {{"triangle_tests_mean", pixels > 0 ? double(counters_.wide(TEMPLATE_C_TESTS_LO)) / pixels : 0.0},
                 {"traced_pixels", pixels},
-                {"sample_dispatches", double(batches_.dispatches())}};
+                {"sample_dispatches", double(batches_.dispatches())},
+                {"loop_capped_rays", double(c[TEMPLATE_C_CUT_LOOPS])}};
     }
     std::vector<DebugView> debugViews() const override {
         if (!options_.instrumentation) return {};
         return {{"triangle_tests", tests_.id(), 0.0f, "tests"}};
     }
     size_t memoryBytes() const override { return order_.size() + counters_.size(); }
-    // No fixed-size structure (no stack, no pool) and every loop ends at a count, so nothing can
-    // overflow: overflowCount() stays 0. Not in memoryBytes(), as in bvh_raytrace and line_space:
-    // the accumulation image (per pixel, only when a frame takes several dispatches).
+    // No fixed-size structure (no stack, no pool) and every loop ends at a count; a loop the device
+    // ends early (llvmpipe after 65,535 iterations) is counted, its ray taken as blocked.
+    uint64_t overflowCount() const override { return counters_.read()[TEMPLATE_C_CUT_LOOPS]; }
+    // Not in memoryBytes(), as in bvh_raytrace and line_space: the accumulation image (per pixel,
+    // only when a frame takes several dispatches).
 
 private:
     void compile() {

@@ -35,12 +35,20 @@ uniform uint uTriangleCount;
 
 const float kInf = uintBitsToFloat(0x7F800000u);
 
-// Any hit ends the ray; `tests` counts the triangles tested.
+// Any hit ends the ray; `tests` counts the triangles tested. A loop that stops short of its count
+// without a hit was ended from outside (llvmpipe ends a shader invocation's loops after 65,535
+// iterations in all: docs/architecture.md, rule 13): counted, and the ray taken as blocked, so the
+// pixel is never lit by mistake.
 bool occluded(WatertightRay r, inout uint tests) {
-    for (uint i = 0u; i < uTriangleCount; ++i) {
+    uint i = 0u;
+    for (; i < uTriangleCount; ++i) {
         ++tests;
         uint t = order[i];
         if (watertightHit(r, sceneVertex(t, 0u), sceneVertex(t, 1u), sceneVertex(t, 2u))) return true;
+    }
+    if (i < uTriangleCount) {
+        atomicAdd(counters[TEMPLATE_C_CUT_LOOPS], 1u);
+        return true;
     }
     return false;
 }

@@ -1,0 +1,77 @@
+#version 450
+// shadow_volumes, the resolve pass: one invocation per pixel turns the count into visibility.
+// Lit where the light reaches the point and faces it, and the stencil count is 0. The exact R32F
+// count decides where the 8-bit stencil wrapped (a multiple of 256 reads 0: counted, never lit by
+// mistake). With SV_CHECK (analytic ZFAIL), a pixel whose counts beyond and before the test point
+// do not differ by the eye's own count (eye_count.comp) lost or doubled a face: it is decided as a
+// close call. A close call (volume.frag) is listed, for the reference's own ray test against every
+// triangle (close_rays.comp), which then writes its visibility (written here as the stencil says,
+// until then). The list holds one entry per pixel: it cannot overflow.
+#include "common/instrumentation.glsl"
+#include "common/light.glsl"
+#include "common/counters.glsl"
+#include "shadow_volumes/layout.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0) uniform sampler2D uPosition;
+layout(binding = 1) uniform sampler2D uNormal;
+layout(binding = SV_STENCIL_UNIT) uniform usampler2D uStencil;
+layout(binding = SV_COUNT_UNIT) uniform sampler2D uCount;
+layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
+layout(r32ui, binding = SV_CLOSE_IMAGE) readonly uniform uimage2D uClose;
+#if SV_CHECK
+layout(r32i, binding = SV_OTHER_IMAGE) readonly uniform iimage2D uOther;
+#endif
+#if SHADOWLAB_INSTRUMENTATION
+layout(r32f, binding = 1) writeonly uniform image2D uCloseView; // debug: 1 on close calls
+layout(r32f, binding = 2) writeonly uniform image2D uCountView; // debug: the exact count
+#endif
+layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
+layout(std430, binding = SV_CLOSE_LIST_BINDING) buffer CloseList { uint closeCount; uint closeList[]; };
+layout(std430, binding = SV_CLOSE_BLOCKED_BINDING) writeonly buffer CloseBlocked { uint closeBlocked[]; };
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(px, imageSize(uVisibility)))) return;
+    vec4 pos = texelFetch(uPosition, px, 0);
+    float visibility = 1.0; // background
+    float closeView = 0.0, countView = 0.0;
+    if (pos.w >= 0.5) {
+        vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
+        visibility = 0.0;
+        if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
+            uint stencil = texelFetch(uStencil, px, 0).x & 255u;
+            int count = int(texelFetch(uCount, px, 0).x);
+            countView = float(count);
+            bool shadowed = stencil != 0u;
+            if ((uint(count) & 255u) != stencil || (stencil == 0u && count != 0)) {
+                atomicAdd(counters[SV_C_WRAPPED], 1u);
+                shadowed = count != 0;
+            }
+            bool close = imageLoad(uClose, px).x != 0u;
+#if SV_CHECK
+            // Every closed volume adds 1 to (beyond - before) if it holds the eye, else 0.
+            if (count - imageLoad(uOther, px).x != int(counters[SV_C_EYE])) {
+                atomicAdd(counters[SV_C_INCONSISTENT], 1u);
+                close = true;
+            }
+#endif
+            if (close) {
+                // Listed for close_rays.comp, which writes this pixel's visibility.
+                uint entry = atomicAdd(closeCount, 1u);
+                closeList[entry] = uint(px.x) | uint(px.y) << 16;
+                closeBlocked[entry] = 0u;
+                atomicAdd(counters[SV_C_CLOSE_PIXELS], 1u);
+                closeView = 1.0;
+            }
+            visibility = shadowed ? 0.0 : 1.0;
+#if SHADOWLAB_INSTRUMENTATION
+            atomicAdd(counters[SV_C_LIT], 1u);
+#endif
+        }
+    }
+    imageStore(uVisibility, px, vec4(visibility));
+#if SHADOWLAB_INSTRUMENTATION
+    imageStore(uCloseView, px, vec4(closeView));
+    imageStore(uCountView, px, vec4(countView));
+#endif
+}
