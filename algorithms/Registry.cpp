@@ -1,6 +1,7 @@
 // The list of algorithms. Adding one is a folder under algorithms/ and one line here.
 #include "framework/algorithm/ShadowAlgorithm.h"
 #include "algorithms/bvh_raytrace/BvhRaytrace.h"
+#include "algorithms/izb/Izb.h"
 #include "algorithms/line_space/LineSpace.h"
 #include "algorithms/metric_tree/MetricTree.h"
 #include "algorithms/psv/Psv.h"
@@ -23,6 +24,7 @@ const std::vector<AlgorithmInfo>& algorithmRegistry() {
         ptsvInfo(),
         metricTreeInfo(),
         shadowVolumesInfo(),
+        izbInfo(),
     };
     return registry;
 }

@@ -79,7 +79,7 @@ done
 SUITES="Registry/ConformanceGLTest.*:ConformanceTimingModeGLTest.*:Registry/ChangeConformanceGLTest.*"
 SUITES+=":Registry/SchemaConformanceTest.*"
 SUITES+=":Table/PsvAccuracyGLTest.*:Table/PtsvAccuracyGLTest.*:Table/MetricTreeAccuracyGLTest.*"
-SUITES+=":Table/BvhRaytraceAccuracyGLTest.*:Table/ShadowVolumesAccuracyGLTest.*:*TinyStack*:*TinyJobList*:*Fault*"
+SUITES+=":Table/BvhRaytraceAccuracyGLTest.*:Table/ShadowVolumesAccuracyGLTest.*:Table/IzbAccuracyGLTest.*:*TinyStack*:*TinyJobList*:*Fault*"
 TABLE="Table/PortabilityGLTest.*:PortabilityTableTest.*"
 NO_BALLOT_EXCLUDED="Table/PtsvAccuracyGLTest.MatchesReference/*packet*"
 if [ -n "$a_junit" ] && [ ! -s "$a_junit" ]; then

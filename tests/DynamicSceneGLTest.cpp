@@ -41,6 +41,7 @@ Json exactAlgorithms() {
                         {{"algorithm", "metric_tree"}, {"id", "metric_tree_recluster"}, {"params", {{"cache", false}, {"motion", "recluster"}}}},
                         {{"algorithm", "ptsv"}},
                         {{"algorithm", "shadow_volumes"}},
+                        {{"algorithm", "izb"}},
                         {{"algorithm", "bvh_raytrace"}}});
 }
 

@@ -149,6 +149,7 @@ const std::map<std::string, std::vector<Variant>>& variants() {
           {"zpass", {{"method", str("zpass")}}},
           {"hardware_depth_test", {{"depth_test", str("hardware")}}},
           {"hardware_zpass", {{"depth_test", str("hardware")}, {"method", str("zpass")}}}}},
+        {"izb", {{"defaults", {}}, {"no_cell_test", {{"cell_test", false}}}}},
     };
     return table;
 }
@@ -160,6 +161,7 @@ const std::map<std::string, std::vector<std::string>> kPathKeys = {
     {"ptsv", {"traversal", "vote", "two_pass", "bounds"}},
     {"metric_tree", {"query", "tile"}},
     {"shadow_volumes", {"method", "depth_test"}},
+    {"izb", {"cell_test"}},
 };
 
 struct Case {

@@ -101,6 +101,83 @@ Shot cameraInsideShadow() {
     return s;
 }
 
+// `scene`'s triangles whose centroid passes `keep`, as a new open mesh.
+namespace {
+template <class Keep> Scene cut(const Scene& scene, Keep keep) {
+    std::vector<glm::vec3> kept;
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+        const glm::vec3* v = &scene.positions[3 * t];
+        if (keep((v[0] + v[1] + v[2]) / 3.0f))
+            for (int k = 0; k < 3; ++k) kept.push_back(v[k]);
+    }
+    Scene out;
+    out.addTriangles(kept, Material{});
+    return out;
+}
+} // namespace
+
+// A point light amid 600 random triangles (a soup: no two share an edge, many pierce one another)
+// and two boxes of open planes, over a ground: volumes start all around the light.
+Shot lightAmidClutter() {
+    Shot s;
+    s.scene = ground();
+    s.scene.append(makeTriangleSoup(600, {3.0f, 1.6f, 3.0f}, 0.25f, 11, Material{}), translate({0, 1.6f, 0}));
+    s.camera = lookAt({0.5f, 4.5f, 4.0f}, {0, 0.5f, 0});
+    s.light = pointLight({0.1f, 1.7f, 0.2f});
+    return s;
+}
+
+// A fence of thin posts and rails under a directional light 4° above the horizon: long, thin
+// shadows on ground lit at a grazing angle (n . l = 0.07).
+Shot grazingOverThin() {
+    Shot s;
+    s.scene = ground();
+    s.scene.append(makeFence(9, 0.45f, 0.6f, 0.015f, 2, 24, Material{}), translate({0, 0, -0.5f}));
+    s.camera = lookAt({0.4f, 2.5f, 3.0f}, {0, 0, -1.0f});
+    const float elevation = glm::radians(4.0f);
+    s.light = directionalLight({std::cos(elevation) * 0.6f, std::sin(elevation), -std::cos(elevation) * 0.8f});
+    return s;
+}
+
+// Open meshes: a bowl (the lower half of a sphere), a tube (a cylinder without its ends) and a
+// box without a lid, under a point light that shines into all three.
+Shot openMeshes() {
+    Shot s;
+    s.scene = ground();
+    Scene bowl = cut(makeSphere(0.5f, 800, Material{}), [](glm::vec3 c) { return c.y < 0.0f; });
+    s.scene.append(bowl, translate({-1.0f, 0.6f, 0.2f}));
+    Scene tube = cut(makeCylinder(0.25f, 0.9f, 200, Material{}), [](glm::vec3 c) { return c.y > 0.01f && c.y < 0.89f; });
+    s.scene.append(tube, translate({0.8f, 0.3f, -0.6f}) * rotate(30, {0, 0, 1}));
+    Scene box;
+    box.append(makePlane({0.8f, 0.8f}, 1, Material{}), glm::mat4(1.0f));
+    for (int k = 0; k < 4; ++k)
+        box.append(makePlane({0.8f, 0.6f}, 1, Material{}),
+                   rotate(90.0f * float(k), {0, 1, 0}) * translate({0, 0.3f, 0.4f}) * rotate(90, {1, 0, 0}));
+    s.scene.append(box, translate({0.4f, 0.05f, 0.9f}));
+    s.camera = lookAt({0.0f, 3.2f, 4.0f}, {0, 0.3f, 0});
+    s.light = pointLight({-0.6f, 3.0f, 1.2f});
+    return s;
+}
+
+// Non-manifold fins: five quads around one vertical edge (that edge has five triangles, each
+// other edge of a fin one or two), a soup of 300 triangles, and a sphere, under a spot light.
+Shot finsAndSoup() {
+    Shot s;
+    s.scene = ground();
+    for (int k = 0; k < 5; ++k)
+        s.scene.append(makePlane({0.6f, 0.8f}, 1, Material{}),
+                       translate({-0.6f, 0.45f, 0}) * rotate(72.0f * float(k), {0, 1, 0}) * translate({0.3f, 0, 0}) *
+                           rotate(90, {1, 0, 0}));
+    s.scene.append(makeTriangleSoup(300, {1.2f, 0.6f, 1.2f}, 0.2f, 5, Material{}), translate({0.8f, 0.9f, 0.3f}));
+    s.scene.append(makeSphere(0.3f, 300, Material{}), translate({0.2f, 0.3f, -0.9f}));
+    s.camera = lookAt({0.0f, 3.0f, 4.0f}, {0, 0.3f, 0});
+    s.light = pointLight({0.4f, 3.5f, 1.0f});
+    s.light.type = LightType::Spot;
+    s.light.target = {0, 0, 0};
+    s.light.coneDeg = 40.0f;
+    return s;
+}
+
 Shot engineOnGround() {
     Shot s;
     Scene e = loadGltf(kEngineGlb);

@@ -45,6 +45,19 @@ Shot cameraInsideShadow();
 /// A few thousand triangles of closed meshes (a sphere and a tilted torus) under a point light.
 Shot thousandsOfTriangles();
 
+/// A point light amid 600 random triangles (a soup: no two share an edge, many pierce one another)
+/// over a ground: shadow volumes start all around the light, and the eye is inside some.
+Shot lightAmidClutter();
+/// A fence of 1.5 cm posts and rails under a directional light 4° above the horizon: long, thin
+/// shadows on ground lit at a grazing angle (n . l = 0.07).
+Shot grazingOverThin();
+/// Open meshes: a bowl (the lower half of a sphere), a tube (a cylinder without its ends) and a box
+/// without a lid, under a point light that shines into all three.
+Shot openMeshes();
+/// Non-manifold fins (five quads around one edge), a soup of 300 triangles and a sphere, under a
+/// 40° spot light.
+Shot finsAndSoup();
+
 /// The 2CylinderEngine (a real CAD model, 110k triangles with many open edges), scaled to a radius
 /// of 3 over a 12 × 12 ground, under a point light.
 Shot engineOnGround();

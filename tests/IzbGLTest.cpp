@@ -1,0 +1,99 @@
+// izb (the irregular z-buffer) on OSMesa: against the Embree reference on the hard scenes shared
+// with shadow_volumes (a light amid clutter, grazing light over thin geometry, open meshes, soups,
+// non-manifold fins, the engine) under point, spot and directional lights, grid sizes and the
+// conservative cell test; its job list and list walks overflowing, reported and never lighting a
+// pixel by mistake.
+#include "algorithms/izb/Izb.h"
+#include "tests/AlgorithmHarness.h"
+#include "tests/TestSupport.h"
+
+#include <cstdio>
+
+namespace shadowlab {
+namespace {
+
+using namespace test;
+
+// izb tests each listed sample with the reference's own ray and watertight test, against every
+// triangle whose conservative footprint covers the sample's cell: exact by construction. Every row
+// is held to 1e-4 of the lit pixels, which at 96² (4,000 to 9,000 lit pixels) is no wrong pixel.
+const AccuracyCase kAccuracy[] = {
+    {"intersecting_triangles", intersectingTriangles, {}, 1e-4},
+    {"omni_inside_shell", omniInsideShell, {}, 1e-4},
+    {"directional", directionalObjects, {}, 1e-4},
+    {"camera_inside_shadow", cameraInsideShadow, {}, 1e-4},
+    {"thousands", thousandsOfTriangles, {}, 1e-4},
+    {"spot", smokeSpotShot, {}, 1e-4},
+    {"light_amid_clutter", lightAmidClutter, {}, 1e-4},
+    {"grazing_over_thin", grazingOverThin, {}, 1e-4},
+    {"open_meshes", openMeshes, {}, 1e-4},
+    {"fins_and_soup", finsAndSoup, {}, 1e-4},
+    {"engine", engineOnGround, {}, 1e-4},
+    {"edge_on_wall", [] { return withEdgeOnWall(thousandsOfTriangles()); }, {}, 1e-4},
+    // Grids: the auto one at 96² is the coarsest, 64 cells a side (long lists); finer ones (a few
+    // samples per cell); every cell of a footprint's box tested (no conservative rasterisation):
+    // the same image, different work.
+    {"grid_256_clutter", lightAmidClutter, {{"grid", 256}}, 1e-4},
+    {"grid_1024_thousands", thousandsOfTriangles, {{"grid", 1024}}, 1e-4},
+    {"grid_1024_directional", directionalObjects, {{"grid", 1024}}, 1e-4},
+    {"no_cell_test_clutter", lightAmidClutter, {{"cell_test", false}}, 1e-4},
+    {"no_cell_test_grazing", grazingOverThin, {{"cell_test", false}}, 1e-4},
+};
+
+class IzbGLTest : public GLTest {};
+class IzbAccuracyGLTest : public GLTest, public ::testing::WithParamInterface<AccuracyCase> {};
+
+TEST_P(IzbAccuracyGLTest, MatchesReference) {
+    const AccuracyCase& c = GetParam();
+    const AlgorithmRun o = runAlgorithm(izbInfo(), c.make(), c.params);
+    std::printf("[izb] %-24s lit %5zu mismatch %.5f%% (false lit %.5f%%) samples %.0f jobs %.0f tests/sample %.1f "
+                "list max %.0f\n",
+                c.name, o.accuracy.litPixels, 100 * o.accuracy.mismatchRatio, 100 * o.accuracy.falseLit,
+                o.counters.at("samples"), o.counters.at("jobs"), o.counters.at("tests_per_sample"), o.counters.at("list_max"));
+    EXPECT_GT(o.accuracy.litPixels, size_t(kRes * kRes / 8)) << "the view should show lit surfaces";
+    EXPECT_LE(o.accuracy.mismatchRatio, c.maxMismatch);
+    EXPECT_EQ(o.overflow, 0u);
+    size_t shadowed = 0;
+    for (size_t i = 0; i < o.lit.size(); ++i) shadowed += o.lit[i] && o.reference[i] < 0.5f;
+    EXPECT_GT(shadowed, size_t(50)) << "the scene should cast shadows on what the camera sees";
+    EXPECT_LT(shadowed + 50, o.accuracy.litPixels);
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, IzbAccuracyGLTest, ::testing::ValuesIn(kAccuracy),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// Every pixel that differs from the reference is written shadowed (never lit by mistake), and the
+// overflow counts at least as many pixels as differ.
+void expectLostWorkShadowed(const AlgorithmRun& o, const char* what) {
+    size_t wrong = 0;
+    for (size_t i = 0; i < o.lit.size(); ++i)
+        if (o.lit[i] && (o.visibility[i] < 0.5f) != (o.reference[i] < 0.5f)) {
+            ++wrong;
+            EXPECT_LT(o.visibility[i], 0.5f) << what << ": pixel " << i << " lit by mistake";
+        }
+    std::printf("[izb] %s: overflow %llu pixels, %zu differ from the reference\n", what, (unsigned long long)o.overflow, wrong);
+    EXPECT_GT(o.overflow, 0u) << what;
+    EXPECT_GE(o.overflow, uint64_t(wrong)) << what;
+    EXPECT_EQ(o.accuracy.falseLit, 0.0) << what;
+}
+
+// A job list of 1,024 (triangle, tile) jobs on the engine, which asks for far more: the tiles left
+// out are flagged, and their samples written shadowed and counted.
+TEST_F(IzbGLTest, FullJobListLosesTilesThatAreWrittenShadowed) {
+    const AlgorithmRun o = runAlgorithm(izbInfo(), engineOnGround(), {{"job_capacity", 1024}});
+    EXPECT_GT(o.counters.at("lost_tiles"), 0.0);
+    EXPECT_GT(o.counters.at("jobs"), 1024.0);
+    expectLostWorkShadowed(o, "job_capacity 1024");
+}
+
+// A walk of at most 16 samples per cell and triangle where the roof's shadow puts hundreds of
+// samples in one cell (cameraInsideShadow: 451 at most): the capped cells' samples are written
+// shadowed and counted.
+TEST_F(IzbGLTest, CappedListWalksAreWrittenShadowed) {
+    const AlgorithmRun o = runAlgorithm(izbInfo(), cameraInsideShadow(), {{"walk_cap", 16}});
+    EXPECT_GT(o.counters.at("capped_cells"), 0.0);
+    expectLostWorkShadowed(o, "walk_cap 16");
+}
+
+} // namespace
+} // namespace shadowlab
