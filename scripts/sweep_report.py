@@ -118,13 +118,24 @@ def axis_table(s, axis):
 
 def ratio_table(s, ratio):
     num, _, den = ratio.partition("/")
+    # merge.paper: the paper's own ratio beside each measured one, where it gives both times.
+    paper = s.merge.get("paper", {})
+    times = paper.get("times_ms", {})
+    paper_ratio = times[num] / times[den] if num in times and den in times else None
     head = [a["name"] for a in s.axes] + ["triangles", f"{num} / {den}"]
-    lines = [f"## {num} / {den}: total time per frame, same run", "", "| " + " | ".join(head) + " |",
-             "|" + "---|" * len(s.axes) + "---:|---:|"]
+    if paper_ratio is not None:
+        head += ["paper", "ours / paper"]
+    lines = [f"## {num} / {den}: total time per frame, same run", ""]
+    if paper_ratio is not None:
+        lines += [f"Paper: {paper['source']}: {num} {times[num]:g} ms, {den} {times[den]:g} ms, ratio {paper_ratio:.2f}.", ""]
+    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(s.axes) + "---:|" * (len(head) - len(s.axes))]
     for run in sorted(s.runs.values(), key=lambda r: r["index"]):
         a, b = run["values"].get(num, {}).get("time_ms.total"), run["values"].get(den, {}).get("time_ms.total")
         if a is not None and b:
-            lines.append("| " + " | ".join([run["axes"][x["name"]] for x in s.axes] + [f"{run['triangles']:,}", f"{a / b:.2f}"]) + " |")
+            row = [run["axes"][x["name"]] for x in s.axes] + [f"{run['triangles']:,}", f"{a / b:.2f}"]
+            if paper_ratio is not None:
+                row += [f"{paper_ratio:.2f}", f"{a / b / paper_ratio:.2f}"]
+            lines.append("| " + " | ".join(row) + " |")
     return lines
 
 

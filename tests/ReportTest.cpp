@@ -228,7 +228,8 @@ TEST(SweepReportTest, MergeReportShowsEveryPlotAndIsSelfContained) {
     // What `sweep merge` hands its script (plan.json, sweep.csv), for 2 × 2 runs of two algorithms
     // with different stages: the report's figures do not depend on how the runs were made.
     const std::string dir = test::makeTempDir("sweep-report");
-    Json plan = Json::parse(R"({"name": "tiny", "merge": {"ratios": ["psv/reference"]},
+    Json plan = Json::parse(R"({"name": "tiny", "merge": {"ratios": ["psv/reference"],
+      "paper": {"source": "A paper, Table 9", "times_ms": {"psv": 3, "reference": 1.5}}},
       "axes": [{"name": "tris", "scale": "triangles", "labels": ["300", "1200"]},
                {"name": "pcf", "scale": "category", "labels": ["0", "1"]}], "runs": []})");
     std::ostringstream csv;
@@ -261,6 +262,9 @@ TEST(SweepReportTest, MergeReportShowsEveryPlotAndIsSelfContained) {
     ASSERT_EQ(test::runCommand(std::string(SHADOWLAB_PLOT_PYTHON) + " " + SHADOWLAB_SOURCE_DIR + "/scripts/sweep_report.py " + dir, out), 0) << out;
     const std::string md = slurp(dir + "/sweep.md");
     EXPECT_EQ(count(md, "\n## Figures\n"), 1u);
+    // merge.paper: the paper's ratio (3 / 1.5) beside each measured one, and ours over it.
+    EXPECT_NE(md.find("Paper: A paper, Table 9: psv 3 ms, reference 1.5 ms, ratio 2.00."), std::string::npos) << md;
+    EXPECT_NE(md.find("| paper | ours / paper |"), std::string::npos) << md;
     for (const char* plot : {"sweep_tris.png", "sweep_pcf.png", "sweep_stages.png"}) {
         EXPECT_NE(md.find(std::string("](") + plot + ")"), std::string::npos) << plot;
         EXPECT_GT(pngSize(slurp(dir + "/" + plot)).first, 0) << plot;

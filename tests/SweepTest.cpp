@@ -60,6 +60,9 @@ const BadSweep kBadSweeps[] = {
     {"BadBaseOutsideAnyAxis", R"({"base": {"frames": -1}})", "/base/frames|out of range"},
     {"NoBase", R"({"base": null})", "/base|required"},
     {"BadRatio", R"({"merge": {"ratios": ["psv"]}})", "/merge/ratios|not ID/ID"},
+    {"PaperTimeNotPositive", R"({"merge": {"paper": {"source": "s", "times_ms": {"psv": 0}}}})", "/merge/paper/times_ms/psv|out of range"},
+    {"PaperWithoutSource", R"({"merge": {"paper": {"times_ms": {"psv": 1}}}})", "/merge/paper/source|required"},
+    {"PaperWithoutTimes", R"({"merge": {"paper": {"source": "s"}}})", "/merge/paper/times_ms|expected an object"},
     // Every fixed column of sweep.csv, `kind` included: the report reads rows by column name.
     {"AxisNamedKind", R"({"axes": [{"name": "kind", "values": {"frames": [1, 2]}}]})", "/axes/0/name|column"},
     {"AxisNamedValue", R"({"axes": [{"name": "value", "values": {"frames": [1, 2]}}]})", "/axes/0/name|column"},

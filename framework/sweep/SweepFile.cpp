@@ -343,6 +343,22 @@ Sweep parseSweep(const Json& json, const std::string& file) {
                 if (v.get<std::string>().find('/') == std::string::npos)
                     merge.fail(key, "\"" + v.get<std::string>() + "\" is not ID/ID (the total time of one algorithm id over another's)");
     }
+    // merge.paper: a paper's own times for some of the algorithm ids, so that sweep.md gives the
+    // paper's ratio beside each measured one (its source named, e.g. "Sintorn et al. 2014, Fig. 1").
+    if (merge.has("paper")) {
+        JsonNode paper = merge.child("paper");
+        const std::string source = paper.requireString("source");
+        if (const std::string why = textProblem(source, kMaxLabelChars); !why.empty()) paper.fail("source", why);
+        JsonNode times = paper.child("times_ms");
+        if (!paper.raw().contains("times_ms") || !paper.raw()["times_ms"].is_object() || paper.raw()["times_ms"].empty())
+            paper.fail("times_ms", "expected an object of algorithm id: milliseconds");
+        for (const auto& [id, value] : paper.raw()["times_ms"].items()) {
+            if (const std::string why = textProblem(id, kMaxLabelChars); !why.empty()) times.fail(id, "the id " + why);
+            times.getFloat(id, 0.0, 1e-9, 1e9);
+        }
+        times.finish();
+        paper.finish();
+    }
     merge.finish();
     s.merge = root.has("merge") ? root.raw()["merge"] : Json::object();
     JsonNode out = root.child("output");
