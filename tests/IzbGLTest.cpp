@@ -38,6 +38,10 @@ const AccuracyCase kAccuracy[] = {
     {"grid_1024_directional", directionalObjects, {{"grid", 1024}}, 1e-4},
     {"no_cell_test_clutter", lightAmidClutter, {{"cell_test", false}}, 1e-4},
     {"no_cell_test_grazing", grazingOverThin, {{"cell_test", false}}, 1e-4},
+    // The grid over the whole face instead of fitted to the samples' box.
+    {"scene_grid_clutter", lightAmidClutter, {{"grid_fit", std::string("scene")}}, 1e-4},
+    {"scene_grid_directional", directionalObjects, {{"grid_fit", std::string("scene")}}, 1e-4},
+    {"scene_grid_engine", engineOnGround, {{"grid_fit", std::string("scene")}}, 1e-4},
 };
 
 class IzbGLTest : public GLTest {};

@@ -149,7 +149,7 @@ const std::map<std::string, std::vector<Variant>>& variants() {
           {"zpass", {{"method", str("zpass")}}},
           {"hardware_depth_test", {{"depth_test", str("hardware")}}},
           {"hardware_zpass", {{"depth_test", str("hardware")}, {"method", str("zpass")}}}}},
-        {"izb", {{"defaults", {}}, {"no_cell_test", {{"cell_test", false}}}}},
+        {"izb", {{"defaults", {}}, {"no_cell_test", {{"cell_test", false}}}, {"scene_grid", {{"grid_fit", str("scene")}}}}},
     };
     return table;
 }
@@ -161,7 +161,7 @@ const std::map<std::string, std::vector<std::string>> kPathKeys = {
     {"ptsv", {"traversal", "vote", "two_pass", "bounds"}},
     {"metric_tree", {"query", "tile"}},
     {"shadow_volumes", {"method", "depth_test"}},
-    {"izb", {"cell_test"}},
+    {"izb", {"cell_test", "grid_fit"}},
 };
 
 struct Case {

@@ -21,6 +21,7 @@ struct IzbParams {
     int jobCapacity; ///< jobs the list holds
     int walkCap;     ///< samples one cell's walk may test against one triangle
     bool cellTest;   ///< test each cell against the projected triangle, not only its box
+    std::string gridFit; ///< "samples" | "scene"
     float rayOffset;
 };
 
@@ -44,6 +45,12 @@ const ParamStruct<IzbParams>& izbParams() {
         .boolean("cell_test", &P::cellTest, true,
                  "skip the cells of a triangle's box that its projection cannot touch (conservative rasterisation); off = every cell of the box",
                  ParamChange::Update)
+        // samples by default: on the peer engine orbit the fitted grids hold the same samples in
+        // shorter lists (docs/algorithms/izb.md, "Measured").
+        .choice("grid_fit", &P::gridFit, "samples", {"samples", "scene"},
+                "where each face's grid lies: fitted every frame to the box of that face's samples (samples: the "
+                "paper's reprojection of crowded regions, one fitted grid per face) or over the whole face (scene)",
+                ParamChange::Recompile)
         .apply(rayOffsetRow(&P::rayOffset));
     return s;
 }
@@ -58,6 +65,7 @@ public:
         scene_ = &scene;
         jobs_ = GlBuffer(size_t(p_.jobCapacity) * 8, nullptr, 0);
         jobCount_ = GlBuffer(4 * sizeof(uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        faceBounds_ = GlBuffer(6 * 4 * sizeof(uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
         counters_.allocate();
     }
 
@@ -99,8 +107,9 @@ public:
         tileFlags_.bindBase(GL_SHADER_STORAGE_BUFFER, IZB_FLAG_BINDING);
         cellFlags_.bindBase(GL_SHADER_STORAGE_BUFFER, IZB_CELL_FLAG_BINDING);
         occupied_.bindBase(GL_SHADER_STORAGE_BUFFER, IZB_OCCUPIED_BINDING);
+        faceBounds_.bindBase(GL_SHADER_STORAGE_BUFFER, IZB_BOUNDS_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, IZB_COUNTER_BINDING);
-        for (const ShaderProgram* program : {&insert_, &jobsPass_, &test_, &resolve_}) {
+        for (const ShaderProgram* program : {&bounds_, &insert_, &jobsPass_, &test_, &resolve_}) {
             setLightUniforms(*program, f.light);
             setGrid(*program, f.light);
         }
@@ -112,6 +121,17 @@ public:
         occupied_.clearUint(0);
         jobCount_.clearUint(0);
         bindPixelPassInputs(f);
+        if (p_.gridFit == "samples") {
+            // Empty boxes: min words at the top of the order, max words at the bottom.
+            uint32_t empty[24];
+            for (int face = 0; face < 6; ++face)
+                for (int k = 0; k < 4; ++k) empty[4 * face + k] = k < 2 ? 0xFFFFFFFFu : 0u;
+            faceBounds_.upload(empty, sizeof(empty));
+            bounds_.set("uResolution", r);
+            bounds_.set("uRayOffset", offset);
+            bounds_.dispatch2D(r.x, r.y, 8, 8);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
         insert_.set("uResolution", r);
         insert_.set("uRayOffset", offset);
         insert_.dispatch2D(r.x, r.y, 8, 8);
@@ -204,11 +224,13 @@ private:
     void compile() {
         const auto instr = instrumentationDefine(options_);
         const std::pair<std::string, std::string> texels{"SCENE_POSITION_TEXELS", "1"};
-        insert_ = ShaderProgram::compute("izb/insert.comp", {});
-        jobsPass_ = ShaderProgram::compute("izb/jobs.comp", {texels});
+        const std::pair<std::string, std::string> fit{"IZB_FIT_SAMPLES", p_.gridFit == "samples" ? "1" : "0"};
+        bounds_ = ShaderProgram::compute("izb/bounds.comp", {});
+        insert_ = ShaderProgram::compute("izb/insert.comp", {fit});
+        jobsPass_ = ShaderProgram::compute("izb/jobs.comp", {texels, fit});
         jobArgs_ = ShaderProgram::compute("izb/job_args.comp", {});
-        test_ = ShaderProgram::compute("izb/test.comp", {instr, texels});
-        resolve_ = ShaderProgram::compute("izb/resolve.comp", {instr});
+        test_ = ShaderProgram::compute("izb/test.comp", {instr, texels, fit});
+        resolve_ = ShaderProgram::compute("izb/resolve.comp", {instr, fit});
     }
 
     IzbParams p_;
@@ -217,8 +239,8 @@ private:
     glm::ivec2 resolution_{0};
     int faces_ = 6;
     int grid_ = 64; ///< `grid` as resolved for the image size
-    ShaderProgram insert_, jobsPass_, jobArgs_, test_, resolve_;
-    GlBuffer head_, next_, samples_, blocked_, jobs_, jobCount_, tileFlags_, cellFlags_, occupied_;
+    ShaderProgram bounds_, insert_, jobsPass_, jobArgs_, test_, resolve_;
+    GlBuffer head_, next_, samples_, blocked_, jobs_, jobCount_, tileFlags_, cellFlags_, occupied_, faceBounds_;
     GlTexture listView_;
     GpuCounters<IZB_COUNTER_WORDS> counters_;
 };

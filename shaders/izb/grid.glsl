@@ -23,8 +23,43 @@ vec3 izbOnFace(vec3 w, int f) {
     // p.z is the face's axis; p.xy the two others, in a fixed order per axis.
     return vec3(p.x, p.y, s * p.z);
 }
-ivec2 izbCellOf(vec2 uv) { // uv in [-1, 1]
-    return clamp(ivec2(floor((uv * 0.5 + 0.5) * float(uGrid))), ivec2(0), ivec2(uGrid - 1));
+// Where each face's grid lies, in face coordinates. grid_fit `scene`: the whole face, [-1, 1]^2.
+// grid_fit `samples` (IZB_FIT_SAMPLES): the box of the face's own samples this frame (bounds.comp),
+// so that the cells go where the samples are (the paper's reprojection of crowded regions, in its
+// simplest form: one fitted grid per face). Points outside fall into the border cells, which reach
+// to infinity outward (test.comp), so nothing is missed either way.
+#if IZB_FIT_SAMPLES
+layout(std430, binding = IZB_BOUNDS_BINDING) readonly buffer FaceBounds { uint faceBounds[]; }; // 4 ordered words per face
+// Ordered uint <-> float: the uint order of the words is the float order of the values.
+float izbUnorder(uint u) { return uintBitsToFloat((u & 0x80000000u) != 0u ? u ^ 0x80000000u : ~u); }
+#endif
+vec4 izbFaceBox(int face) { // (lo.x, lo.y, hi.x, hi.y)
+#if IZB_FIT_SAMPLES
+    uint b = 4u * uint(face);
+    vec4 box = vec4(izbUnorder(faceBounds[b]), izbUnorder(faceBounds[b + 1u]), izbUnorder(faceBounds[b + 2u]),
+                    izbUnorder(faceBounds[b + 3u]));
+    if (!(box.x <= box.z && box.y <= box.w)) return vec4(-1.0, -1.0, 1.0, 1.0); // no sample on the face
+    vec2 pad = max(vec2(1e-6), 1e-5 * max(abs(box.xy), abs(box.zw))); // a single sample still has a box
+    return vec4(box.xy - pad, box.zw + pad);
+#else
+    return vec4(-1.0, -1.0, 1.0, 1.0);
+#endif
+}
+ivec2 izbCellOf(int face, vec2 uv) {
+    vec4 box = izbFaceBox(face);
+    vec2 t = (uv - box.xy) / (box.zw - box.xy);
+    return clamp(ivec2(floor(t * float(uGrid))), ivec2(0), ivec2(uGrid - 1));
+}
+// The cell's square in face coordinates, the border cells reaching to infinity outward.
+void izbCellBox(int face, ivec2 cell, out vec2 lo, out vec2 hi) {
+    vec4 box = izbFaceBox(face);
+    vec2 size = (box.zw - box.xy) / float(uGrid);
+    lo = box.xy + vec2(cell) * size;
+    hi = lo + size;
+    if (cell.x == 0) lo.x = -1e30;
+    if (cell.y == 0) lo.y = -1e30;
+    if (cell.x == uGrid - 1) hi.x = 1e30;
+    if (cell.y == uGrid - 1) hi.y = 1e30;
 }
 // Directional: (u, v) in [-1, 1] over the covered square.
 vec2 izbOrtho(vec3 p) { return vec2(dot(p - uGridCenter, uGridU), dot(p - uGridCenter, uGridV)) / uGridRadius; }

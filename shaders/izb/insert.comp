@@ -31,14 +31,14 @@ void main() {
     vec3 x = pos.xyz + n * uRayOffset;
     if (pos.w >= 0.5 && lightIlluminates(pos.xyz) && dot(n, toLight(pos.xyz)) > 0.0) {
         if (lightIsDirectional()) {
-            at = izbCellOf(izbOrtho(x));
+            at = izbCellOf(0, izbOrtho(x));
             cell = izbCellIndex(0, at);
         } else {
             vec3 w = x - uLightPosition;
             if (dot(w, w) > 0.0) {
                 face = izbFace(w);
                 vec3 f = izbOnFace(w, face);
-                at = izbCellOf(f.xy / f.z);
+                at = izbCellOf(face, f.xy / f.z);
                 cell = izbCellIndex(face, at);
             } else {
                 cell = IZB_ON_LIGHT; // on the light: nothing lies between them, never blocked

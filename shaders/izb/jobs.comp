@@ -26,7 +26,7 @@ void main() {
     int face = int(id % uint(uFaces));
     Footprint fp;
     if (!izbFootprint(sceneVertex(t, 0u), sceneVertex(t, 1u), sceneVertex(t, 2u), face, fp)) return;
-    ivec2 c0 = izbCellOf(max(fp.lo, vec2(-1.0))), c1 = izbCellOf(min(fp.hi, vec2(1.0)));
+    ivec2 c0 = izbCellOf(face, fp.lo), c1 = izbCellOf(face, fp.hi);
     ivec2 t0 = c0 / IZB_TILE, t1 = c1 / IZB_TILE;
     int tilesPerSide = (uGrid + IZB_TILE - 1) / IZB_TILE;
     int ty = t0.y, tx = t0.x;

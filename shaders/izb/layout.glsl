@@ -8,6 +8,7 @@
 #define IZB_FLAG_BINDING 9     // uint[faces * tiles]: 1 where a tile's work was lost (job list full)
 #define IZB_CELL_FLAG_BINDING 10 // uint[faces * grid^2]: 1 where a cell's walk was capped
 #define IZB_COUNTER_BINDING 11
+#define IZB_BOUNDS_BINDING 13  // grid_fit samples: per face, the box of its samples (4 ordered words)
 #define IZB_OCCUPIED_BINDING 12 // uint[faces * tiles]: 1 where a tile holds a sample (no job for the others)
 #define IZB_NONE 0xFFFFFFFFu     // no sample (list end), or a sample the light does not reach
 #define IZB_ON_LIGHT 0xFFFFFFFEu // a lit sample on the light itself (not listed)

@@ -40,14 +40,8 @@ void main() {
     vec3 a = sceneVertex(t, 0u), b = sceneVertex(t, 1u), c = sceneVertex(t, 2u);
     Footprint fp;
     if (!izbFootprint(a, b, c, face, fp)) return;
-    float size = 2.0 / float(uGrid);
-    vec2 lo = vec2(cell) * size - 1.0, hi = lo + size;
-    // The edge cells reach past the face: a point clamped into them may lie beyond [-1, 1] (a
-    // directional light's grid) or on the border, so they reach to infinity outward.
-    if (cell.x == 0) lo.x = -1e30;
-    if (cell.y == 0) lo.y = -1e30;
-    if (cell.x == uGrid - 1) hi.x = 1e30;
-    if (cell.y == uGrid - 1) hi.y = 1e30;
+    vec2 lo, hi;
+    izbCellBox(face, cell, lo, hi);
     if (uCellTest != 0 && !izbCellTouches(fp, lo, hi)) return;
     uint index = izbCellIndex(face, cell);
     uint s = head[index], steps = 0u, tests = 0u;
