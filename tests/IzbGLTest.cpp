@@ -38,10 +38,12 @@ const AccuracyCase kAccuracy[] = {
     {"grid_1024_directional", directionalObjects, {{"grid", 1024}}, 1e-4},
     {"no_cell_test_clutter", lightAmidClutter, {{"cell_test", false}}, 1e-4},
     {"no_cell_test_grazing", grazingOverThin, {{"cell_test", false}}, 1e-4},
-    // The grid over the whole face instead of fitted to the samples' box.
-    {"scene_grid_clutter", lightAmidClutter, {{"grid_fit", std::string("scene")}}, 1e-4},
-    {"scene_grid_directional", directionalObjects, {{"grid_fit", std::string("scene")}}, 1e-4},
-    {"scene_grid_engine", engineOnGround, {{"grid_fit", std::string("scene")}}, 1e-4},
+    // Each face's grid fitted to its samples' box instead of over the whole face.
+    {"fit_samples_clutter", lightAmidClutter, {{"grid_fit", std::string("samples")}}, 1e-4},
+    {"fit_samples_directional", directionalObjects, {{"grid_fit", std::string("samples")}}, 1e-4},
+    {"fit_samples_camera_inside", cameraInsideShadow, {{"grid_fit", std::string("samples")}}, 1e-4},
+    {"fit_samples_grazing", grazingOverThin, {{"grid_fit", std::string("samples")}}, 1e-4},
+    {"fit_samples_engine", engineOnGround, {{"grid_fit", std::string("samples")}}, 1e-4},
 };
 
 class IzbGLTest : public GLTest {};

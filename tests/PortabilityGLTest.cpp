@@ -149,7 +149,7 @@ const std::map<std::string, std::vector<Variant>>& variants() {
           {"zpass", {{"method", str("zpass")}}},
           {"hardware_depth_test", {{"depth_test", str("hardware")}}},
           {"hardware_zpass", {{"depth_test", str("hardware")}, {"method", str("zpass")}}}}},
-        {"izb", {{"defaults", {}}, {"no_cell_test", {{"cell_test", false}}}, {"scene_grid", {{"grid_fit", str("scene")}}}}},
+        {"izb", {{"defaults", {}}, {"no_cell_test", {{"cell_test", false}}}, {"fitted_grid", {{"grid_fit", str("samples")}}}}},
     };
     return table;
 }
