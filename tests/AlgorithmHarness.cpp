@@ -89,4 +89,23 @@ void expectOverflowedPixelsShadowed(const AlgorithmRun& o, double pixels) {
     EXPECT_EQ(double(marked), pixels);
 }
 
+std::vector<AccuracyCase> hardSceneTable(double maxMismatch, std::vector<AccuracyCase> rows) {
+    std::vector<AccuracyCase> out = {
+        {"intersecting_triangles", intersectingTriangles, {}, maxMismatch},
+        {"omni_inside_shell", omniInsideShell, {}, maxMismatch},
+        {"directional", directionalObjects, {}, maxMismatch},
+        {"camera_inside_shadow", cameraInsideShadow, {}, maxMismatch},
+        {"thousands", thousandsOfTriangles, {}, maxMismatch},
+        {"spot", smokeSpotShot, {}, maxMismatch},
+        {"light_amid_clutter", lightAmidClutter, {}, maxMismatch},
+        {"grazing_over_thin", grazingOverThin, {}, maxMismatch},
+        {"open_meshes", openMeshes, {}, maxMismatch},
+        {"fins_and_soup", finsAndSoup, {}, maxMismatch},
+        {"engine", engineOnGround, {}, maxMismatch},
+        {"edge_on_wall", [] { return withEdgeOnWall(thousandsOfTriangles()); }, {}, maxMismatch},
+    };
+    out.insert(out.end(), rows.begin(), rows.end());
+    return out;
+}
+
 } // namespace shadowlab::test

@@ -79,6 +79,12 @@ struct AccuracyCase {
 /// Readable in ctest's listing (gtest would otherwise print the row's bytes).
 void PrintTo(const AccuracyCase& c, std::ostream* os);
 
+/// The hard scenes every exact baseline's table starts with, with its defaults and `maxMismatch`:
+/// the shared shots (intersecting triangles to a wall in a plane through the light) and the hard
+/// ones (a light amid clutter, grazing light over thin geometry, open meshes, soups and fins, the
+/// engine). `rows` follow them (the algorithm's own parameters).
+std::vector<AccuracyCase> hardSceneTable(double maxMismatch, std::vector<AccuracyCase> rows);
+
 /// The stack-overflow contract of the traversing algorithms: every pixel their "stack_overflow"
 /// view marks is written fully shadowed (never lit by mistake), and the view marks exactly the
 /// `pixels` their counter reports.

@@ -17,19 +17,7 @@ using namespace test;
 // izb tests each listed sample with the reference's own ray and watertight test, against every
 // triangle whose conservative footprint covers the sample's cell: exact by construction. Every row
 // is held to 1e-4 of the lit pixels, which at 96² (4,000 to 9,000 lit pixels) is no wrong pixel.
-const AccuracyCase kAccuracy[] = {
-    {"intersecting_triangles", intersectingTriangles, {}, 1e-4},
-    {"omni_inside_shell", omniInsideShell, {}, 1e-4},
-    {"directional", directionalObjects, {}, 1e-4},
-    {"camera_inside_shadow", cameraInsideShadow, {}, 1e-4},
-    {"thousands", thousandsOfTriangles, {}, 1e-4},
-    {"spot", smokeSpotShot, {}, 1e-4},
-    {"light_amid_clutter", lightAmidClutter, {}, 1e-4},
-    {"grazing_over_thin", grazingOverThin, {}, 1e-4},
-    {"open_meshes", openMeshes, {}, 1e-4},
-    {"fins_and_soup", finsAndSoup, {}, 1e-4},
-    {"engine", engineOnGround, {}, 1e-4},
-    {"edge_on_wall", [] { return withEdgeOnWall(thousandsOfTriangles()); }, {}, 1e-4},
+const std::vector<AccuracyCase> kAccuracy = hardSceneTable(1e-4, {
     // Grids: the auto one at 96² is the coarsest, 64 cells a side (long lists); finer ones (a few
     // samples per cell); every cell of a footprint's box tested (no conservative rasterisation):
     // the same image, different work.
@@ -44,7 +32,7 @@ const AccuracyCase kAccuracy[] = {
     {"fit_samples_camera_inside", cameraInsideShadow, {{"grid_fit", std::string("samples")}}, 1e-4},
     {"fit_samples_grazing", grazingOverThin, {{"grid_fit", std::string("samples")}}, 1e-4},
     {"fit_samples_engine", engineOnGround, {{"grid_fit", std::string("samples")}}, 1e-4},
-};
+});
 
 class IzbGLTest : public GLTest {};
 class IzbAccuracyGLTest : public GLTest, public ::testing::WithParamInterface<AccuracyCase> {};

@@ -32,21 +32,8 @@ Shot closedOnly() {
 
 // shadow_volumes is exact with its defaults (ZFAIL, every triangle casting, close calls): each row
 // is held to 1e-4 of the lit pixels, which at 96² (5,000 to 9,000 lit pixels) is no wrong pixel.
-const AccuracyCase kAccuracy[] = {
-    {"intersecting_triangles", intersectingTriangles, {}, 1e-4},
-    {"omni_inside_shell", omniInsideShell, {}, 1e-4},
-    {"directional", directionalObjects, {}, 1e-4},
-    {"camera_inside_shadow", cameraInsideShadow, {}, 1e-4},
-    {"thousands", thousandsOfTriangles, {}, 1e-4},
-    {"spot", smokeSpotShot, {}, 1e-4},
-    {"light_amid_clutter", lightAmidClutter, {}, 1e-4},
-    {"grazing_over_thin", grazingOverThin, {}, 1e-4},
-    {"open_meshes", openMeshes, {}, 1e-4},
-    {"fins_and_soup", finsAndSoup, {}, 1e-4},
-    // A real CAD model: 110k triangles, 13k open edges, a few non-manifold ones.
-    {"engine", engineOnGround, {}, 1e-4},
+const std::vector<AccuracyCase> kAccuracy = hardSceneTable(1e-4, {
     {"engine_zpass", engineOnGround, {{"method", std::string("zpass")}}, 1e-4},
-    {"edge_on_wall", [] { return withEdgeOnWall(thousandsOfTriangles()); }, {}, 1e-4},
     // ZPASS is exact where no view ray starts inside a volume (the eye lit, in front of every cap).
     {"zpass_thousands", thousandsOfTriangles, {{"method", std::string("zpass")}}, 1e-4},
     {"zpass_directional", directionalObjects, {{"method", std::string("zpass")}}, 1e-4},
@@ -60,7 +47,7 @@ const AccuracyCase kAccuracy[] = {
     // The classic light-facing volumes: exact on closed meshes.
     {"light_facing_closed", closedOnly, {{"volumes", std::string("light_facing")}}, 1e-4},
     {"light_facing_closed_zpass", closedOnly, {{"volumes", std::string("light_facing")}, {"method", std::string("zpass")}}, 1e-4},
-};
+});
 
 class ShadowVolumesGLTest : public GLTest {};
 class ShadowVolumesAccuracyGLTest : public GLTest, public ::testing::WithParamInterface<AccuracyCase> {};

@@ -38,7 +38,7 @@ bool izbFootprint(vec3 a, vec3 b, vec3 c, int face, out Footprint fp) {
     vec2 m = vec2(kIzbMargin) * (1.0 + max(abs(fp.lo), abs(fp.hi)));
     fp.lo -= m;
     fp.hi += m;
-    return true; // the grid's border cells reach to infinity: every footprint lands somewhere
+    return true; // whether it meets the face's grid is the caller's test (izbFaceBox)
 }
 
 // The cell's square (face coordinates) may hold a point of the projected triangle (conservative:

@@ -26,6 +26,9 @@ void main() {
     int face = int(id % uint(uFaces));
     Footprint fp;
     if (!izbFootprint(sceneVertex(t, 0u), sceneVertex(t, 1u), sceneVertex(t, 2u), face, fp)) return;
+    // Every sample of the face lies in its grid's box: a footprint wholly outside it covers none.
+    vec4 box = izbFaceBox(face);
+    if (any(greaterThan(fp.lo, box.zw)) || any(lessThan(fp.hi, box.xy))) return;
     ivec2 c0 = izbCellOf(face, fp.lo), c1 = izbCellOf(face, fp.hi);
     ivec2 t0 = c0 / IZB_TILE, t1 = c1 / IZB_TILE;
     int tilesPerSide = (uGrid + IZB_TILE - 1) / IZB_TILE;
