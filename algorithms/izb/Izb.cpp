@@ -144,9 +144,7 @@ public:
         jobsPass_.set("uTriangleCount", triangles);
         jobsPass_.set("uFaces", faces);
         jobsPass_.set("uJobCapacity", unsigned(p_.jobCapacity));
-        jobsPass_.use();
-        const size_t invocations = size_t(triangles) * size_t(faces);
-        glDispatchCompute(unsigned(std::max<size_t>(1, (invocations + 63) / 64)), 1, 1);
+        jobsPass_.dispatchLinear(std::max<size_t>(1, size_t(triangles) * size_t(faces)), 64);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         jobArgs_.set("uJobCapacity", unsigned(p_.jobCapacity));
         jobArgs_.use();

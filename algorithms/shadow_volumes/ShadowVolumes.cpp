@@ -171,13 +171,11 @@ public:
         draw_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_DRAW_BINDING);
         setLightUniforms(facingPass_, f.light);
         facingPass_.set("uTriangleCount", triangles);
-        facingPass_.use();
-        glDispatchCompute(std::max(1u, (triangles + 63u) / 64u), 1, 1);
+        facingPass_.dispatchLinear(std::max(1u, triangles), 64);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         silhouettePass_.set("uEdgeCount", unsigned(edges_));
         silhouettePass_.set("uCapacity", unsigned(capacity_));
-        silhouettePass_.use();
-        glDispatchCompute(std::max(1u, unsigned((edges_ + 63) / 64)), 1, 1);
+        silhouettePass_.dispatchLinear(std::max<size_t>(1, edges_), 64);
         if (checked()) {
             // The volumes holding the eye, for the resolve pass's check.
             setLightUniforms(eyePass_, f.light);

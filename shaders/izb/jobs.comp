@@ -10,6 +10,7 @@
 #include "izb/grid.glsl"
 #include "izb/footprint.glsl"
 layout(local_size_x = 64) in;
+uniform uint uInvocationsPerRow;
 layout(std430, binding = IZB_JOB_BINDING) writeonly buffer Jobs { uvec2 jobs[]; };
 layout(std430, binding = IZB_JOB_COUNT_BINDING) buffer JobCount { uint jobCount, groupsX, groupsY, groupsZ; };
 layout(std430, binding = IZB_FLAG_BINDING) buffer TileFlags { uint tileFlags[]; };
@@ -20,7 +21,7 @@ uniform int uFaces;         // 6 (point, spot) or 1 (directional)
 uniform uint uJobCapacity;
 
 void main() {
-    uint id = gl_GlobalInvocationID.x;
+    uint id = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x; // rows: ShaderProgram::dispatchLinear
     if (id >= uTriangleCount * uint(uFaces)) return;
     uint t = id / uint(uFaces);
     int face = int(id % uint(uFaces));

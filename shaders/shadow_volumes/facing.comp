@@ -10,11 +10,12 @@
 #include "common/scene.glsl"
 #include "shadow_volumes/layout.glsl"
 layout(local_size_x = 64) in;
+uniform uint uInvocationsPerRow;
 layout(std430, binding = SV_FACING_BINDING) writeonly buffer Facing { int facing[]; };
 uniform uint uTriangleCount;
 
 void main() {
-    uint t = gl_GlobalInvocationID.x;
+    uint t = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x; // rows: ShaderProgram::dispatchLinear
     if (t >= uTriangleCount) return;
     vec3 a = sceneVertex(t, 0u), b = sceneVertex(t, 1u), c = sceneVertex(t, 2u);
     vec3 n = cross(b - a, c - a);

@@ -10,6 +10,7 @@
 // sum of |m| can never exceed (each side adds at most 1): an overflow is counted all the same.
 #include "shadow_volumes/layout.glsl"
 layout(local_size_x = 64) in;
+uniform uint uInvocationsPerRow;
 layout(std430, binding = SV_SIDES_BINDING) readonly buffer Sides { uint sides[]; };
 layout(std430, binding = SV_FIRST_BINDING) readonly buffer First { uint first[]; };
 layout(std430, binding = SV_FACING_BINDING) readonly buffer Facing { int facing[]; };
@@ -20,7 +21,7 @@ uniform uint uEdgeCount;
 uniform uint uCapacity;
 
 void main() {
-    uint e = gl_GlobalInvocationID.x;
+    uint e = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x; // rows: ShaderProgram::dispatchLinear
     if (e >= uEdgeCount) return;
     int m = 0;
     for (uint i = first[e]; i < first[e + 1u]; ++i) {
