@@ -89,6 +89,16 @@ void expectOverflowedPixelsShadowed(const AlgorithmRun& o, double pixels) {
     EXPECT_EQ(double(marked), pixels);
 }
 
+void expectAccurateRow(const AlgorithmRun& o, double maxMismatch) {
+    EXPECT_GT(o.accuracy.litPixels, o.lit.size() / 8) << "the view should show lit surfaces";
+    EXPECT_LE(o.accuracy.mismatchRatio, maxMismatch);
+    EXPECT_EQ(o.overflow, 0u);
+    size_t shadowed = 0;
+    for (size_t i = 0; i < o.lit.size(); ++i) shadowed += o.lit[i] && o.reference[i] < 0.5f;
+    EXPECT_GT(shadowed, size_t(50)) << "the scene should cast shadows on what the camera sees";
+    EXPECT_LT(shadowed + 50, o.accuracy.litPixels);
+}
+
 std::vector<AccuracyCase> hardSceneTable(double maxMismatch, std::vector<AccuracyCase> rows) {
     std::vector<AccuracyCase> out = {
         {"intersecting_triangles", intersectingTriangles, {}, maxMismatch},

@@ -85,6 +85,10 @@ void PrintTo(const AccuracyCase& c, std::ostream* os);
 /// engine). `rows` follow them (the algorithm's own parameters).
 std::vector<AccuracyCase> hardSceneTable(double maxMismatch, std::vector<AccuracyCase> rows);
 
+/// One accuracy row's checks: the view shows lit surfaces and shadows on them (or the row tests
+/// nothing), the mismatch is within `maxMismatch`, and nothing overflowed.
+void expectAccurateRow(const AlgorithmRun& o, double maxMismatch);
+
 /// The stack-overflow contract of the traversing algorithms: every pixel their "stack_overflow"
 /// view marks is written fully shadowed (never lit by mistake), and the view marks exactly the
 /// `pixels` their counter reports.
