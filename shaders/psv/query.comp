@@ -152,7 +152,10 @@ bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
         PSV_STEP(n.inter != 0u ? n.inter : n.pos, t)
     }
 #undef PSV_STEP
-    return false; // not reached
+    // Reached only when the device ended the loops from outside (llvmpipe after 65,535 iterations
+    // in all, docs/architecture.md rule 13): the walk did not finish, so the pixel is capped.
+    r.capped = true;
+    return false;
 }
 #endif
 
@@ -236,6 +239,9 @@ Result query(Query Q) {
 #endif
     }
 #undef PSV_PUSH
+    // Every way out of the walk that leaves `walking` set has found q shadowed (visibility 0): a
+    // walk still going with light left was ended from outside (rule 13), and is capped.
+    if (walking && r.visibility != 0.0) r.capped = true;
     r.overflow = r.overflow || r.capped;
     // An overflowed pixel is never reported lit: it is written shadowed and counted (a wrong dark
     // pixel is visible in the overflow view and in overflowCount(); a silent light leak is not).
