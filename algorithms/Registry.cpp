@@ -35,6 +35,19 @@ const AlgorithmInfo* findAlgorithm(const std::string& name) {
     return nullptr;
 }
 
+std::string storageRefusal(const FootprintQuery& q, const char* what, size_t bytes, bool reportedLimit) {
+    const size_t limit = reportedLimit ? q.reportedStorageBlockBytes : q.storageBlockBytes;
+    if (limit == 0 || bytes <= limit) return "";
+    return std::string(what) + " (" + std::to_string(bytes >> 20) + " MiB) exceed one storage block (" +
+           std::to_string(limit >> 20) + " MiB" + (reportedLimit ? ", GL_MAX_SHADER_STORAGE_BLOCK_SIZE" : "") + ")";
+}
+
+std::string texelRefusal(const FootprintQuery& q, const char* what, size_t texels) {
+    if (q.textureBufferTexels == 0 || texels <= q.textureBufferTexels) return "";
+    return std::string(what) + " (" + std::to_string(texels) + " texels) exceed one buffer-texture view (" +
+           std::to_string(q.textureBufferTexels) + ", GL_MAX_TEXTURE_BUFFER_SIZE)";
+}
+
 bool AlgorithmInfo::supports(LightType t) const { return std::find(lights.begin(), lights.end(), t) != lights.end(); }
 
 std::string AlgorithmInfo::motionRefusal(const ParamValues& params) const {

@@ -297,6 +297,32 @@ TEST_F(MetricTreeGLTest, TileQueryGivesThePixelQuerysImage) {
     }
 }
 
+// The cluster-ordered geometry is split over up to six blocks where one buffer-texture view cannot
+// hold it (past 44.7 M triangles on llvmpipe). Forced here by a tiny block: the same image, bit for
+// bit, from one, two and six blocks, and a block too small for six refused by name.
+TEST_F(MetricTreeGLTest, GeometrySplitOverBlocksGivesTheSingleBlockImage) {
+    for (Shot (*make)() : {engine, fenceDirectional}) {
+        const Shot s = make();
+        const int n = int(s.scene.triangleCount());
+        const Outcome one = run(s, {}, false);
+        EXPECT_EQ(one.counters.at("geometry_blocks"), 1.0);
+        for (int blocks : {2, 6}) {
+            const int block = (n + blocks - 1) / blocks;
+            const Outcome split = run(s, {{"geometry_block", block}}, false);
+            EXPECT_EQ(split.counters.at("geometry_blocks"), double(blocks));
+            EXPECT_EQ(split.visibility, one.visibility) << blocks << " blocks of " << block << " triangles";
+            EXPECT_EQ(split.counters.at("geometry_bytes"), one.counters.at("geometry_bytes"));
+            EXPECT_EQ(split.overflow, 0u);
+        }
+        try {
+            run(s, {{"geometry_block", n / 7}}, false);
+            ADD_FAILURE() << "seven blocks' worth of triangles were not refused";
+        } catch (const std::exception& e) {
+            EXPECT_NE(std::string(e.what()).find("geometry blocks of"), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST_F(MetricTreeGLTest, ClusteringIsCachedOnDisk) {
     const std::string dir = test::makeTempDir("mt-cache");
     const char* old = std::getenv("XDG_CACHE_HOME");

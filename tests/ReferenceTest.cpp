@@ -4,7 +4,9 @@
 #include "framework/core/Error.h"
 #include "framework/reference/EmbreeTracer.h"
 #include "algorithms/reference/Reference.h"
+#include "framework/scene/GltfLoader.h"
 #include "tests/ShadowTestScenes.h"
+#include "tests/TestSupport.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -389,6 +391,38 @@ TEST(ReferenceTracer, TwoMillionTriangles) {
                 tracer.memoryBytes() / 1e6);
 }
 
+// The layouts that save memory at scale answer every ray as the default one does: the vertices
+// read in place from the Scene (no copy) and the compact BVH (indexed leaves, compact nodes), on
+// the engine, with rays grazing its thin parts and aimed at its vertices and edges.
+TEST(ReferenceTest, SharedVerticesAndCompactBvhAnswerEveryRayAlike) {
+    Scene s = loadGltf(test::kEngineGlb);
+    ASSERT_GT(s.positions.capacity(), s.positions.size()) << "no spare vertex: the shared layout would be copied";
+    EmbreeTracer copied(s, EmbreeTracer::MotionUpdate::Refit);
+    EmbreeTracer shared(s, EmbreeTracer::MotionUpdate::Refit, EmbreeTracer::Vertices::Share);
+    EmbreeTracer compact(s, EmbreeTracer::MotionUpdate::Refit, EmbreeTracer::Vertices::Share, true);
+    EXPECT_FALSE(copied.sharesVertices());
+    EXPECT_TRUE(shared.sharesVertices());
+    EXPECT_LT(shared.memoryBytes() + 30 * s.triangleCount(), copied.memoryBytes()); // no 36-byte copy
+    EXPECT_LT(compact.memoryBytes(), shared.memoryBytes());
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const glm::vec3 lo = s.bounds.min, ext = s.bounds.extent();
+    int blocked = 0;
+    for (int i = 0; i < 20000; ++i) {
+        // Half the rays start at a vertex or an edge midpoint (where watertightness is tested), half anywhere.
+        const size_t t = size_t(u(rng) * float(s.triangleCount() - 1));
+        const glm::vec3 at = i % 2 ? 0.5f * (s.positions[3 * t] + s.positions[3 * t + 1])
+                                   : lo + ext * glm::vec3(u(rng), u(rng), u(rng));
+        const glm::vec3 to = lo + ext * glm::vec3(u(rng), 1.5f + u(rng), u(rng));
+        const glm::vec3 dir = to - at;
+        const bool a = copied.occluded(at, dir, 1.0f);
+        ASSERT_EQ(shared.occluded(at, dir, 1.0f), a) << i;
+        ASSERT_EQ(compact.occluded(at, dir, 1.0f), a) << i;
+        blocked += a;
+    }
+    EXPECT_GT(blocked, 2000); // the rays do meet the engine
+}
+
 TEST(ReferenceAlgorithm, RegistryEntry) {
     AlgorithmInfo info = referenceInfo();
     EXPECT_EQ(info.name, "reference");
@@ -397,7 +431,9 @@ TEST(ReferenceAlgorithm, RegistryEntry) {
         EXPECT_NE(std::find(info.lights.begin(), info.lights.end(), t), info.lights.end()) << toString(t);
     const ParamSchema& schema = info.schema();
     EXPECT_EQ(&schema, &info.schema()); // built once
-    ASSERT_EQ(schema.specs().size(), 3u);
+    ASSERT_EQ(schema.specs().size(), 4u);
+    ASSERT_TRUE(schema.find("bvh"));
+    EXPECT_EQ(std::get<std::string>(schema.find("bvh")->def), "auto");
     EXPECT_EQ(info.motion, MotionHandling::Refit);
     const ParamSpec* motion = schema.find("motion_update");
     ASSERT_TRUE(motion);

@@ -230,11 +230,24 @@ private:
 
 } // namespace
 
+/// Nodes (64 bytes, at most one per triangle) and leaf-ordered triangles (48 bytes) on the GPU,
+/// both checked against the reported storage-block size as setScene does; ~150 bytes a triangle
+/// while the binned SAH builder runs on the host; a moving scene keeps its tree and posed copy.
+Footprint bvhRaytraceFootprint(const FootprintQuery& q) {
+    Footprint f;
+    const size_t n = q.triangles;
+    f.bytes = 112 * n + (q.moving ? 152 * n : 0);
+    f.peakBytes = 152 * n;
+    f.refusal = storageRefusal(q, "its leaf-ordered triangles", 48 * n, true);
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its nodes", 64 * n, true);
+    return f;
+}
 AlgorithmInfo bvhRaytraceInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<BvhRaytrace>(
         "bvh_raytrace", "GLSL ray tracing of the reference's shadow rays through a binned-SAH BVH built on the CPU",
         {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true, &bvhSchema);
     info.motion = MotionHandling::Refit;
+    info.footprint = &bvhRaytraceFootprint;
     return info;
 }
 

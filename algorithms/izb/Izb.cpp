@@ -247,9 +247,19 @@ private:
 
 } // namespace
 
+/// Per pixel (lists, samples, visibility) and per cell of its grid; the triangles are read through
+/// the scene positions' view.
+Footprint izbFootprint(const FootprintQuery& q) {
+    Footprint f;
+    f.bytes = 32 * size_t(q.resolution.x) * size_t(q.resolution.y) + 6 * 24 * 1024 * 1024;
+    f.refusal = texelRefusal(q, "the scene positions' view it reads", 3 * q.triangles);
+    return f;
+}
 AlgorithmInfo izbInfo() {
-    return makeAlgorithmInfo<Izb>("izb", "irregular z-buffer: view samples in a light-space grid, triangles rasterised conservatively onto it and tested exactly",
+    AlgorithmInfo info = makeAlgorithmInfo<Izb>("izb", "irregular z-buffer: view samples in a light-space grid, triangles rasterised conservatively onto it and tested exactly",
                                   {LightType::Point, LightType::Spot, LightType::Directional}, true, &izbSchema);
+    info.footprint = &izbFootprint;
+    return info;
 }
 
 } // namespace shadowlab

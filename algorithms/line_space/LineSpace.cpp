@@ -452,12 +452,24 @@ private:
 
 } // namespace
 
+/// Its pools depend on (N, d), not on the scene, and are checked in setScene; what grows with the
+/// scene is the exact start region's leaf lists (>= 4 bytes a triangle) and its check that the
+/// scene positions fit one storage block (the reported size), as setScene does.
+Footprint lineSpaceFootprint(const FootprintQuery& q) {
+    Footprint f;
+    f.bytes = 8 * q.triangles;
+    f.peakBytes = 16 * q.triangles;
+    if (std::get<std::string>(q.params->get("start_region")) == "exact")
+        f.refusal = storageRefusal(q, "the scene positions its exact start region reads", 36 * q.triangles, true);
+    return f;
+}
 AlgorithmInfo lineSpaceInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<LineSpace>(
         "line_space", "approximate shadows from precomputed line-space visibility in an N-tree (no triangle tests)",
         {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, false, &lineSpaceSchema);
     info.motion = MotionHandling::StaticOnly;
     info.rebuildParam = "rebuild_every_frame";
+    info.footprint = &lineSpaceFootprint;
     return info;
 }
 

@@ -36,6 +36,7 @@ struct MetricTreeParams {
     std::string tile;                                          ///< tile query: "auto" | "4x2" ... "8x8"
     float rayOffset;                                           ///< × scene radius
     std::string motion;                                        ///< "rigid" | "recluster"
+    int geometryBlock;                                         ///< triangles per geometry block, 0 = the device's largest
 };
 
 const ParamStruct<MetricTreeParams>& metricTreeParams() {
@@ -95,7 +96,14 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                 "moving parts: rigid = clusters are made per part (never spanning two) and their spheres, capsules, "
                 "cones and slabs move with it each frame; recluster = the whole clustering is redone on the posed "
                 "triangles every frame they move (the `recluster` stage)",
-                ParamChange::Rebuild);
+                ParamChange::Rebuild)
+        // 0 by default: the fewer blocks, the fewer arms in the query's load (a SIMD back end runs
+        // every arm). Smaller values exist to test the split (MetricTreeGLTest) and for devices
+        // whose limits lie.
+        .integer("geometry_block", &P::geometryBlock, 0, 0, INT_MAX, "triangles",
+                 "triangles per block of the cluster-ordered geometry copy (at most 6 blocks); 0 = the largest the "
+                 "device allows (a buffer-texture view's texels / 3, or one storage block's for rigid motion)",
+                 ParamChange::Rebuild);
     return s;
 }
 
@@ -116,10 +124,17 @@ public:
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
         const size_t n = scene.triangleCount();
-        if (n > size_t(MT_GEOMETRY_CHUNKS) * MT_TRIANGLES_PER_CHUNK)
+        const size_t block = blockTriangles(scene);
+        if (n > size_t(MT_GEOMETRY_CHUNKS) * block)
             throw RuntimeError("metric_tree: " + std::to_string(n) + " triangles exceed the " +
-                               std::to_string(size_t(MT_GEOMETRY_CHUNKS) * MT_TRIANGLES_PER_CHUNK) +
-                               " the geometry blocks hold");
+                               std::to_string(size_t(MT_GEOMETRY_CHUNKS) * block) + " its " +
+                               std::to_string(MT_GEOMETRY_CHUNKS) + " geometry blocks of " + std::to_string(block) +
+                               " triangles hold on this device");
+        if (block != blockTriangles_) {
+            blockTriangles_ = block;
+            poseClusters_ = ShaderProgram(), poseGeometry_ = ShaderProgram();
+            compile();
+        }
         clusters_ = GlBuffer(), nodes_ = GlBuffer();
         for (GlBuffer& g : geometry_) g = GlBuffer();
         // A moving scene: clusters per part in the part's own space, posed each frame (sceneMoved).
@@ -134,9 +149,10 @@ public:
         order_ = GlBuffer::fromVector(pc.clustering.order, 0);
         movingFirst_ = pc.staticTriangles;
         movingClusterFirst_ = pc.staticClusters;
-        if (!poseClusters_) {  // no define of theirs changes: compiled once, for moving scenes only
-            poseClusters_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "1"}});
-            poseGeometry_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "0"}});
+        if (!poseClusters_) {  // only the block size changes their code: compiled again with it, for moving scenes only
+            const std::pair<std::string, std::string> block{"MT_TRIANGLES_PER_CHUNK", std::to_string(blockTriangles_)};
+            poseClusters_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "1"}, block});
+            poseGeometry_ = ShaderProgram::compute("metric_tree/pose.comp", {{"MT_POSE_CLUSTERS", "0"}, block});
         }
     }
 
@@ -177,19 +193,25 @@ public:
         clusters_ = GlBuffer::fromVector(c.clusters, 0);
         nodes_ = GlBuffer(std::max<size_t>(1, clusterCount_) * MT_NODE_BYTES, nullptr, GL_DYNAMIC_STORAGE_BIT);
         counters_.allocate();
-        // The triangles in cluster order, split over blocks of at most MT_TRIANGLES_PER_CHUNK.
+        // The triangles in cluster order, split over blocks of at most blockTriangles_, each filled
+        // in slices so that no second copy of a block exists on the host.
         geometryBytes_ = 0;
         for (GlBuffer& g : geometry_) g = GlBuffer();
-        for (size_t chunk = 0; chunk * MT_TRIANGLES_PER_CHUNK < n; ++chunk) {
-            const size_t begin = chunk * MT_TRIANGLES_PER_CHUNK, end = std::min(n, begin + MT_TRIANGLES_PER_CHUNK);
-            std::vector<float> v;
-            v.reserve(9 * (end - begin));
-            for (size_t i = begin; i < end; ++i)
-                for (int k = 0; k < 3; ++k) {
-                    const glm::vec3 p = s.positions[3 * size_t(c.order[i]) + k];
-                    v.insert(v.end(), {p.x, p.y, p.z});
-                }
-            geometry_[chunk] = GlBuffer::fromVector(v, 0);
+        constexpr size_t kSlice = 1 << 20;
+        std::vector<float> v;
+        for (size_t chunk = 0; chunk * blockTriangles_ < n; ++chunk) {
+            const size_t begin = chunk * blockTriangles_, end = std::min(n, begin + blockTriangles_);
+            geometry_[chunk] = GlBuffer(9 * sizeof(float) * (end - begin), nullptr, GL_DYNAMIC_STORAGE_BIT);
+            for (size_t from = begin; from < end; from += kSlice) {
+                const size_t to = std::min(end, from + kSlice);
+                v.clear();
+                for (size_t i = from; i < to; ++i)
+                    for (int k = 0; k < 3; ++k) {
+                        const glm::vec3 p = s.positions[3 * size_t(c.order[i]) + k];
+                        v.insert(v.end(), {p.x, p.y, p.z});
+                    }
+                geometry_[chunk].upload(v.data(), v.size() * sizeof(float), 9 * sizeof(float) * (from - begin));
+            }
             geometryBytes_ += geometry_[chunk].size();
         }
         if (!geometry_[0]) geometry_[0] = GlBuffer(36, nullptr, 0); // an empty scene still binds its blocks
@@ -198,7 +220,7 @@ public:
         for (int i = 0; i < MT_GEOMETRY_CHUNKS; ++i)
             geometryTexels_[i] = geometry_[i] ? makeBufferTexture(geometry_[i], GL_RGB32F, 12, "metric_tree geometry") : GlTexture();
         // The query reads the blocks that hold triangles only (a #define): recompiled when that changes.
-        const int used = int(std::max<size_t>(1, (n + MT_TRIANGLES_PER_CHUNK - 1) / MT_TRIANGLES_PER_CHUNK));
+        const int used = int(std::max<size_t>(1, (n + blockTriangles_ - 1) / blockTriangles_));
         if (used != geometryUsed_) {
             geometryUsed_ = used;
             compile();
@@ -257,12 +279,19 @@ public:
                     {"tile_pixels", tileQueryPixels()},
                     {"tile_fallbacks", double(c[MT_C_TILE_FALLBACKS])},
                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
-                    {"clustering_ms", clusteringMs_}};
+                    {"clustering_ms", clusteringMs_},
+                    {"cache_read_ms", cacheReadMs_},
+                    {"cache_write_ms", cacheWriteMs_},
+                    {"geometry_bytes", double(geometryBytes_)},
+                    {"geometry_blocks", double(geometryUsed_)}};
         return {{"clusters", n},
                 {"capsule_percent", n > 0 ? 100.0 * double(capsuleCount_) / n : 0.0},
                 {"triangles_per_cluster", n > 0 ? double(scene_->triangleCount()) / n : 0.0},
                 {"bytes_per_cluster", n > 0 ? double(mt::structureBytes(clusterCount_)) / n : 0.0},
                 {"geometry_bytes", double(geometryBytes_)},
+                {"geometry_blocks", double(geometryUsed_)},
+                {"cache_read_ms", cacheReadMs_},
+                {"cache_write_ms", cacheWriteMs_},
                 {"clusters_inserted", double(c[MT_C_INSERTED])},
                 {"clusters_culled", double(c[MT_C_CULLED])},
                 {"insert_depth_max", double(c[MT_C_INSERT_DEPTH_MAX])},
@@ -297,6 +326,9 @@ public:
     /// counter block. Not counted, as in the paper: the triangles themselves, which metric_tree
     /// keeps in cluster order (counter geometry_bytes), and the per-pixel debug images.
     size_t memoryBytes() const override { return mt::structureBytes(clusterCount_) + counters_.size(); }
+    size_t residentBytes() const override {
+        return memoryBytes() + geometryBytes_ + restClusters_.size() + clusterPart_.size() + order_.size();
+    }
 
     /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
     uint64_t overflowCount() const override {
@@ -323,10 +355,21 @@ private:
                                        {"MT_TILE_CANDIDATES", std::to_string(p_.tileCandidates)},
                                        {"MT_TILE_PIXELS", std::to_string(tilePixels())},
                                        {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
+                                       {"MT_TRIANGLES_PER_CHUNK", std::to_string(blockTriangles_)},
                                        instrumentationDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
         insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);
+    }
+
+    /// Triangles per geometry block for `scene`: the parameter, else the largest block this device
+    /// lets the passes that touch it address. Rigid motion writes the blocks as storage blocks.
+    size_t blockTriangles(const SceneGpu& scene) const {
+        if (p_.geometryBlock > 0) return size_t(p_.geometryBlock);
+        const bool written = scene.dynamic() && p_.motion == "rigid";
+        // A multiple of 16 triangles keeps every block's byte offset 16-byte aligned.
+        const size_t block = written ? maxShaderStorageBlockBytes() / (9 * sizeof(float)) : maxTextureBufferTexels() / 3;
+        return std::max<size_t>(16, block / 16 * 16);
     }
 
     /// Pixels per tile of the tile query: "WxH" -> W * H; auto -> autoTilePixels().
@@ -356,10 +399,22 @@ private:
         const uint64_t hash = dir.empty() ? 0 : scene.contentHash();
         const std::string path = dir.empty() ? std::string() : mt::cacheFile(dir, hash, o);
         const size_t n = scene.triangleCount();
+        // Each step timed on its own: at tens of millions of triangles the cache's write and read
+        // are results of their own (counters cache_read_ms, cache_write_ms).
+        auto timed = [](double& ms, auto&& step) {
+            const auto t0 = std::chrono::steady_clock::now();
+            auto result = step();
+            ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            return result;
+        };
+        cacheReadMs_ = cacheWriteMs_ = 0;
         mt::Clustering c = diskcache::loadOrBuild(
-            "metric_tree", path, [&](std::string* why) { return mt::loadCache(path, hash, o, scene, why); },
+            "metric_tree", path,
+            [&](std::string* why) { return timed(cacheReadMs_, [&] { return mt::loadCache(path, hash, o, scene, why); }); },
             [&] { return mt::clusterScene(scene, o); },
-            [&](const mt::Clustering& value, std::string* why) { return mt::saveCache(path, hash, o, n, value, why); },
+            [&](const mt::Clustering& value, std::string* why) {
+                return timed(cacheWriteMs_, [&] { return mt::saveCache(path, hash, o, n, value, why); });
+            },
             &cacheHit_);
         clusteringMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         return c;
@@ -525,10 +580,11 @@ private:
     GlTexture nodesVisited_, triangleTests_, fruitless_, overflow_;
     size_t clusterCount_ = 0, capsuleCount_ = 0, geometryBytes_ = 0;
     int geometryUsed_ = 1; ///< geometry blocks holding triangles (MT_GEOMETRY_USED)
+    size_t blockTriangles_ = MT_TRIANGLES_PER_CHUNK; ///< triangles per geometry block (MT_TRIANGLES_PER_CHUNK)
     int subgroupSize_ = 0; ///< the context's subgroup width (0: unknown), for tile = auto
     float lsEps_ = kAngularEps;
     bool cacheHit_ = false;
-    double clusteringMs_ = 0;
+    double clusteringMs_ = 0, cacheReadMs_ = 0, cacheWriteMs_ = 0;
 };
 
 } // namespace
@@ -538,11 +594,33 @@ int autoTilePixels(int subgroupWidth) {
     return std::clamp(64 / subgroupWidth, 8, 64);
 }
 
+/// 36 bytes a triangle of cluster-ordered geometry, 128 a cluster (at most 2 n / cluster_size + 1:
+/// the demo averages 9.9 triangles a cluster at 16), 16 a pixel of debug images; while the
+/// clustering runs, ~20 bytes a triangle (Clustering.cpp) and one upload slice.
+Footprint metricTreeFootprint(const FootprintQuery& q) {
+    const MetricTreeParams p = metricTreeParams().read(*q.params);
+    const size_t n = q.triangles, pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
+    const size_t clusters = std::min(n, 2 * n / size_t(p.clusterSize) + 1);
+    const bool rigid = q.moving && p.motion == "rigid";
+    Footprint f;
+    f.bytes = 36 * n + 128 * clusters + 16 * pixels + (rigid ? 68 * clusters + 4 * n : 0);
+    f.peakBytes = 24 * n + 36 * (size_t(1) << 20);
+    size_t block = p.geometryBlock > 0 ? size_t(p.geometryBlock)
+                   : rigid            ? q.reportedStorageBlockBytes / 36 / 16 * 16
+                                      : q.textureBufferTexels / 3 / 16 * 16;
+    if (block > 0 && n > MT_GEOMETRY_CHUNKS * block)
+        f.refusal = "its " + std::to_string(MT_GEOMETRY_CHUNKS) + " geometry blocks of " + std::to_string(block) +
+                    " triangles hold " + std::to_string(MT_GEOMETRY_CHUNKS * block);
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its clusters and nodes", 64 * clusters);
+    return f;
+}
+
 AlgorithmInfo metricTreeInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<MetricTree>("metric_tree",
                                     "clusters bounded by spheres/capsules in a per-frame ternary metric tree (compute), per-pixel query",
                                     {LightType::Point, LightType::Directional}, true, &metricTreeSchema);
     info.motion = MotionHandling::Rigid;
+    info.footprint = &metricTreeFootprint;
     return info;
 }
 

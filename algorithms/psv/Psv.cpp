@@ -263,10 +263,24 @@ private:
 
 } // namespace
 
+/// The node pool (the paper's 128 bytes a triangle) is one storage block and one RGBA32UI view of
+/// two texels a node; the frusta and the close calls read the scene's positions through its view.
+Footprint psvFootprint(const FootprintQuery& q) {
+    Footprint f;
+    const size_t n = q.triangles;
+    f.bytes = psv::memoryBytes(n) + 8 * size_t(q.resolution.x) * size_t(q.resolution.y);
+    f.refusal = storageRefusal(q, "its node pool", psv::nodeCount(n) * PSV_NODE_BYTES);
+    if (f.refusal.empty()) f.refusal = texelRefusal(q, "its node pool's view", 2 * psv::nodeCount(n));
+    if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", 3 * n);
+    return f;
+}
+
 AlgorithmInfo psvInfo() {
-    return makeAlgorithmInfo<Psv>("psv",
+    AlgorithmInfo info = makeAlgorithmInfo<Psv>("psv",
                                     "partitioned shadow volumes: per-frame TOP tree of shadow frusta (compute), per-pixel stack, stackless or hybrid query",
                                     {LightType::Point, LightType::Spot, LightType::Directional}, true, &psvSchema);
+    info.footprint = &psvFootprint;
+    return info;
 }
 
 } // namespace shadowlab

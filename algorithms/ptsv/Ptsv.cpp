@@ -532,10 +532,21 @@ private:
 
 } // namespace
 
+/// 128 bytes a triangle of planes (one storage block, checked against the reported limit as
+/// setScene does), the view-sample hierarchy and job lists per pixel.
+Footprint ptsvFootprint(const FootprintQuery& q) {
+    Footprint f;
+    const size_t planes = q.triangles * PTSV_PLANES_PER_TRIANGLE * 16;
+    f.bytes = planes + 40 * size_t(q.resolution.x) * size_t(q.resolution.y);
+    f.refusal = storageRefusal(q, "its shadow-volume planes", planes, true);
+    return f;
+}
 AlgorithmInfo ptsvInfo() {
-    return makeAlgorithmInfo<Ptsv>("ptsv",
+    AlgorithmInfo info = makeAlgorithmInfo<Ptsv>("ptsv",
                                     "per-triangle shadow volumes through a per-frame view-sample cluster hierarchy (compute)",
                                     {LightType::Point, LightType::Directional}, true, &ptsvSchema);
+    info.footprint = &ptsvFootprint;
+    return info;
 }
 
 } // namespace shadowlab

@@ -16,7 +16,12 @@ struct ReferenceParams {
     int threads;     ///< 0 = all hardware threads
     float rayOffset; ///< × scene radius
     std::string motionUpdate; ///< refit | rebuild: how the BVH follows moving parts
+    std::string bvh;          ///< auto | fast | compact: Embree's data layout
 };
+
+/// `bvh: auto` takes the compact layout from this many triangles (docs/memory.md: it saves about
+/// 40 bytes a triangle, and the reference's time per frame is small next to any GPU algorithm's).
+constexpr size_t kCompactBvhTriangles = 10'000'000;
 
 const ParamStruct<ReferenceParams>& referenceParams() {
     using P = ReferenceParams;
@@ -27,6 +32,10 @@ const ParamStruct<ReferenceParams>& referenceParams() {
         .choice("motion_update", &P::motionUpdate, "refit", {"refit", "rebuild"},
                 "how the Embree BVH follows moving parts each frame: refit its boxes (fast; the tree degrades as "
                 "parts travel) or rebuild it (the CPU alternative's full cost); either is exact",
+                ParamChange::Rebuild)
+        .choice("bvh", &P::bvh, "auto", {"auto", "fast", "compact"},
+                "Embree's layout: fast (precomputed triangle leaves) or compact (indexed leaves reading the scene's "
+                "vertices, compact nodes: less memory, slower rays); auto: compact from 10 M triangles; either is exact",
                 ParamChange::Rebuild);
     return s;
 }
@@ -37,13 +46,19 @@ class Reference final : public ShadowAlgorithm {
 public:
     explicit Reference(const ParamValues& params) : p_(referenceParams().read(params)) {}
 
+    bool compactBvh(size_t triangles) const {
+        return p_.bvh == "compact" || (p_.bvh == "auto" && triangles >= kCompactBvhTriangles);
+    }
+
     void setScene(const SceneGpu& scene) override {
         tracer_.reset(); // free the old BVH before building the new one
         scene_ = &scene;
         posed_.clear();
         tracer_ = std::make_unique<EmbreeTracer>(scene.cpu(), p_.motionUpdate == "rebuild"
                                                                   ? EmbreeTracer::MotionUpdate::Rebuild
-                                                                  : EmbreeTracer::MotionUpdate::Refit);
+                                                                  : EmbreeTracer::MotionUpdate::Refit,
+                                               // the SceneGpu's Scene lives as long as this scene is set
+                                               EmbreeTracer::Vertices::Share, compactBvh(scene.triangleCount()));
     }
 
     // The moving triangles are read back from the GPU rather than posed again here, so the ground
@@ -82,7 +97,8 @@ public:
 
     /// The threads tracing rays (EmbreeTracer::traceVisibility's rule for 0: all hardware threads).
     std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
-        return {{"threads", std::to_string(p_.threads > 0 ? p_.threads : int(std::max(1u, std::thread::hardware_concurrency())))}};
+        return {{"threads", std::to_string(p_.threads > 0 ? p_.threads : int(std::max(1u, std::thread::hardware_concurrency())))},
+                {"bvh", scene_ && compactBvh(scene_->triangleCount()) ? "compact" : "fast"}};
     }
 
     /// The visibility of the last frame (row-major, width * height), as uploaded.
@@ -99,11 +115,29 @@ private:
 
 } // namespace
 
+/// Embree's BVH and index buffer: kEmbreeBytesPerTriangle measured (docs/memory.md; the vertices
+/// are the Scene's own for a static scene, copied, 36 bytes more, for a moving one), plus the
+/// reference's visibility and G-buffer copies per pixel.
+constexpr size_t kEmbreeBytesPerTriangle = 90;
+constexpr size_t kEmbreeCompactBytesPerTriangle = 60;
+Footprint referenceFootprint(const FootprintQuery& q) {
+    Footprint f;
+    const size_t pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
+    const std::string layout = std::get<std::string>(q.params->get("bvh"));
+    const bool compact = layout == "compact" || (layout == "auto" && q.triangles >= kCompactBvhTriangles);
+    f.bytes = q.triangles * ((compact ? kEmbreeCompactBytesPerTriangle : kEmbreeBytesPerTriangle) + (q.moving ? 36 + 36 : 0)) +
+              48 * pixels;
+    // Embree's builder holds primitive references and temporary nodes while it builds.
+    f.peakBytes = q.triangles * 64;
+    return f;
+}
+
 AlgorithmInfo referenceInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<Reference>(
         "reference", "ground truth: exact shadows ray-traced on the CPU with Embree (multi-threaded)",
         {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true, &referenceSchema);
     info.motion = MotionHandling::Refit;
+    info.footprint = &referenceFootprint;
     return info;
 }
 

@@ -379,11 +379,25 @@ private:
 
 } // namespace
 
+/// Edge sides and silhouette records (12 bytes a triangle each, storage blocks), the first side of
+/// each edge and the facing sign (4 each), 28 bytes a pixel; the edge adjacency's build peaks at
+/// ~130 bytes a triangle on the host. The triangles are read through the scene positions' view.
+Footprint shadowVolumesFootprint(const FootprintQuery& q) {
+    Footprint f;
+    const size_t n = q.triangles;
+    f.bytes = 44 * n + 28 * size_t(q.resolution.x) * size_t(q.resolution.y);
+    f.peakBytes = 130 * n;
+    f.refusal = storageRefusal(q, "its edge sides", 12 * n);
+    if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", 3 * n);
+    return f;
+}
 AlgorithmInfo shadowVolumesInfo() {
-    return makeAlgorithmInfo<ShadowVolumes>("shadow_volumes",
+    AlgorithmInfo info = makeAlgorithmInfo<ShadowVolumes>("shadow_volumes",
                                             "stencil shadow volumes: GPU silhouettes with multiplicity, ZFAIL (caps) or ZPASS",
                                             {LightType::Point, LightType::Spot, LightType::Directional}, true,
                                             &shadowVolumesSchema);
+    info.footprint = &shadowVolumesFootprint;
+    return info;
 }
 
 } // namespace shadowlab

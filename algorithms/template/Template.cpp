@@ -143,10 +143,20 @@ private:
 
 /// 8. The registry entry: name (= folder, JSON "algorithm" value, results label), summary, lights,
 /// exactness (exact algorithms are held to the reference's tiny mismatch by the conformance test).
+/// The triangle order (4 bytes a triangle); the brute-force loop reads the scene positions as one
+/// storage block.
+Footprint templateFootprint(const FootprintQuery& q) {
+    Footprint f;
+    f.bytes = 4 * q.triangles;
+    f.refusal = storageRefusal(q, "the scene positions it reads", 36 * q.triangles);
+    return f;
+}
 AlgorithmInfo templateInfo() {
-    return makeAlgorithmInfo<Template>("template", "example plugin: exact hard shadows, every pixel against every triangle",
+    AlgorithmInfo info = makeAlgorithmInfo<Template>("template", "example plugin: exact hard shadows, every pixel against every triangle",
                                        {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true,
                                        &templateSchema);
+    info.footprint = &templateFootprint;
+    return info;
 }
 
 } // namespace shadowlab

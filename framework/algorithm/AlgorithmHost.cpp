@@ -72,6 +72,7 @@ FrameMeasurement AlgorithmHost::computeFrame(const FrameView& view, StageTimer& 
     m.counters = algorithm_->counters();
     m.overflow = algorithm_->overflowCount();
     m.memoryBytes = algorithm_->memoryBytes();
+    m.residentBytes = algorithm_->residentBytes();
     return m;
 }
 

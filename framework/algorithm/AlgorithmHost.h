@@ -35,6 +35,7 @@ struct FrameMeasurement {
     std::vector<Counter> counters;
     uint64_t overflow = 0;
     size_t memoryBytes = 0;
+    size_t residentBytes = 0; ///< ShadowAlgorithm::residentBytes(): everything it holds
     /// stages plus the "total" row: summed GPU time, and the frame's wall time.
     std::vector<StageTime> stagesWithTotal() const;
 };

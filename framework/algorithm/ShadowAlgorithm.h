@@ -77,6 +77,30 @@ struct AlgorithmOptions {
     bool instrumentation = true;
 };
 
+/// A scene as an algorithm's memory estimate sees it, before the scene exists (checkMemoryPlan).
+struct FootprintQuery {
+    size_t triangles = 0;           ///< an upper bound of the scene's triangles
+    glm::ivec2 resolution{0};
+    bool moving = false;            ///< the scene has moving parts
+    const ParamValues* params = nullptr;
+    size_t storageBlockBytes = 0;   ///< what one storage block addresses on this device, measured (MemoryPlan.cpp)
+    size_t reportedStorageBlockBytes = 0; ///< GL_MAX_SHADER_STORAGE_BLOCK_SIZE, for plugins that check it themselves
+    size_t textureBufferTexels = 0; ///< GL_MAX_TEXTURE_BUFFER_SIZE of this device
+};
+
+/// What an algorithm will hold for a FootprintQuery's scene, or why it cannot take it here.
+struct Footprint {
+    size_t bytes = 0;     ///< held for the run: its structures, copies of the scene, per-pixel images (host + GPU:
+                          ///< a software renderer keeps GPU buffers in host memory)
+    size_t peakBytes = 0; ///< held only while setScene() runs, on top of `bytes` (e.g. a clustering's working set)
+    std::string refusal;  ///< not empty: this algorithm cannot run the scene on this device, and why
+};
+
+/// The usual refusals of a Footprint: "" when `bytes` fit one storage block / `texels` one
+/// buffer-texture view of the query's device, else a sentence naming `what` and the limit.
+std::string storageRefusal(const FootprintQuery& q, const char* what, size_t bytes, bool reportedLimit = false);
+std::string texelRefusal(const FootprintQuery& q, const char* what, size_t texels);
+
 class ShadowAlgorithm {
 public:
     virtual ~ShadowAlgorithm() = default;
@@ -94,6 +118,9 @@ public:
     virtual std::vector<DebugView> debugViews() const { return {}; }
     /// Bytes of GPU (or CPU, for CPU algorithms) memory the algorithm holds for its structures.
     virtual size_t memoryBytes() const { return 0; }
+    /// Every byte it holds (host and GPU) for the memory report: memoryBytes() plus copies of the
+    /// scene and per-pixel images that the paper's figure leaves out.
+    virtual size_t residentBytes() const { return memoryBytes(); }
     /// Fixed-size structures that overflowed in the last frame (0 = the image is trustworthy).
     virtual uint64_t overflowCount() const { return 0; }
     /// The value each parameter whose choice depends on the device ("auto", "0 = ...") resolved to
@@ -112,6 +139,9 @@ struct AlgorithmInfo {
     std::string rebuildParam;     ///< StaticOnly: the bool parameter that allows moving scenes (rebuilt each frame)
     const ParamSchema& (*schema)();
     std::unique_ptr<ShadowAlgorithm> (*create)(const ParamValues& params, const AlgorithmOptions& options);
+    /// Its memory estimate for a scene, before the scene exists; nullptr: nothing that grows with the
+    /// scene. The runner refuses a run up front when one refuses or the sum exceeds the machine.
+    Footprint (*footprint)(const FootprintQuery& query) = nullptr;
 
     bool supports(LightType t) const;
     /// "" when the algorithm can run on a scene that moves with these parameter values, else why not.

@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
 #include "framework/experiment/Config.h"
+#include "framework/experiment/MemoryPlan.h"
 #include "framework/experiment/DeviceReport.h"
 #include "framework/experiment/Runner.h"
 #include "framework/gl/DeviceInfo.h"
@@ -32,6 +33,11 @@ const char* kRunUsage = R"(  shadowlab run CONFIG.json [--out DIR] [--force] [--
 const char* kValidateUsage = R"(  shadowlab validate CONFIG.json [--set PATH=VALUE]...
       Checks the config (and loads its scene) without rendering; prints the resolved config.
 )";
+const char* kPlanUsage = R"(  shadowlab plan CONFIG.json [--set PATH=VALUE]... [--triangles N]
+      The memory a run would need, without making the scene: the scene's predicted triangles (or
+      N), each algorithm's estimate or why it refuses the scene on this device, and the total
+      against the memory available. Exit 2 when the run would be refused (as run would refuse it).
+)";
 const char* kListUsage = R"(  shadowlab list [--json | --markdown [NAME]]
       Lists the registered algorithms and their parameters; --markdown prints each parameter table
       as docs/algorithms/NAME.md holds it (scripts/update_param_docs.py rewrites the docs from it).
@@ -46,7 +52,7 @@ const char* kInfoUsage = R"(  shadowlab info [--json]
 
 std::string fullUsage() {
     return std::string("shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.\n\nUsage:\n") +
-           kRunUsage + kValidateUsage + kListUsage + kInfoUsage + kSweepUsage + "  shadowlab --help | --version\n\n" +
+           kRunUsage + kValidateUsage + kPlanUsage + kListUsage + kInfoUsage + kSweepUsage + "  shadowlab --help | --version\n\n" +
            "Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.\n";
 }
 
@@ -149,10 +155,16 @@ int run(const std::vector<std::string>& args) {
     OutputPlace place = OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes);
     for (const auto& n : notes) std::fprintf(stderr, "shadowlab: %s\n", shortText(n, 600).c_str());
     opt.place = &place;
-    cfg = loadConfig(config, true, overrides);
-    throwIfInterrupted();
+    // The context first: the memory plan needs the device's limits, and is checked before the
+    // scene is made, so a run that cannot fit stops here (exit 2) instead of in the OOM killer.
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
+    const ScenePrediction predicted = predictConfigScene(config, overrides);
+    const MemoryPlan plan = checkMemoryPlan(cfg, predicted.triangles, predicted.moving, currentDeviceLimits(predicted.triangles));
+    std::fprintf(stderr, "shadowlab: memory: %s\n", plan.summary().c_str());
+    opt.memoryPlan = plan.toJson();
+    cfg = loadConfig(config, true, overrides);
+    throwIfInterrupted();
     // The name is the config's text: cut, so a huge or multi-line one stays one short line.
     std::fprintf(stderr, "shadowlab: %s, %zu triangles, %d×%d, %d frames on %s (%s)\n", shortText(cfg.name, 100).c_str(),
                  cfg.scene->triangleCount(), cfg.resolution.x, cfg.resolution.y, cfg.frames, glRendererString().c_str(),
@@ -166,6 +178,48 @@ int run(const std::vector<std::string>& args) {
         std::fprintf(stderr, "shadowlab: %d OpenGL errors were reported during the run\n", glErrorCount());
         return 1;
     }
+    return 0;
+}
+
+/// `shadowlab plan CONFIG [--set PATH=VALUE] [--triangles N]`: the memory plan of a run and each
+/// algorithm's estimate or refusal on this device, for the config's scene or for N triangles,
+/// without making the scene. Exit 0 when the run would start, 2 (with the run's error) when not.
+int plan(const std::vector<std::string>& args) {
+    std::string config;
+    std::vector<std::string> overrides;
+    size_t triangles = 0;
+    for (size_t i = 1; i < args.size(); ++i) {
+        if (isHelp(args[i])) return commandUsage(kPlanUsage);
+        if (args[i] == "--set") {
+            if (++i >= args.size()) usageError("--set needs PATH=VALUE");
+            checkOverride(args[i]);
+            overrides.push_back(args[i]);
+        } else if (args[i] == "--triangles") {
+            if (++i >= args.size()) usageError("--triangles needs a count");
+            char* end = nullptr;
+            const unsigned long long v = std::strtoull(args[i].c_str(), &end, 10);
+            if (args[i].empty() || *end != '\0' || v == 0) usageError("--triangles needs a positive count, got " + shortText(args[i], 40));
+            triangles = size_t(v);
+        } else if (config.empty() && !args[i].empty() && args[i][0] != '-') {
+            config = args[i];
+        } else {
+            usageError("plan takes one config file, --set PATH=VALUE and --triangles N");
+        }
+    }
+    if (config.empty()) usageError("plan needs a config file");
+    ExperimentConfig cfg = loadConfig(config, false, overrides);
+    auto context = createHeadlessContext(false);
+    installGlDebugCallback(true);
+    ScenePrediction predicted = predictConfigScene(config, overrides);
+    if (triangles > 0) predicted.triangles = triangles;
+    const DeviceLimits limits = currentDeviceLimits(predicted.triangles);
+    std::printf("scene: up to %zu triangles%s; storage block %zu MiB (reported %zu), buffer-texture view %zu texels\n",
+                predicted.triangles, predicted.moving ? ", moving" : "", limits.storageBlockBytes >> 20,
+                limits.reportedStorageBlockBytes >> 20, limits.textureBufferTexels);
+    for (const std::string& line : describeFootprints(cfg, predicted.triangles, predicted.moving, limits))
+        std::printf("%s\n", line.c_str());
+    const MemoryPlan p = checkMemoryPlan(cfg, predicted.triangles, predicted.moving, limits);
+    std::printf("plan: %s\n", p.summary().c_str());
     return 0;
 }
 
@@ -241,6 +295,7 @@ int main(int argc, char** argv) {
                          cfg.algorithms.size(), cfg.reference ? " + reference" : "");
             return 0;
         }
+        if (args[0] == "plan") return plan(args);
         if (args[0] == "run") return run(args);
         if (args[0] == "info") return info(args);
         if (args[0] == "sweep") return sweepCommand(args);

@@ -318,4 +318,13 @@ ExperimentConfig loadConfig(const std::string& file, bool loadScene, const std::
     return parseConfig(j, file, loadScene);
 }
 
+ScenePrediction predictConfigScene(const std::string& file, const std::vector<std::string>& overrides) {
+    Json j = JsonNode::parseFile(file);
+    for (const auto& o : overrides) applyOverride(j, o);
+    Json resolved = Json::object();
+    JsonNode root(file, &j, "", &resolved);
+    if (!root.has("scene")) root.fail("scene", "required key is missing");
+    return predictScene(root.child("scene"));
+}
+
 } // namespace shadowlab

@@ -4,6 +4,7 @@
 // defaults; `resolved` holds every value actually used (written as config.resolved.json).
 #include "framework/algorithm/ShadowAlgorithm.h"
 #include "framework/scene/Scene.h"
+#include "framework/scene/SceneConfig.h"
 #include "framework/view/Camera.h"
 #include "framework/view/Light.h"
 #include "framework/view/Path.h"
@@ -79,5 +80,7 @@ ExperimentConfig loadConfig(const std::string& file, bool loadScene = true,
 void applyOverride(Json& config, const std::string& assignment);
 /// Same, from JSON already in memory; `file` names it in errors and anchors relative paths.
 ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loadScene = true);
+/// The config's scene counted without making it (predictScene), with the same overrides.
+ScenePrediction predictConfigScene(const std::string& file, const std::vector<std::string>& overrides = {});
 
 } // namespace shadowlab

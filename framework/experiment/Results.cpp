@@ -202,6 +202,7 @@ Json ExperimentResults::summary() const {
                                     {"visibility_differs_frames", a.visibilityDiffers}};
         }
         j["memory_bytes"] = a.memoryBytes;
+        j["resident_bytes"] = a.residentBytes;
         j["overflow"] = overflow;
         Json resolved = Json::object();
         for (const auto& [k, v] : a.resolvedParams) resolved[k] = v;
@@ -212,6 +213,32 @@ Json ExperimentResults::summary() const {
     out["complete"] = true;
     return out;
 }
+
+namespace {
+/// "## Memory": the peak resident set and each part's bytes, per triangle, beside the plan's estimate.
+void writeMemorySection(std::ostream& os, const Json& s) {
+    if (!s.contains("memory")) return;
+    const Json& m = s["memory"];
+    const double mib = 1024.0 * 1024.0, gib = mib * 1024.0;
+    os << "\n## Memory\n\n" << std::fixed << std::setprecision(2) << "Peak resident memory of the run "
+       << double(m["peak_rss_bytes"].get<size_t>()) / gib << " GiB (" << double(m["rss_after_setup_bytes"].get<size_t>()) / gib
+       << " GiB once every algorithm had its scene), machine " << double(m["machine_bytes"].get<size_t>()) / gib
+       << " GiB. A software renderer keeps GPU buffers in host memory, so every part below is resident.\n\n";
+    const Json plan = m.value("plan", Json());
+    if (!plan.is_null())
+        os << "Estimated before the scene was made: peak " << double(plan["peak_bytes"].get<size_t>()) / gib << " GiB for up to "
+           << plan["triangles"].get<size_t>() << " triangles, of " << double(plan["available_bytes"].get<size_t>()) / gib
+           << " GiB available.\n\n";
+    os << "| part | MiB | bytes per triangle | estimate (MiB) |\n|---|---:|---:|---:|\n";
+    for (const auto& [name, v] : m["parts"].items()) {
+        os << "| " << name << " | " << double(v["bytes"].get<size_t>()) / mib << " | " << std::setprecision(1)
+           << v["bytes_per_triangle"].get<double>() << std::setprecision(2) << " | ";
+        if (!plan.is_null() && plan["held_bytes"].contains(name)) os << double(plan["held_bytes"][name].get<size_t>()) / mib;
+        os << " |\n";
+    }
+    os.unsetf(std::ios::fixed);
+}
+} // namespace
 
 void ExperimentResults::writeReport(const std::string& path, const Json& s) const {
     std::ostringstream os;
@@ -292,6 +319,7 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
         }
         os << " |\n";
     }
+    writeMemorySection(os, s);
     writeFileAtomic(path, os.str());
 }
 

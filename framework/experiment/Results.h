@@ -27,6 +27,7 @@ struct AlgorithmResults {
     Json params;
     double preprocessMs = 0;
     size_t memoryBytes = 0;
+    size_t residentBytes = 0; ///< everything it held (ShadowAlgorithm::residentBytes), largest over frames
     std::vector<FrameRecord> frames;      ///< the timed pass: statistics compiled out, every frame
     /// The untimed statistics pass (instrumented shaders) over ExperimentConfig::statisticsFrames():
     /// its counters are the ones reported; its times only show what instrumentation costs.

@@ -3,6 +3,7 @@
 #include "framework/algorithm/AlgorithmHost.h"
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
+#include "framework/core/SystemMemory.h"
 #include "framework/experiment/OutputPlace.h"
 #include "framework/experiment/Progress.h"
 #include "framework/gl/DeviceInfo.h"
@@ -79,6 +80,28 @@ void runPlots(const std::string& dir, const std::string& finalDir, const std::st
 
 } // namespace
 
+/// Memory as measured: the process's peak resident set, and bytes (and bytes per triangle) of the
+/// scene on the host and the GPU and of everything each algorithm held; with the plan checked
+/// before the scene was made, when there was one.
+Json memoryRecord(const ExperimentConfig& cfg, const SceneGpu& sceneGpu, const ExperimentResults& results,
+                  size_t rssAfterSetup, const Json& plan) {
+    const double n = double(std::max<size_t>(1, cfg.scene->triangleCount()));
+    Json parts = Json::object();
+    auto part = [&](const std::string& name, size_t bytes) {
+        parts[name] = {{"bytes", bytes}, {"bytes_per_triangle", double(bytes) / n}};
+    };
+    part("scene", cfg.scene->bytes());
+    part("scene_gpu", sceneGpu.bytes());
+    for (const auto& a : results.algorithms) part(a.id, a.residentBytes);
+    const SystemMemory machine = systemMemory();
+    Json m = {{"peak_rss_bytes", peakResidentBytes()},
+              {"rss_after_setup_bytes", rssAfterSetup},
+              {"machine_bytes", machine.total},
+              {"parts", parts}};
+    if (!plan.is_null()) m["plan"] = plan;
+    return m;
+}
+
 ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& opt, const std::string& backend) {
     auto wallStart = Clock::now();
     std::optional<OutputPlace> ownPlace;
@@ -116,6 +139,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         inst.results.preprocessMs = inst.host->preprocessMs();
         instances.push_back(std::move(inst));
     }
+    const size_t rssAfterSetup = residentBytes();
     const std::vector<int> statFrames = cfg.statisticsFrames();
     auto isStatFrame = [&](int f) { return std::binary_search(statFrames.begin(), statFrames.end(), f); };
     auto isImageFrame = [&](int f) {
@@ -195,6 +219,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             m.wallMs += sceneUpdate.wallMs;
             FrameRecord rec = recordOf(m, frame);
             inst.results.memoryBytes = std::max(inst.results.memoryBytes, m.memoryBytes);
+            inst.results.residentBytes = std::max(inst.results.residentBytes, m.residentBytes);
 
             std::vector<float> vis = inst.host->readVisibility();
             bool isReference = cfg.reference && inst.entry == &cfg.referenceEntry;
@@ -247,6 +272,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
 
     for (auto& inst : instances) results.algorithms.push_back(std::move(inst.results));
     results.meta["wall_time_s"] = msSince(wallStart) / 1000.0;
+    results.meta["memory"] = memoryRecord(cfg, sceneGpu, results, rssAfterSetup, opt.memoryPlan);
     results.meta["frames_without_lit_pixels"] = framesWithoutLit;
     results.meta["warnings"] = Json::array();
     if (cfg.reference && !framesWithoutLit.empty()) {

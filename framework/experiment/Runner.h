@@ -16,6 +16,9 @@ struct RunOptions {
     /// The output place, already opened (checked and locked) by the caller before the scene was
     /// loaded; when null and writeOutputs, runExperiment opens it itself.
     OutputPlace* place = nullptr;
+    /// The memory plan checked before the scene was made (MemoryPlan::toJson), written to
+    /// summary.json beside what was measured; null when the caller made none.
+    Json memoryPlan;
 };
 
 /// Runs the experiment on the current GL context and writes its output directory.

@@ -45,11 +45,16 @@ GlTexture makeTexture2D(GLenum internalFormat, int width, int height, GLenum fil
     return GlTexture(id);
 }
 
-GlTexture makeBufferTexture(const GlBuffer& buffer, GLenum internalFormat, size_t texelBytes, const char* what) {
+size_t maxTextureBufferTexels() {
     GLint maxTexels = 0;
     glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
+    return size_t(std::max(maxTexels, 0));
+}
+
+GlTexture makeBufferTexture(const GlBuffer& buffer, GLenum internalFormat, size_t texelBytes, const char* what) {
+    const size_t maxTexels = maxTextureBufferTexels();
     const size_t texels = buffer.size() / texelBytes;
-    if (texels > size_t(maxTexels))
+    if (texels > maxTexels)
         throw RuntimeError(std::string(what) + ": " + std::to_string(texels) + " texels exceed this context's " +
                            "GL_MAX_TEXTURE_BUFFER_SIZE (" + std::to_string(maxTexels) + ")");
     GLuint id = 0;

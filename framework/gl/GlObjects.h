@@ -88,6 +88,8 @@ GlTexture makeTexture2D(GLenum internalFormat, int width, int height, GLenum fil
 /// (llvmpipe) is far cheaper than per-lane storage-buffer loads. Throws RuntimeError when the buffer
 /// holds more texels than GL_MAX_TEXTURE_BUFFER_SIZE.
 GlTexture makeBufferTexture(const GlBuffer& buffer, GLenum internalFormat, size_t texelBytes, const char* what);
+/// GL_MAX_TEXTURE_BUFFER_SIZE of the current context: texels one buffer-texture view can address.
+size_t maxTextureBufferTexels();
 
 /// Reads a whole single-channel float texture (level 0) into a vector of width*height floats.
 std::vector<float> readTextureR32F(GLuint texture, int width, int height);

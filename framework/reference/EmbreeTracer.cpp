@@ -93,7 +93,10 @@ RTCRay makeRay(glm::vec3 o, glm::vec3 d, float tfar) {
 
 EmbreeTracer::EmbreeTracer(const Scene& scene) : EmbreeTracer(scene, MotionUpdate::Refit) {}
 
-EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update) : state_(std::make_unique<DeviceState>()) {
+EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update) : EmbreeTracer(scene, update, Vertices::Copy) {}
+
+EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update, Vertices vertices, bool compact)
+    : state_(std::make_unique<DeviceState>()) {
     device_ = rtcNewDevice("verbose=0");
     if (!device_) throw RuntimeError("Embree: cannot create a device (" + std::string(errorName(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(
@@ -136,6 +139,7 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update) : state_(std
     if (transparent_) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     const bool dynamic = scene.dynamic();
     if (dynamic) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_DYNAMIC);
+    if (compact) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_COMPACT);
     scene_ = rtcNewScene(device_);
     if (!scene_) fail("rtcNewScene");
     rtcSetSceneFlags(scene_, flags);
@@ -146,19 +150,26 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update) : state_(std
             fail("indexing the scene", "too many triangles for 32-bit indices");
         RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
         if (!geom) fail("rtcNewGeometry");
-        // Copies into Embree-allocated buffers: they carry the padding Embree's SSE loads need past
-        // the last vertex (a std::vector<glm::vec3> does not), and the Scene need not outlive us.
         size_t nv = scene.positions.size();
-        auto* verts = static_cast<float*>(
-            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+        // Shared: the Scene's floats in place, when nothing will move them and the vector's spare
+        // capacity covers Embree's read past the last vertex. Otherwise copied into Embree-allocated
+        // buffers, which carry that padding, and the Scene need not outlive us.
+        sharesVertices_ = vertices == Vertices::Share && !dynamic && scene.positions.capacity() > nv;
+        float* verts = nullptr;
+        if (sharesVertices_)
+            rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, scene.positions.data(), 0,
+                                       3 * sizeof(float), nv);
+        else
+            verts = static_cast<float*>(
+                rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
         auto* index = static_cast<uint32_t*>(
             rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangleCount_));
-        if (!verts || !index) {
+        if ((!verts && !sharesVertices_) || !index) {
             rtcReleaseGeometry(geom);
             fail("allocating geometry buffers");
         }
         static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
-        std::memcpy(verts, scene.positions.data(), nv * sizeof(glm::vec3));
+        if (verts) std::memcpy(verts, scene.positions.data(), nv * sizeof(glm::vec3));
         for (uint32_t i = 0; i < uint32_t(nv); ++i) index[i] = i; // triangle soup: triangle t = vertices 3t..3t+2
         if (dynamic && update == MotionUpdate::Refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
         rtcCommitGeometry(geom);

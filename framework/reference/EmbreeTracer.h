@@ -52,6 +52,16 @@ public:
     /// by refitting its boxes (RTC_BUILD_QUALITY_REFIT: fast, the tree's quality degrades as parts
     /// travel) or by a full rebuild.
     EmbreeTracer(const Scene& scene, MotionUpdate update);
+    /// How the tracer holds the vertices. Copy: its own (the Scene may go away). Share: a static
+    /// scene's Scene::positions are read in place, no second copy (36 bytes a triangle); the Scene
+    /// must then outlive the tracer and not change. Embree's 16-byte loads read 4 bytes past the
+    /// last vertex, so a vector without spare capacity is copied anyway (sharesVertices() says).
+    enum class Vertices { Copy, Share };
+    /// `compact`: Embree's memory-conservative layouts (RTC_SCENE_FLAG_COMPACT: indexed leaves
+    /// that read the vertices in place, compact nodes), for scenes whose BVH would crowd memory.
+    EmbreeTracer(const Scene& scene, MotionUpdate update, Vertices vertices, bool compact = false);
+    /// Whether the vertices are the Scene's own (Vertices::Share took effect).
+    bool sharesVertices() const { return sharesVertices_; }
     ~EmbreeTracer();
     EmbreeTracer(const EmbreeTracer&) = delete;
     EmbreeTracer& operator=(const EmbreeTracer&) = delete;
@@ -100,6 +110,7 @@ private:
     RTCGeometry geometry_ = nullptr; ///< the one triangle geometry (owned by scene_)
     size_t triangleCount_ = 0;
     bool transparent_ = false;
+    bool sharesVertices_ = false;
     std::vector<uint32_t> materialIds_;   ///< only when transparent_: primID → material
     std::vector<float> materialTransmit_; ///< 1 - opacity per material
     // Memory counter and last error of the device: heap-allocated so the pointer handed to

@@ -18,18 +18,21 @@ static_assert(sizeof(TriangleInfo) == 16 && sizeof(MaterialInfo) == 16);
 
 SceneGpu::SceneGpu(const Scene& scene) : scene_(&scene), bounds_(scene.bounds) {
     positions_ = GlBuffer::fromVector(scene.positions, 0);
-    positionTexels_ = makeBufferTexture(positions_, GL_RGB32F, 12, "scene positions");
+    // The buffer-texture view holds at most GL_MAX_TEXTURE_BUFFER_SIZE texels, three per triangle
+    // (44.7 M triangles on llvmpipe): past that there is no view, and the algorithms that read the
+    // positions through it refuse the scene up front (their memory estimate says so).
+    if (scene.positions.size() <= size_t(maxTextureBufferTexels()))
+        positionTexels_ = makeBufferTexture(positions_, GL_RGB32F, 12, "scene positions");
+    // normal.xyz + material per triangle, read by the algorithms (SSBO) and by the G-buffer through
+    // a buffer-texture view indexed by gl_PrimitiveID: no per-vertex copy (48 bytes a triangle).
     std::vector<TriangleInfo> tris(scene.triangleCount());
-    // Per-vertex attribute (normal.xyz, material): the rasteriser needs per-triangle data at each
-    // vertex; reading it from an SSBO by gl_VertexID would cap the scene at the SSBO size limit.
-    std::vector<TriangleInfo> perVertex(scene.triangleCount() * 3);
     for (size_t t = 0; t < tris.size(); ++t) {
         glm::vec3 n = scene.normals[t];
         tris[t] = {n.x, n.y, n.z, scene.materialIds[t]};
-        for (int k = 0; k < 3; ++k) perVertex[3 * t + k] = tris[t];
     }
     triangles_ = GlBuffer::fromVector(tris, 0);
-    vertexNormals_ = GlBuffer::fromVector(perVertex, 0);
+    tris = {};
+    triangleTexels_ = makeBufferTexture(triangles_, GL_RGBA32UI, 16, "scene triangles");
     std::vector<MaterialInfo> mats;
     for (const auto& m : scene.materials) mats.push_back({m.albedo.x, m.albedo.y, m.albedo.z, m.opacity});
     materials_ = GlBuffer::fromVector(mats, 0);
@@ -41,13 +44,6 @@ SceneGpu::SceneGpu(const Scene& scene) : scene_(&scene), bounds_(scene.bounds) {
     glEnableVertexArrayAttrib(vao, 0);
     glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, 0, 0);
-    glVertexArrayVertexBuffer(vao, 1, vertexNormals_.id(), 0, sizeof(TriangleInfo));
-    glEnableVertexArrayAttrib(vao, 1);
-    glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(vao, 1, 1);
-    glEnableVertexArrayAttrib(vao, 2);
-    glVertexArrayAttribIFormat(vao, 2, 1, GL_UNSIGNED_INT, 12);
-    glVertexArrayAttribBinding(vao, 2, 1);
     if (scene.dynamic()) uploadMotion();
 }
 
@@ -113,7 +109,6 @@ void SceneGpu::setTime(double time) {
     transforms_.bindBase(GL_SHADER_STORAGE_BUFFER, 5);
     positions_.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
     triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
-    vertexNormals_.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
     const size_t moving = scene_->movingTriangleCount();
     update_.set("uCount", unsigned(moving));
     update_.use();
@@ -137,7 +132,10 @@ void SceneGpu::bindStorage() const {
     triangles_.bindBase(GL_SHADER_STORAGE_BUFFER, kSceneTrianglesBinding);
     materials_.bindBase(GL_SHADER_STORAGE_BUFFER, kSceneMaterialsBinding);
     glBindTextureUnit(kScenePositionUnit, positionTexels_.id());
+    glBindTextureUnit(kSceneTriangleUnit, triangleTexels_.id());
 }
+
+size_t SceneGpu::bytes() const { return positions_.size() + triangles_.size() + materials_.size() + local_.size() + movingIndex_.size() + transforms_.size(); }
 
 void SceneGpu::draw() const {
     glBindVertexArray(vao_.id());

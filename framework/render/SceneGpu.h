@@ -18,6 +18,9 @@ enum SceneBinding : GLuint {
 };
 /// Texture unit of the positions' buffer-texture view (scene.glsl, SCENE_POSITION_TEXELS).
 constexpr GLuint kScenePositionUnit = 15;
+/// Texture unit of the triangles' buffer-texture view (RGBA32UI: normal bits + material), read by
+/// the G-buffer by gl_PrimitiveID.
+constexpr GLuint kSceneTriangleUnit = 14;
 
 class SceneGpu {
 public:
@@ -55,8 +58,15 @@ public:
     const GlBuffer& partTransforms() const { return transforms_; }
     GLuint vertexArray() const { return vao_.id(); }
 
+    /// GPU bytes of the scene's buffers (positions, triangles, materials, moving parts' copies).
+    size_t bytes() const;
+    /// Whether the positions have a buffer-texture view (SCENE_POSITION_TEXELS): not past
+    /// GL_MAX_TEXTURE_BUFFER_SIZE texels, three per triangle.
+    bool hasPositionTexels() const { return positionTexels_.id() != 0; }
+
     /// Binds positions, triangles and materials to their SceneBinding points, and the positions'
-    /// buffer-texture view (RGB32F, vertex k of triangle i = texel 3i + k) to kScenePositionUnit.
+    /// buffer-texture view (RGB32F, vertex k of triangle i = texel 3i + k) to kScenePositionUnit, and the
+    /// triangles' view to kSceneTriangleUnit.
     void bindStorage() const;
     /// Draws every triangle (non-indexed) with the bound program.
     void draw() const;
@@ -65,8 +75,8 @@ private:
     void uploadMotion();
 
     const Scene* scene_;
-    GlBuffer positions_, triangles_, materials_, vertexNormals_;
-    GlTexture positionTexels_;
+    GlBuffer positions_, triangles_, materials_;
+    GlTexture positionTexels_, triangleTexels_;
     GlVertexArray vao_;
     Bounds bounds_;
     std::vector<glm::mat4> pose_;

@@ -210,11 +210,11 @@ Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint
     return scene;
 }
 
-Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing) {
+Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg) {
     count = glm::max(count, glm::ivec3(1));
     Scene scene;
     size_t copies = size_t(count.x) * size_t(count.y) * size_t(count.z);
-    scene.positions.reserve(copies * object.positions.size());
+    scene.positions.reserve(copies * object.positions.size() + 1); // + 1: see Scene::append
     scene.normals.reserve(copies * object.normals.size());
     scene.materialIds.reserve(copies * object.materialIds.size());
     // Centred in X and Z, stacked upwards from the object's own height in Y.
@@ -224,7 +224,11 @@ Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing) {
             for (int x = 0; x < count.x; ++x) {
                 glm::vec3 offset = first + glm::vec3(x, y, z) * spacing;
                 size_t matBase = scene.materials.size(), triBase = scene.triangleCount();
-                scene.append(object, glm::translate(glm::mat4(1.0f), offset));
+                const float copy = float((size_t(y) * size_t(count.z) + size_t(z)) * size_t(count.x) + size_t(x));
+                const glm::mat4 turn = rotateStepDeg == glm::vec3(0.0f)
+                                           ? glm::mat4(1.0f)
+                                           : composeTransform(glm::vec3(0.0f), copy * rotateStepDeg, glm::vec3(1.0f));
+                scene.append(object, glm::translate(glm::mat4(1.0f), offset) * turn);
                 // The copies share the object's materials: drop the duplicates append() made.
                 if (matBase > 0) {
                     scene.materials.resize(matBase);

@@ -20,6 +20,6 @@ Scene makeFence(int posts, float spacing, float height, float radius, int rails,
 /// `triangles` random triangles of edge length about `triangleSize` inside a box of `extent` centred at the origin.
 Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint32_t seed, const Material& m);
 /// `count.x × count.y × count.z` copies of `object`, spaced by `spacing`, grid centred on the origin in X and Z.
-Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing);
+Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg = glm::vec3(0.0f));
 
 } // namespace shadowlab

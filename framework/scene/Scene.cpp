@@ -30,8 +30,10 @@ void Scene::append(const Scene& other, const glm::mat4& m) {
     // A mirroring transform flips the winding; keep normals consistent with the winding.
     bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;
     // Grow geometrically (at least doubling): appending many objects one by one stays linear.
-    if (positions.capacity() < positions.size() + other.positions.size()) {
-        const size_t want = std::max(positions.size() + other.positions.size(), 2 * positions.capacity());
+    // One spare vertex: a static scene's positions are then Embree's own vertex buffer, whose
+    // 16-byte loads read 4 bytes past the last vertex (EmbreeTracer::Vertices::Share).
+    if (positions.capacity() < positions.size() + other.positions.size() + 1) {
+        const size_t want = std::max(positions.size() + other.positions.size() + 1, 2 * positions.capacity());
         positions.reserve(want);
         normals.reserve(want / 3);
         materialIds.reserve(want / 3);
@@ -176,6 +178,13 @@ void Scene::attachMotion(const MotionFn& motion, double startTime, double endTim
               [](const MovingPart& a, const MovingPart& b) { return a.firstTriangle < b.firstTriangle; });
     moving = std::move(parts);
     applyPose(poseAt(0.0));
+}
+
+size_t Scene::bytes() const {
+    size_t b = positions.capacity() * sizeof(glm::vec3) + normals.capacity() * sizeof(glm::vec3) +
+               materialIds.capacity() * sizeof(uint32_t) + materials.capacity() * sizeof(Material);
+    for (const MovingPart& p : moving) b += p.local.capacity() * sizeof(glm::vec3);
+    return b;
 }
 
 uint64_t Scene::contentHash() const {

@@ -51,6 +51,13 @@ private:
 /// One part's world matrix at `time`, checked as poseAt() checks it.
 glm::mat4 poseOf(const MovingPart& part, double time);
 
+/// Bytes a triangle takes in a Scene (3 positions 36, normal 12, material id 4), and in SceneGpu
+/// (positions 36, normal + material 16), which a software renderer keeps in host memory too.
+constexpr size_t kSceneBytesPerTriangle = 52;
+constexpr size_t kSceneGpuBytesPerTriangle = 52;
+/// The least a triangle costs a run: the scene on the host and on the GPU, nothing else.
+constexpr size_t kMinBytesPerTriangle = kSceneBytesPerTriangle + kSceneGpuBytesPerTriangle;
+
 /// A triangle soup in world space: triangle i has vertices positions[3i..3i+2].
 struct Scene {
     std::vector<glm::vec3> positions;     ///< 3 per triangle
@@ -64,6 +71,8 @@ struct Scene {
     glm::dvec2 timeRange{0.0};
 
     size_t triangleCount() const { return normals.size(); }
+    /// Host bytes the scene holds (capacities, moving parts' object-space copies included).
+    size_t bytes() const;
     bool dynamic() const { return !moving.empty(); }
     size_t movingTriangleCount() const;
     /// The ranges [from, to) of triangles outside every moving part, in order.

@@ -1,8 +1,10 @@
 // The "scene" object of a config (full reference with examples: docs/scene.md).
 //
 //   {"objects": [OBJECT, ...],                                   at least one object
-//    "max_triangles": 20000000,                                  budget of the whole scene (1..200,000,000),
-//                                                                 checked before anything that size is built
+//    "max_triangles": N,                                         budget of the whole scene (1..200,000,000; default:
+//                                                                 what the machine's memory could hold at the least
+//                                                                 cost a triangle has, 104 bytes), checked before
+//                                                                 anything that size is built
 //    "time_range": [start, end]}                                 the clock the frames sample uniformly (default:
 //                                                                 the camera path's, else the light path's, else
 //                                                                 the span of the objects' motion)
@@ -23,7 +25,9 @@
 //     fence     posts = 10, spacing = 0.5, height = 1.5, radius = 0.03, rails = 2, triangles_per_cylinder = 64
 //     soup      triangles = 1000, extent [4, 4, 4], triangle_size = 0.2, seed = 1
 //     grid      object = OBJECT (any, recursively), count [nx, ny, nz] = [2, 1, 2] (1..100000),
-//               spacing [sx, sy, sz] = [2, 2, 2]; M replaces the object's materials only if given
+//               spacing [sx, sy, sz] = [2, 2, 2], rotate_step_deg [rx, ry, rz] = [0, 0, 0] (copy i, counted
+//               along x, then z, then y, is turned by i × step about its own origin, Euler as in T);
+//               M replaces the object's materials only if given
 //     triangle requests are 1..max_triangles; generated counts are within 5 % of them (>= 1000)
 //   T = {"translate": [0, 0, 0], "rotate_deg": [0, 0, 0] (Euler degrees: X first, then Y, then Z),
 //        "scale": 1 or [sx, sy, sz] (non-zero; negative mirrors),
@@ -36,6 +40,7 @@
 #include "framework/scene/SceneConfig.h"
 
 #include "framework/core/JsonParse.h"
+#include "framework/core/SystemMemory.h"
 #include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
 
@@ -53,13 +58,31 @@ namespace shadowlab {
 namespace {
 
 const std::vector<std::string> kKinds = {"plane", "sphere", "torus", "cylinder", "fence", "soup", "grid"};
-// 52 bytes per triangle in Scene: 20 M is ~1 GB, above the largest study shipped (11 M); the hard
-// ceiling, ~10 GB, is far beyond what a 24 GiB machine can render anyway.
-constexpr int kDefaultMaxTriangles = 20'000'000;
+// The hard ceiling: 32-bit vertex indices (Embree's) and GLsizei draw counts stay far from overflow.
 constexpr int kMaxTrianglesCeiling = 200'000'000;
+/// The default max_triangles follows the machine: the triangles whose least possible footprint
+/// (kMinBytesPerTriangle: the Scene's 52 bytes on the host and its 52 on the GPU, which a software
+/// renderer also keeps in host memory) fits in its memory. It guards against a typo (a grid of
+/// 10,000 × 10,000); what a run will really need is checked against the memory available by
+/// checkMemoryPlan (framework/experiment/MemoryPlan.h) before anything that size is made.
+int defaultMaxTriangles() {
+    const double total = double(systemMemory().total);
+    if (!(total > 0)) return 20'000'000; // no /proc/meminfo: the old fixed default
+    return int(std::min<double>(kMaxTrianglesCeiling, total / double(kMinBytesPerTriangle)));
+}
 constexpr int kMaxGridDepth = 8;
 
-using Builder = std::function<Scene()>;
+/// An object's generator (run later) and an upper bound of the triangles it will make, known
+/// without making them (a glTF file is loaded to be counted), so the memory a scene needs can be
+/// checked before anything that size exists.
+struct Builder {
+    std::function<Scene()> make;
+    std::function<double()> count;
+    bool moves = false; ///< it has a path, an animation or node paths (or holds an object that does)
+    Scene operator()() const { return make(); }
+};
+/// Generated counts are within 5 % of the request (docs/scene.md).
+constexpr double kGeneratedSlack = 1.05;
 
 float positive(JsonNode& node, const std::string& key, double def) {
     double v = node.getFloat(key, def, 0.0);
@@ -138,24 +161,24 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         glm::vec2 size = node.getVec2("size", glm::vec2(10.0f));
         if (!(size.x > 0.0f && size.y > 0.0f)) node.fail("size", "both sizes must be greater than 0");
         int sub = node.getInt("subdivisions", 1, 1, 4096);
-        return [=] { return makePlane(size, sub, m); };
+        return Builder{[=] { return makePlane(size, sub, m); }, [=] { return 2.0 * sub * sub; }};
     }
     if (kind == "sphere") {
         float r = positive(node, "radius", 1.0);
         int n = triangles(2000);
-        return [=] { return makeSphere(r, n, m); };
+        return Builder{[=] { return makeSphere(r, n, m); }, [=] { return kGeneratedSlack * n; }};
     }
     if (kind == "torus") {
         float major = positive(node, "major_radius", 1.0), minor = positive(node, "minor_radius", 0.3);
         // A tube reaching the axis (horn or spindle torus) is not a closed surface any more.
         if (!(minor < major)) node.fail("minor_radius", "must be smaller than major_radius");
         int n = triangles(2000);
-        return [=] { return makeTorus(major, minor, n, m); };
+        return Builder{[=] { return makeTorus(major, minor, n, m); }, [=] { return kGeneratedSlack * n; }};
     }
     if (kind == "cylinder") {
         float r = positive(node, "radius", 0.5), h = positive(node, "height", 1.0);
         int n = triangles(500);
-        return [=] { return makeCylinder(r, h, n, m); };
+        return Builder{[=] { return makeCylinder(r, h, n, m); }, [=] { return kGeneratedSlack * n; }};
     }
     if (kind == "fence") {
         int posts = node.getInt("posts", 10, 1, 100000);
@@ -167,7 +190,8 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
             node.fail("triangles_per_cylinder",
                       "(posts + rails) × triangles_per_cylinder exceeds the scene's max_triangles (" +
                           std::to_string(budget) + ")");
-        return [=] { return makeFence(posts, spacing, height, radius, rails, perCylinder, m); };
+        return Builder{[=] { return makeFence(posts, spacing, height, radius, rails, perCylinder, m); },
+                       [=] { return kGeneratedSlack * double(posts + rails) * perCylinder; }};
     }
     if (kind == "soup") {
         int n = triangles(1000);
@@ -175,7 +199,7 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         if (glm::any(glm::lessThan(extent, glm::vec3(0.0f)))) node.fail("extent", "extents must not be negative");
         float size = positive(node, "triangle_size", 0.2);
         uint32_t seed = uint32_t(node.getInt("seed", 1, 0));
-        return [=] { return makeTriangleSoup(n, extent, size, seed, m); };
+        return Builder{[=] { return makeTriangleSoup(n, extent, size, seed, m); }, [=] { return double(n); }};
     }
     // grid
     if (depth >= kMaxGridDepth) node.fail("object", "grids nest deeper than " + std::to_string(kMaxGridDepth) + " levels");
@@ -183,14 +207,16 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
     Builder inner = parseObject(node.child("object"), depth + 1, budget);
     glm::ivec3 count = node.getIVec3("count", glm::ivec3(2, 1, 2), 1, 100000);
     glm::vec3 spacing = node.getVec3("spacing", glm::vec3(2.0f));
-    return [=] {
+    glm::vec3 rotateStep = node.getVec3("rotate_step_deg", glm::vec3(0.0f));
+    const double copies = double(count.x) * count.y * count.z;
+    return Builder{[=] {
         Scene object = inner();
-        double total = double(object.triangleCount()) * count.x * count.y * count.z;
+        double total = double(object.triangleCount()) * copies;
         if (total > budget)
             node.fail("count", "the grid would have " + std::to_string(size_t(total)) +
                                    " triangles (the scene's max_triangles is " + std::to_string(budget) + ")");
-        return makeGrid(object, count, spacing);
-    };
+        return makeGrid(object, count, spacing, rotateStep);
+    }, [=] { return inner.count() * copies; }, inner.moves};
 }
 
 /// The built object must be usable: an overflowing radius or scale turns every triangle into
@@ -253,7 +279,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
             np.finish();
             motion.nodes.push_back(std::move(nm));
         }
-        build = [path, where, budget, motion] {
+        build.make = [path, where, budget, motion] {
             try {
                 return loadGltf(path, nullptr, size_t(budget), motion);
             } catch (const InputError& e) {
@@ -261,6 +287,8 @@ Builder parseObject(JsonNode node, int depth, int budget) {
                 throw InputError(e.file(), e.jsonPath(), e.cause() + " (loaded from " + where + ")");
             }
         };
+        build.count = [make = build.make] { return double(make().triangleCount()); };
+        build.moves = !motion.animation.empty() || !motion.nodes.empty();
     } else {
         build = parseGenerator(node, kind, material, depth, budget);
     }
@@ -270,7 +298,10 @@ Builder parseObject(JsonNode node, int depth, int budget) {
     if (node.has("path")) path = RigidPath::parse(node.child("path"));
     node.finish();
 
-    return [=]() mutable {
+    Builder placed;
+    placed.count = build.count;
+    placed.moves = build.moves || path.has_value();
+    placed.make = [=]() mutable {
         Scene s = build();
         if (overrideMaterial && (kind == "gltf" || kind == "grid")) overrideMaterials(s, material);
         glm::mat4 m = transform.matrix;
@@ -289,6 +320,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         checkBuilt(s, node);
         return s;
     };
+    return placed;
 }
 
 } // namespace
@@ -305,7 +337,7 @@ struct ParsedScene {
 
 static ParsedScene parseScene(JsonNode& sceneNode) {
     ParsedScene p;
-    p.budget = sceneNode.getInt("max_triangles", kDefaultMaxTriangles, 1, kMaxTrianglesCeiling);
+    p.budget = sceneNode.getInt("max_triangles", defaultMaxTriangles(), 1, kMaxTrianglesCeiling);
     if (sceneNode.has("time_range")) {
         glm::vec2 r = sceneNode.getVec2("time_range", glm::vec2(0.0f));
         if (!(r.y >= r.x)) sceneNode.fail("time_range", "expected [start, end] with end >= start");
@@ -321,6 +353,15 @@ static ParsedScene parseScene(JsonNode& sceneNode) {
 
 void checkScene(JsonNode sceneNode) { parseScene(sceneNode); }
 
+ScenePrediction predictScene(JsonNode sceneNode) {
+    ParsedScene parsed = parseScene(sceneNode);
+    double total = 0;
+    ScenePrediction p;
+    for (const Builder& b : parsed.builders) total += b.count(), p.moving |= b.moves;
+    p.triangles = size_t(std::ceil(total));
+    return p;
+}
+
 void absolutiseScenePaths(Json& object, const std::string& baseDir) {
     if (!object.is_object()) return;
     if (object.contains("gltf") && object["gltf"].is_string())
@@ -335,17 +376,30 @@ Scene buildScene(JsonNode sceneNode) {
     const std::vector<Builder>& builders = parsed.builders;
     const std::vector<JsonNode>& objects = parsed.objects;
     const int budget = parsed.budget;
-    Scene scene;
+    // Every object is made first, then the scene reserved once at its exact size (+ 1 vertex, see
+    // Scene::append) and each object appended and freed in turn: at most twice the scene is ever
+    // held (the plan's load peak), where growing the scene object by object would double its
+    // capacity and keep the slack for the whole run.
+    std::vector<Scene> made;
+    size_t total = 0;
     for (size_t i = 0; i < builders.size(); ++i) {
-        Scene s = builders[i]();
-        if (double(scene.triangleCount()) + double(s.triangleCount()) > budget)
-            objects[i].failHere("the scene would have " + std::to_string(scene.triangleCount() + s.triangleCount()) +
+        made.push_back(builders[i]());
+        total += made.back().triangleCount();
+        if (double(total) > budget)
+            objects[i].failHere("the scene would have " + std::to_string(total) +
                                 " triangles with this object, more than max_triangles (" + std::to_string(budget) + ")");
-        if (i == 0) {
-            scene = std::move(s);
-            continue;
+    }
+    Scene scene;
+    if (made.size() == 1) {
+        scene = std::move(made[0]);
+    } else {
+        scene.positions.reserve(3 * total + 1);
+        scene.normals.reserve(total);
+        scene.materialIds.reserve(total);
+        for (Scene& s : made) {
+            scene.append(s, glm::mat4(1.0f));
+            s = Scene();
         }
-        scene.append(s, glm::mat4(1.0f));
     }
     scene.updateBounds();
     scene.hasTimeRange = parsed.hasTimeRange;

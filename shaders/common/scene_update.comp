@@ -8,7 +8,6 @@ layout(local_size_x = 64) in;
 layout(std430, binding = 0) buffer ScenePositions { float positions[]; };  // 9 floats per triangle
 struct TriangleInfo { vec3 normal; uint material; };
 layout(std430, binding = 1) buffer SceneTriangles { TriangleInfo triangles[]; };
-layout(std430, binding = 2) buffer VertexNormals { TriangleInfo vertexNormals[]; }; // 3 per triangle
 layout(std430, binding = 3) readonly buffer Local { vec4 local[]; };               // 3 per moving triangle
 layout(std430, binding = 4) readonly buffer MovingIndex { uvec2 movingIndex[]; };  // (triangle, part)
 layout(std430, binding = 5) readonly buffer Transforms { mat4 transforms[]; };     // 1 per part
@@ -36,7 +35,6 @@ void main() {
         positions[b] = v[k].x;
         positions[b + 1u] = v[k].y;
         positions[b + 2u] = v[k].z;
-        vertexNormals[3u * triangle + k].normal = n;
     }
     triangles[triangle].normal = n;
 }

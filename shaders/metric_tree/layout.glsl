@@ -8,8 +8,11 @@
 #define MT_NODE_BINDING 4
 #define MT_COUNTER_BINDING 5
 // The triangles in cluster order, 9 floats each, split over MT_GEOMETRY_CHUNKS blocks of at most
-// MT_TRIANGLES_PER_CHUNK triangles: one SSBO may not exceed 128 MiB on llvmpipe (and on many
-// GPUs), and 3.5 M triangles are 126 MB. Six chunks hold 21 M triangles.
+// MT_TRIANGLES_PER_CHUNK triangles. The query reads them through buffer-texture views, of at most
+// GL_MAX_TEXTURE_BUFFER_SIZE texels (134 M on llvmpipe: 44.7 M triangles); rigid motion writes them
+// as storage blocks, of at most 128 MiB on llvmpipe (3.5 M triangles are 126 MB). The host picks
+// the block size per scene (the parameter geometry_block) and passes it as a define; the default
+// here is the storage-block one.
 #define MT_GEOMETRY_BINDING_0 6
 // Texture units of the query's buffer-texture views of the nodes, clusters and geometry blocks
 // (units 0 and 1 are the G-buffer).
@@ -17,7 +20,9 @@
 #define MT_CLUSTER_UNIT 3
 #define MT_GEOMETRY_UNIT_0 4
 #define MT_GEOMETRY_CHUNKS 6
+#ifndef MT_TRIANGLES_PER_CHUNK
 #define MT_TRIANGLES_PER_CHUNK 3500000
+#endif
 
 // Both arrays are 64 bytes per element: cluster i owns node i, so the pool can never overflow
 // and clusters + nodes take exactly 128 bytes per cluster (the paper's figure).

@@ -21,6 +21,7 @@
 // planes by more than uCloseCall goes to the ray test.
 #define PSV_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
 #include "common/light.glsl"
+#define SCENE_POSITION_TEXELS 1 // close calls test triangles through the positions view (any scene size)
 #include "common/scene.glsl"
 #include "common/counters.glsl"
 #include "psv/tree.glsl"

@@ -1,0 +1,19 @@
+#pragma once
+// The machine's memory and this process's use of it, from /proc (Linux): what a run checks its
+// memory plan against (framework/experiment/MemoryPlan.h) and what it reports as measured.
+#include <cstddef>
+
+namespace shadowlab {
+
+struct SystemMemory {
+    size_t total = 0;     ///< MemTotal, bytes (0: unknown)
+    size_t available = 0; ///< MemAvailable, bytes: what can be allocated without swapping
+};
+SystemMemory systemMemory();
+
+/// This process's peak resident set (VmHWM), bytes; 0 when unknown.
+size_t peakResidentBytes();
+/// This process's resident set now (VmRSS), bytes; 0 when unknown.
+size_t residentBytes();
+
+} // namespace shadowlab

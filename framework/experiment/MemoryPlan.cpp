@@ -1,0 +1,158 @@
+#include "framework/experiment/MemoryPlan.h"
+
+#include "framework/core/Error.h"
+#include "framework/core/SystemMemory.h"
+#include "framework/gl/GlObjects.h"
+#include "framework/gl/Shader.h"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace shadowlab {
+
+namespace {
+/// Bytes a storage block really addresses here: GL_MAX_SHADER_STORAGE_BLOCK_SIZE, or more where a
+/// write and a read at the end of a larger buffer round-trip. llvmpipe reports 128 MiB but bounds
+/// its accesses by the bound buffer, which may hold up to 4 GiB; by the spec an access past the
+/// reported size is undefined, so the larger figure is taken only as measured on this context.
+/// The probe's buffer is the reported size and 64 KiB more (llvmpipe zero-fills a new buffer, so it
+/// is resident), and an implementation that addresses past the reported size there is taken to
+/// bound accesses by the buffer (up to 2 GiB, where GLSL's uint word indices stay far from wrapping).
+size_t addressableStorageBytes() {
+    const size_t reported = maxShaderStorageBlockBytes();
+    constexpr size_t kAddressable = size_t(1) << 31;
+    if (reported >= kAddressable) return reported;
+    const size_t probeBytes = reported + (size_t(1) << 16);
+    const uint32_t index = uint32_t(probeBytes / 4 - 4);
+    GlBuffer buffer(probeBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    const uint32_t seed = 41;
+    buffer.upload(&seed, sizeof seed, size_t(index - 1) * 4);
+    ShaderProgram probe = ShaderProgram::compute("common/storage_probe.comp");
+    probe.set("uIndex", index);
+    probe.use();
+    buffer.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    uint32_t words[2] = {0, 0};
+    glGetNamedBufferSubData(buffer.id(), GLintptr(index) * 4, sizeof words, words);
+    return words[0] == 0x5EEDu && words[1] == seed + 1 ? kAddressable : reported;
+}
+} // namespace
+
+DeviceLimits currentDeviceLimits(size_t triangles) {
+    const size_t reported = maxShaderStorageBlockBytes();
+    // Only a scene whose largest per-triangle block (psv's 128 bytes) could pass the reported size
+    // pays for the probe (its buffer is resident while it runs).
+    const size_t storage = triangles * 128 > reported ? addressableStorageBytes() : reported;
+    return {storage, maxTextureBufferTexels(), reported};
+}
+
+std::string formatGiB(size_t bytes) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%.2f GiB", double(bytes) / double(size_t(1) << 30));
+    return s;
+}
+
+Json MemoryPlan::toJson() const {
+    Json parts = Json::object();
+    for (const auto& [name, bytes] : held) parts[name] = bytes;
+    return {{"triangles", triangles},       {"moving", moving},       {"held_bytes", parts},
+            {"load_peak_bytes", loadPeak},  {"peak_bytes", peak},     {"available_bytes", available},
+            {"machine_bytes", machine}};
+}
+
+std::string MemoryPlan::summary() const {
+    std::string s = formatGiB(peak) + " estimated at the peak, of " + formatGiB(available) + " available (";
+    bool first = true;
+    for (const auto& [name, bytes] : held) {
+        if (bytes < (size_t(1) << 20)) continue; // below a MiB: noise in a line about gigabytes
+        char part[96];
+        std::snprintf(part, sizeof part, "%s%s %.2f", first ? "" : ", ", name.c_str(), double(bytes) / double(size_t(1) << 30));
+        s += part;
+        first = false;
+    }
+    return s + (first ? "nothing large" : "") + ")";
+}
+
+namespace {
+std::vector<const AlgorithmEntry*> planEntries(const ExperimentConfig& cfg) {
+    std::vector<const AlgorithmEntry*> entries;
+    if (cfg.reference) entries.push_back(&cfg.referenceEntry);
+    for (const AlgorithmEntry& e : cfg.algorithms) entries.push_back(&e);
+    return entries;
+}
+
+Footprint footprintOf(const AlgorithmEntry& e, const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits) {
+    if (!e.info->footprint) return {};
+    FootprintQuery q;
+    q.triangles = triangles;
+    q.resolution = cfg.resolution;
+    q.moving = moving;
+    q.params = &e.params;
+    q.storageBlockBytes = limits.storageBlockBytes;
+    q.textureBufferTexels = limits.textureBufferTexels;
+    q.reportedStorageBlockBytes = limits.reportedStorageBlockBytes;
+    return e.info->footprint(q);
+}
+} // namespace
+
+std::vector<std::string> describeFootprints(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits) {
+    std::vector<std::string> lines;
+    for (const AlgorithmEntry* e : planEntries(cfg)) {
+        const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
+        lines.push_back(e->id + " (" + e->info->name + "): " +
+                        (f.refusal.empty() ? formatGiB(f.bytes) + " held, " + formatGiB(f.peakBytes) + " more while it sets up"
+                                           : "refuses: " + f.refusal));
+    }
+    return lines;
+}
+
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits) {
+    return checkMemoryPlan(cfg, triangles, moving, limits, systemMemory());
+}
+
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
+                           const SystemMemory& machine) {
+    MemoryPlan plan;
+    plan.triangles = triangles;
+    plan.moving = moving;
+    plan.available = machine.available;
+    plan.machine = machine.total;
+
+    // Moving parts are posed by SceneGpu's update pass, which writes the positions as one storage
+    // block indexed by scene triangle: past what a block addresses those writes would be lost.
+    const size_t poseLimit = limits.storageBlockBytes / (9 * sizeof(float));
+    if (moving && limits.storageBlockBytes > 0 && triangles > poseLimit)
+        throw InputError(cfg.file, "/scene",
+                         "a scene with moving parts is posed through one storage block of at most " +
+                             std::to_string(limits.storageBlockBytes >> 20) + " MiB on this device, " +
+                             std::to_string(poseLimit) + " triangles; this one has up to " + std::to_string(triangles));
+
+    plan.held.emplace_back("scene", triangles * kSceneBytesPerTriangle);
+    plan.held.emplace_back("scene_gpu", triangles * kSceneGpuBytesPerTriangle);
+    // The largest object (a grid's copies) is made whole and then appended to the scene.
+    plan.loadPeak = 2 * triangles * kSceneBytesPerTriangle;
+
+    size_t transient = 0;
+    for (const AlgorithmEntry* e : planEntries(cfg)) {
+        if (!e->info->footprint) continue;
+        const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
+        const std::string where = e->jsonPath.empty() ? (e == &cfg.referenceEntry ? "/reference" : "/algorithms") : e->jsonPath;
+        if (!f.refusal.empty())
+            throw InputError(cfg.file, where, e->info->name + " cannot run this scene (up to " + std::to_string(triangles) +
+                                                  " triangles) on this device: " + f.refusal);
+        plan.held.emplace_back(e->id, f.bytes);
+        transient = std::max(transient, f.peakBytes);
+    }
+    size_t held = 0;
+    for (const auto& part : plan.held) held += part.second;
+    plan.peak = std::max(plan.loadPeak, held + transient);
+    if (plan.available > 0 && plan.peak > plan.available)
+        throw InputError(cfg.file, "/scene",
+                         "the run would need about " + plan.summary() + " for up to " + std::to_string(triangles) +
+                             " triangles; this machine has " + formatGiB(plan.machine) +
+                             " in all: use fewer triangles or algorithms");
+    return plan;
+}
+
+} // namespace shadowlab

@@ -1,0 +1,103 @@
+// The memory plan a run is checked against before its scene exists: the scene's predicted size, each
+// algorithm's estimate or refusal, and the refusal of a run that cannot fit (bad input, exit 2).
+#include "framework/core/Error.h"
+#include "framework/experiment/MemoryPlan.h"
+#include "framework/scene/SceneConfig.h"
+
+#include <gtest/gtest.h>
+
+namespace shadowlab {
+namespace {
+
+constexpr size_t kGiB = size_t(1) << 30;
+// llvmpipe's limits as it reports them, with storage blocks addressed to 2 GiB (the probe's answer there).
+const DeviceLimits kLlvmpipe{size_t(1) << 31, 134217728, size_t(128) << 20};
+
+ExperimentConfig planned(const Json& algorithms, int engines, ScenePrediction& predicted) {
+    Json j = Json::parse(R"({"name": "plan", "resolution": [64, 64], "frames": 1,
+      "scene": {"max_triangles": 200000000, "objects": [
+        {"procedural": "plane", "size": [4, 4]},
+        {"procedural": "grid", "count": [)" + std::to_string(engines) + R"(, 1, 10],
+         "object": {"procedural": "sphere", "triangles": 100000}}]},
+      "camera": {"position": [0, 2, 4], "target": [0, 0, 0]},
+      "light": {"type": "point", "position": [0, 5, 0]}})");
+    j["algorithms"] = algorithms;
+    Json resolved = Json::object();
+    predicted = predictScene(JsonNode("plan.json", &j["scene"], "/scene", &resolved));
+    return parseConfig(j, "plan.json", false);
+}
+
+TEST(MemoryPlanTest, PredictsTheSceneWithoutMakingIt) {
+    ScenePrediction p;
+    planned(Json::array(), 74, p); // 740 spheres of 100,000: 74 M triangles, counted in a moment
+    EXPECT_GE(p.triangles, size_t(74'000'000));
+    EXPECT_LE(p.triangles, size_t(74'000'000 * 1.05) + 2);
+    EXPECT_FALSE(p.moving);
+}
+
+TEST(MemoryPlanTest, ARunThatCannotFitIsRefusedWithItsEstimate) {
+    ScenePrediction p;
+    const ExperimentConfig cfg = planned(Json::array({{{"algorithm", "metric_tree"}}}), 74, p);
+    try {
+        checkMemoryPlan(cfg, p.triangles, p.moving, kLlvmpipe, SystemMemory{8 * kGiB, 6 * kGiB});
+        FAIL() << "a 74 M triangle run fit in 6 GiB";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.file(), "plan.json");
+        EXPECT_EQ(e.jsonPath(), "/scene");
+        const std::string why = e.cause();
+        for (const char* part : {"GiB estimated at the peak", "6.00 GiB available", "8.00 GiB in all", "metric_tree", "reference"})
+            EXPECT_NE(why.find(part), std::string::npos) << part << " in: " << why;
+    }
+    // The same run on a machine that holds it: planned, with every part named.
+    const MemoryPlan plan = checkMemoryPlan(cfg, p.triangles, p.moving, kLlvmpipe, SystemMemory{64 * kGiB, 60 * kGiB});
+    EXPECT_GT(plan.peak, 10 * kGiB);
+    EXPECT_LT(plan.peak, 25 * kGiB);
+    ASSERT_EQ(plan.held.size(), 4u);
+    EXPECT_EQ(plan.held[0].first, "scene");
+    EXPECT_EQ(plan.held[0].second, p.triangles * kSceneBytesPerTriangle);
+}
+
+// Every algorithm states its limit on the device: past it the run is refused up front, naming the
+// algorithm's entry and the structure that would not fit, never an allocation failure later.
+TEST(MemoryPlanTest, EachAlgorithmRefusesPastItsDeviceLimitByName) {
+    struct Row {
+        const char* algorithm;
+        int engines;        // × 10 spheres of 100 k triangles
+        const char* reason; // the structure named
+    };
+    const Row rows[] = {
+        {"psv", 2, nullptr},      {"psv", 20, "node pool"},
+        {"ptsv", 1, "planes"},    {"bvh_raytrace", 3, "leaf-ordered triangles"},
+        {"izb", 50, "positions' view"}, {"shadow_volumes", 50, "positions' view"},
+        {"metric_tree", 74, nullptr},   {"metric_tree", 200, nullptr},
+    };
+    for (const Row& r : rows) {
+        ScenePrediction p;
+        const ExperimentConfig cfg = planned(Json::array({{{"algorithm", r.algorithm}}}), r.engines, p);
+        const SystemMemory roomy{1024 * kGiB, 1024 * kGiB};
+        if (!r.reason) {
+            EXPECT_NO_THROW(checkMemoryPlan(cfg, p.triangles, false, kLlvmpipe, roomy)) << r.algorithm << " " << p.triangles;
+            continue;
+        }
+        try {
+            checkMemoryPlan(cfg, p.triangles, false, kLlvmpipe, roomy);
+            ADD_FAILURE() << r.algorithm << " took " << p.triangles << " triangles";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.jsonPath(), "/algorithms/0") << r.algorithm;
+            EXPECT_NE(e.cause().find(std::string(r.algorithm) + " cannot run this scene"), std::string::npos) << e.cause();
+            EXPECT_NE(e.cause().find(r.reason), std::string::npos) << e.cause();
+        }
+    }
+}
+
+// Moving parts are posed through one storage block: a moving scene past it is refused.
+TEST(MemoryPlanTest, AMovingScenePastThePosingBlockIsRefused) {
+    ScenePrediction p;
+    const ExperimentConfig cfg = planned(Json::array(), 10, p);
+    const DeviceLimits strict{size_t(128) << 20, 134217728, size_t(128) << 20};
+    EXPECT_THROW(checkMemoryPlan(cfg, p.triangles, true, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}), InputError);
+    EXPECT_NO_THROW(checkMemoryPlan(cfg, 1'000'000, true, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}));
+}
+
+} // namespace
+} // namespace shadowlab
