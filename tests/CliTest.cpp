@@ -32,6 +32,7 @@ TEST(CliTest, HelpOnEveryCommand) {
         {{"validate"}, "shadowlab validate CONFIG.json"},
         {{"list"}, "shadowlab list ["},
         {{"info"}, "shadowlab info [--json]"},
+        {{"plan"}, "shadowlab plan CONFIG.json"},
         {{"sweep"}, "shadowlab sweep merge DIR"},
         {{"sweep", "plan"}, "shadowlab sweep plan SWEEP.json"},
         {{"sweep", "config"}, "shadowlab sweep config SWEEP.json INDEX"},
@@ -74,6 +75,38 @@ TEST(CliTest, RunEchoesABoundedName) {
     const test::Ran bad = test::runArgs({bin(), "run", "--" + name});
     EXPECT_EQ(bad.rc, 2);
     EXPECT_LT(bad.err.size(), 1000u);
+}
+
+// A scene an algorithm cannot take on this device is refused before it is made: exit 2, one line
+// naming the entry and the structure, nothing written, and no time spent making 1.2 M triangles.
+// `plan` says the same without running, and gives every algorithm's verdict.
+TEST(CliTest, ARunAnAlgorithmCannotTakeIsRefusedBeforeTheSceneIsMade) {
+    const std::string dir = test::makeTempDir("cli-plan");
+    const std::string config = dir + "/big.json";
+    std::ofstream(config) << R"({"name": "big", "resolution": [32, 32], "frames": 1,
+      "scene": {"objects": [{"procedural": "grid", "count": [12, 1, 10],
+                             "object": {"procedural": "sphere", "triangles": 10000}}]},
+      "camera": {"position": [0, 30, 60], "target": [0, 0, 0]},
+      "light": {"type": "point", "position": [0, 50, 0]},
+      "algorithms": [{"algorithm": "metric_tree"}, {"id": "ptsv", "algorithm": "ptsv"}]})";
+    const test::Ran r = test::runArgs({bin(), "run", config, "--out", dir + "/out", "--no-progress"});
+    EXPECT_EQ(r.rc, 2) << r.err;
+    EXPECT_NE(r.err.find("at /algorithms/1: ptsv cannot run this scene"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("shadow-volume planes"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("wrote"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out")) << "a refused run left an output";
+    const test::Ran plan = test::runArgs({bin(), "plan", config});
+    EXPECT_EQ(plan.rc, 2) << plan.err;
+    EXPECT_NE(plan.out.find("scene: up to 1260000 triangles"), std::string::npos) << plan.out;
+    EXPECT_NE(plan.out.find("metric_tree (metric_tree): "), std::string::npos) << plan.out;
+    EXPECT_NE(plan.out.find("ptsv (ptsv): refuses: its shadow-volume planes"), std::string::npos) << plan.out;
+    // Without ptsv the same scene plans, and a hypothetical size is asked with --triangles.
+    const test::Ran fits = test::runArgs({bin(), "plan", config, "--set", "algorithms=[{\"algorithm\": \"metric_tree\"}]"});
+    EXPECT_EQ(fits.rc, 0) << fits.err;
+    EXPECT_NE(fits.out.find("plan: "), std::string::npos) << fits.out;
+    const test::Ran asked = test::runArgs({bin(), "plan", config, "--triangles", "1000"});
+    EXPECT_EQ(asked.rc, 0) << asked.err;
+    EXPECT_NE(asked.out.find("scene: up to 1000 triangles"), std::string::npos) << asked.out;
 }
 
 // `info` says what a run would run on: the implementation, the subgroup width and what each auto

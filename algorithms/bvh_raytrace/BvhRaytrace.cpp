@@ -230,16 +230,19 @@ private:
 
 } // namespace
 
-/// Nodes (64 bytes, at most one per triangle) and leaf-ordered triangles (48 bytes) on the GPU,
-/// both checked against the reported storage-block size as setScene does; ~150 bytes a triangle
-/// while the binned SAH builder runs on the host; a moving scene keeps its tree and posed copy.
+/// Leaf-ordered triangles (48 bytes) and nodes (64 bytes, one per leaf of at least two triangles on
+/// average: at most 32 a triangle) on the GPU, the triangles checked against the reported
+/// storage-block size as setScene does (the nodes, fewer bytes, pass where they pass); ~150 bytes a
+/// triangle while the binned SAH builder runs on the host; a moving scene keeps its tree and posed copy.
 Footprint bvhRaytraceFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t n = q.triangles;
-    f.bytes = 112 * n + (q.moving ? 152 * n : 0);
+    // Leaves hold leaf_size triangles at most and about half that on average: 2 n / leaf_size nodes.
+    const size_t nodes = std::min(n, 2 * n / size_t(std::max(1, std::get<int>(q.params->get("leaf_size")))) + 1);
+    f.bytes = 48 * n + 64 * nodes + (q.moving ? 152 * n : 0);
     f.peakBytes = 152 * n;
     f.refusal = storageRefusal(q, "its leaf-ordered triangles", 48 * n, true);
-    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its nodes", 64 * n, true);
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its nodes", 64 * nodes, true);
     return f;
 }
 AlgorithmInfo bvhRaytraceInfo() {

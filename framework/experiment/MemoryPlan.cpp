@@ -43,7 +43,7 @@ DeviceLimits currentDeviceLimits(size_t triangles) {
     const size_t reported = maxShaderStorageBlockBytes();
     // Only a scene whose largest per-triangle block (psv's 128 bytes) could pass the reported size
     // pays for the probe (its buffer is resident while it runs).
-    const size_t storage = triangles * 128 > reported ? addressableStorageBytes() : reported;
+    const size_t storage = triangles * 128 + 4096 > reported ? addressableStorageBytes() : reported;
     return {storage, maxTextureBufferTexels(), reported};
 }
 
@@ -133,7 +133,9 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool m
     // The largest object (a grid's copies) is made whole and then appended to the scene.
     plan.loadPeak = 2 * triangles * kSceneBytesPerTriangle;
 
-    size_t transient = 0;
+    // Algorithms set up one after the other (the reference first): each one's transient sits on
+    // top of the scene and of what it and the ones before it hold, not of what comes after.
+    size_t held = plan.held[0].second + plan.held[1].second, setupPeak = 0;
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         if (!e->info->footprint) continue;
         const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
@@ -142,11 +144,10 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool m
             throw InputError(cfg.file, where, e->info->name + " cannot run this scene (up to " + std::to_string(triangles) +
                                                   " triangles) on this device: " + f.refusal);
         plan.held.emplace_back(e->id, f.bytes);
-        transient = std::max(transient, f.peakBytes);
+        held += f.bytes;
+        setupPeak = std::max(setupPeak, held + f.peakBytes);
     }
-    size_t held = 0;
-    for (const auto& part : plan.held) held += part.second;
-    plan.peak = std::max(plan.loadPeak, held + transient);
+    plan.peak = std::max({plan.loadPeak, held, setupPeak});
     if (plan.available > 0 && plan.peak > plan.available)
         throw InputError(cfg.file, "/scene",
                          "the run would need about " + plan.summary() + " for up to " + std::to_string(triangles) +

@@ -27,7 +27,8 @@ struct MemoryPlan {
     bool moving = false;
     std::vector<std::pair<std::string, size_t>> held; ///< what stays for the run, by part: "scene", "scene_gpu", then ids
     size_t loadPeak = 0;   ///< bytes while the scene is made (a grid's copies and the scene they go into)
-    size_t peak = 0;       ///< the estimated peak: max(loadPeak, the held parts + the largest setScene() transient)
+    size_t peak = 0;       ///< the estimated peak: the load's, or the held parts' with each setScene() transient on
+                           ///< top of what is held when it runs (entries are set up in order)
     size_t available = 0;  ///< MemAvailable when planned
     size_t machine = 0;    ///< MemTotal
     Json toJson() const;
