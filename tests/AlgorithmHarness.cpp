@@ -4,6 +4,7 @@
 #include "framework/algorithm/SharedParams.h"
 #include "framework/reference/EmbreeTracer.h"
 #include "framework/gl/GlObjects.h"
+#include "framework/gl/Shader.h"
 
 #include <gtest/gtest.h>
 
@@ -62,6 +63,24 @@ Shot withLight(Shot shot, LightType type) {
     l.samples = 4;  // a few: the brute-force template traces each against every triangle
     shot.light = l;
     return shot;
+}
+
+void expectSimdProbe(const AlgorithmRun& o, const std::vector<std::pair<std::string, std::string>>& sectionWork) {
+    const int width = querySubgroupSize();
+    if (width == 0) {
+        EXPECT_EQ(o.counters.count("simd_width"), 0u) << "a SIMD probe without a ballot";
+        return;
+    }
+    ASSERT_EQ(o.counters.count("simd_width"), 1u);
+    EXPECT_EQ(o.counters.at("simd_width"), double(width));
+    for (const auto& [section, work] : sectionWork) {
+        SCOPED_TRACE(section);
+        const double slots = o.counters.at("simd_" + section + "_slots_per_ray");
+        const double use = o.counters.at("simd_" + section + "_utilisation");
+        EXPECT_GT(use, 0.0);
+        EXPECT_LE(use, 1.0);
+        EXPECT_NEAR(slots * use, o.counters.at(work), 1e-9 * o.counters.at(work));
+    }
 }
 
 void printCase(std::ostream& os, const char* name, const std::map<std::string, ParamValue>& params) {

@@ -13,6 +13,7 @@
 #include <iosfwd>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shadowlab::test {
@@ -63,6 +64,13 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
 /// 40° spot, an area light a fifth of the scene's radius wide with 4 samples): how the registry-driven
 /// tables (ConformanceGLTest, PortabilityGLTest) run every light an algorithm supports on one shot.
 Shot withLight(Shot shot, LightType type);
+
+/// The SIMD probe's counters of an instrumented run (shaders/common/simd_probe.glsl), where the
+/// context has a ballot: its width is the context's, every section's utilisation lies in (0, 1],
+/// and the lanes it counted per ray (slots × utilisation) are exactly the work the kernel's own
+/// per-ray counter `work` counted at the same place. Pairs: section name, counter. Without a
+/// ballot the probe's counters must be absent.
+void expectSimdProbe(const AlgorithmRun& o, const std::vector<std::pair<std::string, std::string>>& sectionWork);
 
 /// Prints `name` and its parameter overrides, for gtest's names of parameterised cases.
 void printCase(std::ostream& os, const char* name, const std::map<std::string, ParamValue>& params);

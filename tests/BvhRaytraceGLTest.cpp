@@ -232,6 +232,8 @@ TEST_F(BvhRaytraceGLTest, CountersAndMemoryDescribeTheTree) {
     EXPECT_GE(o.counters["nodes_visited_max"], o.counters["nodes_visited_mean"]);
     EXPECT_LE(o.counters["nodes_visited_max"], o.counters["bvh_nodes"]);
     EXPECT_EQ(o.counters["rays"], double(o.accuracy.litPixels)); // one ray per lit pixel for a point light
+    // Where a ray's time goes: node visits and triangle tests, idle lanes included.
+    expectSimdProbe(o, {{"node", "nodes_visited_mean"}, {"triangle", "triangles_tested_mean"}});
 }
 
 } // namespace

@@ -206,6 +206,70 @@ TEST(LineSpaceTest, LeafListsFollowTheOccupancy) {
     }
 }
 
+// leaf_split: an occupied leaf's sub-cells are marked exactly where one of its triangles touches
+// the sub-cell widened by the tree's margin (brute force over every sub-cell and triangle of the
+// leaf), so a ray is blocked by a leaf only where its geometry can be; every occupied leaf has a
+// marked sub-cell (the widened sub-cells cover the widened leaf).
+TEST(LineSpaceTest, SubCellsAreMarkedWhereTheirLeafsTrianglesTouchThem) {
+    Scene s = smallScene();
+    for (int split : {2, 4}) {
+        const int n = 4, d = 3;
+        ls::NTree t = ls::buildNTree(s, n, d);
+        ls::LeafLists lists = ls::buildLeafLists(s, t, 2, split);
+        ASSERT_EQ(lists.sub.size(), 2 * (lists.prefix.size() - 1));
+        const size_t occWords = ls::occupancyWords(n);
+        size_t leaf = 0, marked = 0, cells = 0;
+        for (size_t i = 0; i < t.nodes.size(); ++i) {
+            if (int(t.nodes[i].level) != d - 1) continue;
+            const glm::vec3 lo(t.nodes[i].lo[0], t.nodes[i].lo[1], t.nodes[i].lo[2]);
+            const glm::vec3 cell = glm::vec3(t.nodes[i].size[0], t.nodes[i].size[1], t.nodes[i].size[2]) / float(n);
+            for (int c = 0; c < n * n * n; ++c) {
+                if (!((t.occupancy[i * occWords + size_t(c >> 5)] >> (c & 31)) & 1u)) continue;
+                const uint64_t mask = uint64_t(lists.sub[2 * leaf]) | uint64_t(lists.sub[2 * leaf + 1]) << 32;
+                EXPECT_NE(mask, 0u) << "an occupied leaf with no occupied sub-cell";
+                // The shader's boxes: the leaf at lo + c × cell, its sub-cells at leafLo + k × cell / split.
+                const glm::vec3 leafLo = lo + glm::vec3(float(c % n), float((c / n) % n), float(c / (n * n))) * cell;
+                const glm::vec3 sub = cell / float(split);
+                for (int b = 0; b < split * split * split; ++b) {
+                    const glm::vec3 slo = leafLo + glm::vec3(float(b % split), float((b / split) % split), float(b / (split * split))) * sub;
+                    const ls::DBox box{glm::dvec3(slo) - double(t.margin), glm::dvec3(slo + sub) + double(t.margin)};
+                    bool touched = false;
+                    for (uint32_t k = lists.prefix[leaf]; k < lists.prefix[leaf + 1] && !touched; ++k) {
+                        const uint32_t tri = lists.tris[k];
+                        touched = ls::triangleOverlapsBox(glm::dvec3(s.positions[3 * tri]), glm::dvec3(s.positions[3 * tri + 1]),
+                                                          glm::dvec3(s.positions[3 * tri + 2]), box);
+                    }
+                    const bool bit = (mask >> b) & 1u;
+                    // A triangle whose widened bounds lie in one sub-cell is marked there untested: a
+                    // superset, never fewer.
+                    if (touched) EXPECT_TRUE(bit) << "leaf " << leaf << " sub-cell " << b;
+                    marked += bit, cells += 1;
+                }
+                ++leaf;
+            }
+        }
+        // The split is worth it only if most sub-cells of occupied leaves stay empty.
+        EXPECT_LT(double(marked), 0.6 * double(cells)) << "split " << split;
+    }
+}
+
+// Triangle planes of the culled start region: unit normals, the vertices on the plane, zero for a
+// degenerate triangle (never culled).
+TEST(LineSpaceTest, TrianglePlanesHoldTheirVertices) {
+    Scene s = smallScene();
+    const std::vector<glm::vec4> planes = ls::trianglePlanes(s);
+    ASSERT_EQ(planes.size(), s.triangleCount());
+    for (size_t i = 0; i < planes.size(); ++i) {
+        EXPECT_NEAR(glm::length(glm::vec3(planes[i])), 1.0f, 1e-5f);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(glm::dot(glm::vec3(planes[i]), s.positions[3 * i + k]) + planes[i].w, 0.0f, 1e-5f);
+    }
+    Scene degenerate; // addTriangles() drops a zero-area triangle; a soup written directly may hold one
+    degenerate.positions = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
+    degenerate.normals = {{0, 1, 0}};
+    ASSERT_EQ(degenerate.triangleCount(), 1u);
+    EXPECT_EQ(ls::trianglePlanes(degenerate).at(0), glm::vec4(0.0f));
+}
+
 TEST(LineSpaceTest, BuildIsIndependentOfTheThreadCount) {
     Scene s = smallScene();
     ls::NTree a = ls::buildNTree(s, 4, 3, 1), b = ls::buildNTree(s, 4, 3, 3);

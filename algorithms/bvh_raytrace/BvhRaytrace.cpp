@@ -144,7 +144,7 @@ public:
         setLightUniforms(trace_, f.light);
         trace_.set("uRayOffset", rayOffsetLength(p_.rayOffset, *scene_));
         trace_.set("uSampleCount", sampleCount);
-        trace_.set("uStepCap", unsigned(stepCap_));
+        trace_.set("uBvhStepCap", unsigned(stepCap_));
         glBindTextureUnit(BVH_NODE_UNIT, nodeTexels_.id());
         glBindTextureUnit(BVH_TRI_UNIT, triTexels_.id());
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
@@ -183,6 +183,9 @@ public:
                                  {"triangles_tested_mean", perRay(wide(BVH_C_TRIS_LO))},
                                  {"rays", rays},
                                  {"traced_pixels", double(c[BVH_C_PIXELS])}});
+        // Where a ray's time goes, idle lanes included (the same probe as line_space's).
+        static_assert(BVH_SIMD_SECTIONS == 2);
+        appendSimdProbeCounters(out, {"node", "triangle"}, BVH_C_SIMD_BASE, c[BVH_C_SIMD_WIDTH], rays, wide);
         return out;
     }
 
@@ -207,7 +210,7 @@ private:
     void compile() {
         const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(p_.stackSize)},
                                        {"BVH_SHORT_STACK", p_.shortStack ? "1" : "0"},
-                                       instrumentationDefine(options_)};
+                                       simdProbeDefine(options_), instrumentationDefine(options_)};
         trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp", defines);
     }
 

@@ -2,6 +2,8 @@
 
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
+#include "algorithms/bvh_raytrace/BvhBuilder.h"
+#include "algorithms/bvh_raytrace/BvhGpuLayout.h"
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "algorithms/line_space/NTree.h"
 #include "algorithms/line_space/SampleClassifier.h"
@@ -27,6 +29,8 @@ struct LineSpaceParams {
     int maxBlockMib;   ///< 0 = the context's storage block limit
     float rayOffset;   ///< × scene radius
     std::string startRegion, lastLevel;  ///< "exact" | "distance" | "node"; "leaves" | "shaft"
+    std::string startTriangles;          ///< "culled" | "all": how the exact start region tests a leaf's triangles
+    int leafSplit;                       ///< sub-cells per axis of an occupied leaf (1: the leaf decides)
     float startCells, startMaxCells;     ///< leaf widths
     bool rebuildEveryFrame;              ///< allows moving scenes: the whole precomputation each frame
     int samplesPerDispatch;              ///< most light samples per pixel one dispatch traces
@@ -56,18 +60,39 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
         // "node" is Algorithm 1 as published: its start region (the last-level node holding the
         // origin) is too short, the next node's shaft holds the receiver's own surface and lit
         // surfaces shadow themselves (docs/algorithms/line_space.md, "Where the error comes from").
-        .choice("start_region", &P::startRegion, "exact", {"exact", "distance", "node"},
+        // "bvh" by measurement (docs/algorithms/line_space.md, "Cost model"): as accurate as "exact"
+        // at about half its trace time here.
+        .choice("start_region", &P::startRegion, "bvh", {"exact", "distance", "node", "bvh"},
                 "where the line space is not used next to the receiver: the last-level nodes a ray enters before "
                 "rising start_cells leaf widths above the receiver's tangent plane, tested against their triangles "
                 "(exact: a hybrid that keeps the scene's triangles on the GPU) or with geometry before that height "
                 "ignored and the rest of those nodes by leaf occupancy (distance); node = the paper's Algorithm 1, "
-                "the last-level node holding the origin skipped",
+                "the last-level node holding the origin skipped; bvh = the distance region's walk, the segment before "
+                "its end traced exactly through a BVH of the scene (bvh_raytrace's build and traversal)",
                 ParamChange::Rebuild)
         // "shaft" is Algorithm 1's "deep enough": the shaft of a last-level node stands for its
         // leaves, so shadows grow by up to a shaft's width around every occluder.
         .choice("last_level", &P::lastLevel, "leaves", {"leaves", "shaft"},
                 "a non-empty shaft of a last-level node: leaves = the leaves the ray crosses there decide "
                 "(occupancy mask); shaft = the ray is blocked (the paper's)",
+                ParamChange::Rebuild)
+        // The leaf of growth: an occupied leaf blocks every ray through it, so shadows grow by up to a
+        // leaf around every occluder (docs/algorithms/line_space.md, "Where the error comes from").
+        // Split, only the occupied sub-cells the ray crosses block it.
+        // 4 by measurement: RMSE 0.040 -> 0.015 on the 882 k-triangle side-by-side scene for ~25 % more
+        // trace time (docs/algorithms/line_space.md, "The leaf of growth").
+        .integer("leaf_split", &P::leafSplit, 4, 1, 4, "sub-cells per axis",
+                 "where an occupied leaf would block a ray (last_level leaves, the start region after its end), "
+                 "its leaf_split³ sub-cells decide instead, by their own occupancy bits (64 bits per occupied leaf "
+                 "at 4); 1 = the leaf decides",
+                 ParamChange::Rebuild)
+        // "culled" by measurement (docs/algorithms/line_space.md, "Cost model"): the same decisions
+        // for a fraction of the watertight tests; "all" is the leaf walk as it was, for the A/B.
+        .choice("start_triangles", &P::startTriangles, "culled", {"culled", "all"},
+                "start_region exact: how a start-region leaf's triangles are tested: culled = empty leaves skipped "
+                "in a loop of their own, then a plane test of the segment's part in the leaf against each "
+                "triangle's plane and the watertight test only for those it cannot rule out; all = every "
+                "triangle by the watertight test, in one loop with the leaf steps",
                 ParamChange::Rebuild)
         // 6 and 64 by measurement: fewer leaf widths leave self-shadowing, more cost nothing but
         // leave the error where it is (docs/algorithms/line_space.md, Parameters).
@@ -126,11 +151,19 @@ public:
         // leaf lists and the scene's triangles only by the exact one.
         const ls::StartMode mode = startMode();
         const bool occupancy = mode != ls::StartMode::Node || lastLeaves(), exact = mode == ls::StartMode::Exact;
-        leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer();
+        leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer(), triPlanes_ = GlBuffer(), leafSub_ = GlBuffer();
+        bvhNodeTexels_ = GlTexture(), bvhTriTexels_ = GlTexture(), bvhNodes_ = GlBuffer(), bvhTris_ = GlBuffer();
+        size_t nearBytes = 0; // start_region bvh: its nodes and leaf-ordered triangles
+        if (mode == ls::StartMode::Bvh) nearBytes = buildNearField(cpu, limit);
+        const int split = occupancy ? p_.leafSplit : 1;
+        const bool lists_needed = exact || split > 1;
+        const bool culled = exact && culledTriangles();
+        std::vector<glm::vec4> planes; // culled: per scene triangle its plane (unit normal, offset)
+        if (culled) planes = ls::trianglePlanes(cpu);
         ls::LeafLists lists;
         uint64_t longestList = 0; // triangles of the largest leaf list (exact)
-        if (exact) {
-            lists = ls::buildLeafLists(cpu, tree_);
+        if (lists_needed) {
+            lists = ls::buildLeafLists(cpu, tree_, 0, split);
             for (size_t i = 1; i < lists.prefix.size(); ++i)
                 longestList = std::max<uint64_t>(longestList, lists.prefix[i] - lists.prefix[i - 1]);
             // The shader numbers a leaf by the occupancy bits below it: one occupied leaf without a list
@@ -146,7 +179,8 @@ public:
         }
         poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
                       tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0,
-                      exact ? lists.bytes() + scene_->positions().size() : 0};
+                      (exact ? lists.bytes() + scene_->positions().size() + planes.size() * sizeof(glm::vec4)
+                             : lists_needed ? (lists.wordRank.size() + lists.sub.size()) * sizeof(uint32_t) : 0) + nearBytes};
         // Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
         // up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a
         // GPU with a larger limit is caught here.
@@ -172,17 +206,29 @@ public:
                 if (bytes > limit)
                     throw RuntimeError(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
                                        " MiB; one SSBO may hold " + mib(limit) + " MiB here");
-            leafBase_ = GlBuffer::fromVector(lists.wordRank, 0);
             leafPrefix_ = GlBuffer::fromVector(lists.prefix, 0);
             leafTris_ = GlBuffer::fromVector(lists.tris, 0);
+            if (culled) triPlanes_ = GlBuffer::fromVector(planes, 0);
         }
+        if (lists_needed) leafBase_ = GlBuffer::fromVector(lists.wordRank, 0);
+        if (split > 1) leafSub_ = GlBuffer::fromVector(lists.sub, 0);
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
             // Unused chunks get a 4-byte buffer so every buffer texture the shader may declare has one.
             const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
             const size_t last = std::min(tree_.bits.size(), (c + 1) * nodesPerChunk_ * words);
             bitsBuf_[c] = GlBuffer((last - first) * sizeof(uint32_t), last > first ? tree_.bits.data() + first : nullptr, 0);
         }
-        makeTexels(occupancy, exact);
+        makeTexels(occupancy, exact, culled, split > 1);
+        // A point's distance to a triangle's plane, computed in float, is off by a few units in the
+        // last place of the coordinates (the plane's offset is of their size): 4e-5 of the largest
+        // coordinate is ~300 of them and far below a leaf (1/343 of the scene at (7, 3)).
+        planeEps_ = 0;
+        if (!tree_.nodes.empty()) {
+            const ls::NodeGpu& root = tree_.nodes[0];
+            for (int k = 0; k < 3; ++k)
+                planeEps_ = std::max({planeEps_, std::abs(root.lo[k]), std::abs(root.lo[k] + root.size[k])});
+            planeEps_ *= 4e-5f;
+        }
         // The shader reads the line-space pool with one load when it is a single block; a tree that
         // needs more blocks gets the program that picks the block per node.
         const int usedChunks = int(std::max<size_t>(1, chunks));
@@ -248,7 +294,14 @@ public:
         p.set("uLeafCell", region.leafCell);
         p.set("uStartCells", region.cells);
         p.set("uStartMaxCells", region.maxCells);
+        p.set("uPlaneEps", planeEps_);
+        p.set("uLeafMargin", 0.0625f * std::max({region.leafCell.x, region.leafCell.y, region.leafCell.z}));
         if (region.mode == ls::StartMode::Exact) scene_->bindStorage(); // the positions' buffer texture
+        if (region.mode == ls::StartMode::Bvh) {
+            p.set("uBvhStepCap", unsigned(nearStepCap_));
+            glBindTextureUnit(LS_BVH_NODE_UNIT, bvhNodeTexels_.id());
+            glBindTextureUnit(LS_BVH_TRI_UNIT, bvhTriTexels_.id());
+        }
         for (size_t u = 0; u < kTexelUnits; ++u)
             if (texels_[u]) glBindTextureUnit(GLuint(LS_NODE_UNIT + u), texels_[u].id());
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_SAMPLE_BINDING);
@@ -293,11 +346,17 @@ public:
                                  {"cells_stepped_mean", perRay(wide(LS_C_CELLS_LO))},
                                  {"leaf_cells_mean", perRay(wide(LS_C_LEAVES_LO))},
                                  {"triangles_tested_mean", perRay(wide(LS_C_TRIS_LO))},
+                                 {"near_nodes_mean", perRay(wide(LS_C_NEAR_NODES_LO))},
                                  {"occluded_share", perRay(wide(LS_C_OCCLUDED_LO))},
                                  {"rays", rays},
                                  {"traced_pixels", double(c[LS_C_PIXELS])}});
         for (size_t l = 0; l < tree_.nodesPerLevel.size(); ++l)
             out.push_back({"nodes_level_" + std::to_string(l), double(tree_.nodesPerLevel[l])});
+        // The SIMD probe: per section, the lane slots a ray pays (its subgroup's passes × width, per
+        // ray) and the share of them doing its work (utilisation); absent without a ballot.
+        static_assert(LS_SIMD_SECTIONS == 8);
+        appendSimdProbeCounters(out, {"walk", "node", "leaf", "plane", "triangle", "sub_cell", "near_node", "near_triangle"}, LS_C_SIMD_BASE,
+                                c[LS_C_SIMD_WIDTH], rays, wide);
         if (p_.classify && pendingG_.width > 0) {
             const ls::SampleClasses& k = classify();
             const double n = k.samples > 0 ? double(k.samples) : 1.0;
@@ -349,14 +408,19 @@ private:
                 {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)},
                 {"LS_START_MODE", std::to_string(int(startMode()))},
                 {"LS_LAST_LEAVES", lastLeaves() ? "1" : "0"},
+                {"LS_LEAF_SPLIT", std::to_string(startMode() != ls::StartMode::Node || lastLeaves() ? p_.leafSplit : 1)},
+                {"LS_CULL_TRIANGLES", startMode() == ls::StartMode::Exact && culledTriangles() ? "1" : "0"},
+                simdProbeDefine(options_),
                 instrumentationDefine(options_)};
     }
 
     bool lastLeaves() const { return p_.lastLevel == "leaves"; }
+    bool culledTriangles() const { return p_.startTriangles == "culled"; }
 
     ls::StartMode startMode() const {
         const std::string& m = p_.startRegion;
-        return m == "exact" ? ls::StartMode::Exact : m == "distance" ? ls::StartMode::Distance : ls::StartMode::Node;
+        return m == "exact" ? ls::StartMode::Exact : m == "distance" ? ls::StartMode::Distance
+                              : m == "bvh"   ? ls::StartMode::Bvh : ls::StartMode::Node;
     }
 
     /// The start region the shader uses (valid after setScene()); leaf cells from the root's size.
@@ -373,18 +437,37 @@ private:
         return r;
     }
 
+    /// start_region bvh: bvh_raytrace's tree of the scene (its default build: SAH, leaves of 4), the
+    /// near field's exact test. Returns its bytes on the GPU.
+    size_t buildNearField(const Scene& cpu, size_t limit) {
+        bvh::Bvh tree = bvh::buildBvh(cpu, bvh::BuildOptions{});
+        bvh::checkStorageBlock("the near-field BVH nodes", tree.nodes.size() * sizeof(bvh::NodeGpu), limit);
+        bvh::checkStorageBlock("the near-field BVH triangles", tree.triangles.size() * sizeof(glm::vec4), limit);
+        if (tree.triIndices.size() >= (size_t(1) << 27))
+            throw RuntimeError("line_space: more than 2^27 triangles cannot be addressed by the near field's traversal stack");
+        bvhNodes_ = GlBuffer::fromVector(tree.nodes, 0);
+        bvhTris_ = GlBuffer::fromVector(tree.triangles, 0);
+        bvhNodeTexels_ = makeBufferTexture(bvhNodes_, GL_RGBA32UI, 16, "line_space near-field BVH nodes");
+        bvhTriTexels_ = makeBufferTexture(bvhTris_, GL_RGBA32F, 16, "line_space near-field BVH triangles");
+        // As bvh_raytrace: a correct walk takes at most nodes + 2 * leaves + 1 loop passes.
+        nearStepCap_ = uint32_t(std::min<uint64_t>(uint64_t(tree.nodes.size()) + 2 * uint64_t(tree.leaves) + 1, UINT32_MAX));
+        return bvhNodes_.size() + bvhTris_.size();
+    }
+
     /// The trace's buffer-texture views of the pools, one per texture unit from LS_NODE_UNIT on
     /// (layout.glsl); the occupancy pool and the leaf lists only where the start region reads them.
-    void makeTexels(bool occupancy, bool exact) {
-        static_assert(LS_BITS_UNIT - LS_NODE_UNIT + LS_BIT_CHUNKS == kTexelUnits);
+    void makeTexels(bool occupancy, bool exact, bool culled, bool split) {
+        static_assert(LS_BITS_UNIT + LS_BIT_CHUNKS == LS_TRI_PLANE_UNIT && LS_LEAF_SUB_UNIT - LS_NODE_UNIT + 1 == kTexelUnits);
         texels_[0] = makeBufferTexture(nodesBuf_, GL_RGBA32UI, 16, "line_space node pool");
         texels_[LS_TREE_UNIT - LS_NODE_UNIT] = makeBufferTexture(treeBuf_, GL_R32UI, 4, "line_space tree pool");
         if (occupancy) texels_[LS_OCC_UNIT - LS_NODE_UNIT] = makeBufferTexture(occBuf_, GL_R32UI, 4, "line_space occupancy pool");
+        if (exact || split) texels_[LS_LEAF_RANK_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafBase_, GL_R32UI, 4, "line_space leaf ranks");
+        if (split) texels_[LS_LEAF_SUB_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafSub_, GL_RG32UI, 8, "line_space leaf sub-cells");
         if (exact) {
-            texels_[LS_LEAF_RANK_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafBase_, GL_R32UI, 4, "line_space leaf ranks");
             texels_[LS_LEAF_PREFIX_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafPrefix_, GL_R32UI, 4, "line_space leaf prefixes");
             texels_[LS_LEAF_TRIS_UNIT - LS_NODE_UNIT] = makeBufferTexture(leafTris_, GL_R32UI, 4, "line_space leaf triangles");
         }
+        if (culled) texels_[LS_TRI_PLANE_UNIT - LS_NODE_UNIT] = makeBufferTexture(triPlanes_, GL_RGBA32F, 16, "line_space triangle planes");
         for (size_t c = 0; c < LS_BIT_CHUNKS; ++c)
             texels_[LS_BITS_UNIT - LS_NODE_UNIT + c] = makeBufferTexture(bitsBuf_[c], GL_R32UI, 4, "line_space line-space pool");
     }
@@ -433,10 +516,14 @@ private:
     /// Node, tree, line-space pools; (if read) occupancy pool; (exact) leaf lists + scene positions.
     /// A GlBuffer rounds empty ones up to 4 bytes; these are the bytes the shader uses.
     std::array<size_t, 5> poolBytes_{};
-    GlBuffer nodesBuf_, treeBuf_, occBuf_, leafBase_, leafPrefix_, leafTris_, samples_, classifyBuf_;
+    GlBuffer nodesBuf_, treeBuf_, occBuf_, leafBase_, leafPrefix_, leafTris_, triPlanes_, leafSub_, samples_, classifyBuf_;
+    GlBuffer bvhNodes_, bvhTris_;        ///< start_region bvh
+    GlTexture bvhNodeTexels_, bvhTriTexels_;
+    uint32_t nearStepCap_ = 1;
+    float planeEps_ = 0; ///< culled start region: distances to a triangle's plane within this are too close to call
     GpuCounters<LS_COUNTER_WORDS> counters_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
-    static constexpr size_t kTexelUnits = 10;
+    static constexpr size_t kTexelUnits = 12;
     std::array<GlTexture, kTexelUnits> texels_; ///< the pools as buffer textures (makeTexels): how the trace reads them
     size_t nodesPerChunk_ = 1;
     int bitChunks_ = 1; ///< line-space pool blocks the compiled programs read (LS_BIT_CHUNK_COUNT)
@@ -454,13 +541,23 @@ private:
 
 /// Its pools depend on (N, d), not on the scene, and are checked in setScene; what grows with the
 /// scene is the exact start region's leaf lists (>= 4 bytes a triangle) and its check that the
-/// scene positions fit one storage block (the reported size), as setScene does.
+/// scene positions fit one storage block (the reported size), as setScene does; with
+/// start_triangles culled a plane per triangle (16 bytes), with leaf_split > 1 8 bytes per occupied
+/// leaf (at most about one per triangle).
 Footprint lineSpaceFootprint(const FootprintQuery& q) {
     Footprint f;
-    f.bytes = 8 * q.triangles;
-    f.peakBytes = 16 * q.triangles;
-    if (std::get<std::string>(q.params->get("start_region")) == "exact")
-        f.refusal = storageRefusal(q, "the scene positions its exact start region reads", 36 * q.triangles, true);
+    const bool exact = std::get<std::string>(q.params->get("start_region")) == "exact";
+    const bool culled = exact && std::get<std::string>(q.params->get("start_triangles")) == "culled";
+    const bool split = std::get<int>(q.params->get("leaf_split")) > 1;
+    f.bytes = (8 + (culled ? 16 : 0) + (split ? 8 : 0)) * q.triangles;
+    f.peakBytes = f.bytes + 8 * q.triangles;
+    if (exact) f.refusal = storageRefusal(q, "the scene positions its exact start region reads", 36 * q.triangles, true);
+    if (std::get<std::string>(q.params->get("start_region")) == "bvh") {
+        // bvh_raytrace's tree with its default leaves of 4: triangles 48 bytes, nodes ~32 bytes a triangle.
+        f.bytes += 80 * q.triangles;
+        f.peakBytes += 152 * q.triangles;
+        f.refusal = storageRefusal(q, "the near field's leaf-ordered triangles", 48 * q.triangles, true);
+    }
     return f;
 }
 AlgorithmInfo lineSpaceInfo() {

@@ -84,12 +84,21 @@ struct LeafLists {
     std::vector<uint32_t> wordRank; ///< per node and occupancy word (0 above the last level)
     std::vector<uint32_t> prefix;   ///< per occupied leaf, plus one
     std::vector<uint32_t> tris;
-    size_t bytes() const { return (wordRank.size() + prefix.size() + tris.size()) * sizeof(uint32_t); }
+    /// With a leaf split S > 1: per occupied leaf, the occupancy of its S³ sub-cells (bit
+    /// (z × S + y) × S + x, two words: bits 0..31, 32..63), by the same triangle–box test on the
+    /// sub-cells widened by the tree's margin.
+    std::vector<uint32_t> sub;
+    size_t bytes() const { return (wordRank.size() + prefix.size() + tris.size() + sub.size()) * sizeof(uint32_t); }
 };
 
 /// The leaf lists of `tree` (built from `scene`): the build's descent replayed with the same
 /// triangle–box tests on the same boxes, so a leaf has triangles exactly where its occupancy bit is set.
-LeafLists buildLeafLists(const Scene& scene, const NTree& tree, int threads = 0);
+/// `split` (1, 2 or 4): sub-cells per axis of a leaf for LeafLists::sub (1: none).
+LeafLists buildLeafLists(const Scene& scene, const NTree& tree, int threads = 0, int split = 1);
+
+/// Per scene triangle its plane: unit normal (x, y, z) and offset w, so a point p lies at signed
+/// distance dot(n, p) + w; (0, 0, 0, 0) for a degenerate triangle (every point "on" it, never culled).
+std::vector<glm::vec4> trianglePlanes(const Scene& scene);
 
 /// Nodes per line-space pool chunk for SSBOs of at most `maxBlockBytes`.
 inline size_t nodesPerChunk(int n, size_t maxBlockBytes) {

@@ -182,14 +182,14 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
     return t;
 }
 
-LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
+LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads, int split) {
     LeafLists out;
     out.wordRank.assign(t.nodes.size() * occupancyWords(t.n), 0);
     out.prefix.push_back(0);
     if (t.nodes.empty()) return out;
     if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
     const int n = t.n, n3 = n * n * n;
-    Builder builder(scene, n, t.margin);
+    Builder builder(scene, n, t.margin), subBuilder(scene, std::max(1, split), t.margin);
     auto box = [&](uint32_t i) {
         const NodeGpu& node = t.nodes[i];
         return Pending{{node.lo[0], node.lo[1], node.lo[2]}, {node.size[0], node.size[1], node.size[2]}, {}};
@@ -200,9 +200,26 @@ LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
     for (uint32_t i = 0; i < uint32_t(level[0].tris.size()); ++i) level[0].tris[i] = i;
     for (int l = 0; l < t.d && !level.empty(); ++l) {
         std::vector<NodeResult> results(level.size());
+        // Last level, split: per leaf its sub-cells' occupancy, from the leaf's own triangles.
+        std::vector<std::vector<uint64_t>> subMasks(split > 1 && l == t.d - 1 ? level.size() : 0);
         parallelFor(level.size(), threads, [&](size_t i) {
             builder.occupancy(level[i], true, results[i]);
             level[i].tris = {};
+            if (subMasks.empty()) return;
+            subMasks[i].assign(size_t(n3), 0);
+            const glm::vec3 cell = level[i].size / float(n);
+            NodeResult leaf;
+            for (int c = 0; c < n3; ++c) {
+                if (results[i].childTris[size_t(c)].empty()) continue;
+                const int x = c % n, y = (c / n) % n, z = c / (n * n);
+                // The leaf's box by the float expression of the shader's DDA (cellLo).
+                Pending p{{cellLo(level[i].lo.x, cell.x, x), cellLo(level[i].lo.y, cell.y, y), cellLo(level[i].lo.z, cell.z, z)},
+                          cell, results[i].childTris[size_t(c)]};
+                subBuilder.occupancy(p, false, leaf);
+                uint64_t mask = 0;
+                for (size_t b = 0; b < leaf.occupied.size(); ++b) mask |= uint64_t(leaf.occupied[b] != 0) << b;
+                subMasks[i][size_t(c)] = mask;
+            }
         });
         std::vector<uint32_t> nextIndex;
         std::vector<Pending> next;
@@ -215,6 +232,11 @@ LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
                     if (tris.empty()) continue;
                     out.tris.insert(out.tris.end(), tris.begin(), tris.end());
                     out.prefix.push_back(uint32_t(out.tris.size()));
+                    if (!subMasks.empty()) {
+                        const uint64_t mask = subMasks[i][size_t(c)];
+                        out.sub.push_back(uint32_t(mask));
+                        out.sub.push_back(uint32_t(mask >> 32));
+                    }
                 }
                 continue;
             }
@@ -231,6 +253,19 @@ LeafLists buildLeafLists(const Scene& scene, const NTree& t, int threads) {
         level = std::move(next);
     }
     return out;
+}
+
+std::vector<glm::vec4> trianglePlanes(const Scene& scene) {
+    std::vector<glm::vec4> planes(scene.triangleCount(), glm::vec4(0.0f));
+    parallelFor(planes.size(), int(std::max(1u, std::thread::hardware_concurrency())), [&](size_t i) {
+        const glm::dvec3 a = scene.positions[3 * i], b = scene.positions[3 * i + 1], c = scene.positions[3 * i + 2];
+        const glm::dvec3 n = glm::cross(b - a, c - a);
+        const double len = glm::length(n);
+        if (!(len > 0.0) || !std::isfinite(len)) return;
+        const glm::dvec3 u = n / len;
+        planes[i] = glm::vec4(glm::vec3(u), float(-glm::dot(u, a)));
+    });
+    return planes;
 }
 
 } // namespace shadowlab::ls

@@ -66,7 +66,7 @@ SampleClasses classifySamples(const EmbreeTracer& tracer, const CpuGBuffer& g, c
                     if (!ls && exact) {
                         ++c.under;
                         bool elsewhere = true;
-                        if (region.mode == StartMode::Exact) {
+                        if (region.mode == StartMode::Exact || region.mode == StartMode::Bvh) {
                             elsewhere = true; // nothing is ignored: every miss is one
                         } else if (region.mode == StartMode::Distance) {
                             // Traced again from just past the region's end: the float end the shader

@@ -19,7 +19,8 @@
 namespace shadowlab::ls {
 
 /// start_region, in the values of the shader's LS_START_MODE.
-enum class StartMode { Node = 0, Distance = 1, Exact = 2 };
+/// Bvh: the distance region's walk with its start region traced exactly through a BVH (nothing ignored).
+enum class StartMode { Node = 0, Distance = 1, Exact = 2, Bvh = 3 };
 
 /// The start region of line_space's rays (twin of startRegionEnd in shaders/line_space/trace.comp).
 /// Node: the paper's, the last-level node holding the origin (the shader reports it per pixel).
@@ -32,7 +33,7 @@ struct StartRegion {
     /// End of the region for unit normal `nu` and unit direction `d`, float for float the shader's.
     float end(glm::vec3 nu, glm::vec3 d) const {
         const float sinAngle = glm::dot(nu, d), longest = maxCells * glm::dot(glm::abs(d), leafCell);
-        if (!(sinAngle > 0.0f)) return mode == StartMode::Exact ? longest : 0.0f;
+        if (!(sinAngle > 0.0f)) return mode == StartMode::Exact || mode == StartMode::Bvh ? longest : 0.0f;
         return std::min(cells * glm::dot(glm::abs(nu), leafCell) / sinAngle, longest);
     }
 };

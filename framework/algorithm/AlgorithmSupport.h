@@ -42,6 +42,31 @@ inline std::pair<std::string, std::string> instrumentationDefine(const Algorithm
     return {"SHADOWLAB_INSTRUMENTATION", o.instrumentation ? "1" : "0"};
 }
 
+/// The define of the SIMD probe (shaders/common/simd_probe.glsl): 1 in instrumented passes where a
+/// ballot can be read (ARB_shader_ballot with ARB_gpu_shader_int64), else 0.
+inline std::pair<std::string, std::string> simdProbeDefine(const AlgorithmOptions& o) {
+    const bool ballot = o.instrumentation && hasExtension("GL_ARB_shader_ballot") && hasExtension("GL_ARB_gpu_shader_int64");
+    return {"SHADOWLAB_SIMD_PROBE", ballot ? "1" : "0"};
+}
+
+/// The SIMD probe's counters, per section k named names[k]: `simd_<name>_slots_per_ray`, the lane
+/// slots a ray pays there (its subgroup's passes × width, per ray: what the section costs, idle lanes
+/// included), and `simd_<name>_utilisation`, the share of them doing work; plus `simd_width`. `wide(i)`
+/// reads the kernel's 64-bit counter at word i; nothing is added without a probe (width 0).
+template <class Wide>
+void appendSimdProbeCounters(std::vector<Counter>& out, std::initializer_list<const char*> names, size_t base,
+                             double width, double rays, Wide wide) {
+    if (!(width > 0) || !(rays > 0)) return;
+    out.push_back({"simd_width", width});
+    size_t k = 0;
+    for (const char* name : names) {
+        const double passes = double(wide(base + 4 * k)), lanes = double(wide(base + 4 * k + 2));
+        out.push_back({std::string("simd_") + name + "_slots_per_ray", passes * width / rays});
+        out.push_back({std::string("simd_") + name + "_utilisation", passes > 0 ? lanes / (passes * width) : 0.0});
+        ++k;
+    }
+}
+
 /// Per-pixel passes read the G-buffer's world position (texture unit 0) and camera-facing normal
 /// (unit 1) and write visibility to image unit 0 (R32F); units above are the algorithm's own.
 inline void bindPixelPassInputs(const FrameInputs& f) {

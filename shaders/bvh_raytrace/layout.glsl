@@ -23,7 +23,7 @@
 
 // Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words (the shader
 // carries into HI when LO wraps).
-#define BVH_COUNTER_WORDS 12
+#define BVH_COUNTER_WORDS 21
 #define BVH_C_RAYS_LO 0           // shadow rays traced (lit pixels × samples)
 #define BVH_C_RAYS_HI 1
 #define BVH_C_VISITED_LO 2        // inner nodes fetched, summed over rays
@@ -36,6 +36,12 @@
 #define BVH_C_PIXELS 9            // pixels that traced rays (covered, facing and reached by the light)
 #define BVH_C_TRUNCATED_PIXELS 10 // pixels whose sample loop the driver cut short (written shadowed)
 #define BVH_C_CAPPED_PIXELS 11    // pixels with a ray whose traversal reached its step cap (written shadowed)
+// Instrumented, with ARB_shader_ballot: the SIMD probe (common/simd_probe.glsl) of the two loops.
+#define BVH_SIMD_NODE 0           // an inner node fetched and both children's boxes tested
+#define BVH_SIMD_TRI 1            // a triangle tested
+#define BVH_SIMD_SECTIONS 2
+#define BVH_C_SIMD_BASE 12        // section k: passes at 12 + 4k (LO, HI), lanes at 14 + 4k (LO, HI)
+#define BVH_C_SIMD_WIDTH 20       // the widest ballot at entry (0: no probe)
 
 // A frame whose light has more samples than samples_per_dispatch runs several dispatches; between
 // them each traced pixel keeps its state in the accumulation image (image unit BVH_ACCUM_UNIT,

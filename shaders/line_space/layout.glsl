@@ -24,6 +24,14 @@
 // at unit LS_BITS_UNIT + c.
 #define LS_BIT_CHUNKS 4
 #define LS_BITS_UNIT 8
+// start_region exact, start_triangles culled: per scene triangle its plane (RGBA32F: unit normal,
+// offset), read by the plane test before the watertight one.
+#define LS_TRI_PLANE_UNIT 12
+// leaf_split > 1: per occupied leaf (numbered by its rank) the occupancy of its sub-cells (RG32UI).
+#define LS_LEAF_SUB_UNIT 13
+// start_region bvh: the near field's BVH (bvh_raytrace's layout: nodes RGBA32UI, triangles RGBA32F).
+#define LS_BVH_NODE_UNIT 16
+#define LS_BVH_TRI_UNIT 17
 
 // Node pool entry: vec3 lo; uint children; vec3 size; uint level (32 bytes, std430).
 #define LS_NODE_BYTES 32
@@ -44,7 +52,7 @@
 #define LS_OCC_WORDS_PER_NODE(n) (((n) * (n) * (n) + 31) / 32)
 
 // Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words.
-#define LS_COUNTER_WORDS 19
+#define LS_COUNTER_WORDS 54
 #define LS_C_RAYS_LO 0          // shadow rays (lit pixels × samples)
 #define LS_C_RAYS_HI 1
 #define LS_C_VISITED_LO 2       // nodes entered, summed over rays
@@ -64,6 +72,22 @@
 #define LS_C_TRIS_HI 16
 #define LS_C_TRUNCATED 17       // pixels whose sample loop the driver cut short (written shadowed)
 #define LS_C_CAPPED 18          // pixels with a ray whose walk reached its loop cap (written shadowed)
+#define LS_C_NEAR_NODES_LO 19   // start_region bvh: BVH nodes the near fields fetched, summed over rays
+#define LS_C_NEAR_NODES_HI 20
+// Instrumented, with ARB_shader_ballot: the SIMD probe. Per section of the trace (LS_SIMD_*), how
+// often a subgroup ran it (passes) and with how many lanes active in all (lanes), each 64 bits
+// (LO, HI); utilisation = lanes / (passes × width), the width being the lanes of a ballot at entry.
+#define LS_SIMD_WALK 0   // a pass of the DDA over a node's children (empty cells included)
+#define LS_SIMD_NODE 1   // a node entered: slab test and shaft bit
+#define LS_SIMD_LEAF 2   // a leaf visited by a leaf walk (start region, last level)
+#define LS_SIMD_PLANE 3  // a plane test of a start-region triangle (start_triangles culled)
+#define LS_SIMD_TRI 4    // a watertight triangle test (exact start region)
+#define LS_SIMD_SUB 5    // a sub-cell visited (leaf_split > 1)
+#define LS_SIMD_NEAR_NODE 6 // a BVH node of the near field (start_region bvh)
+#define LS_SIMD_NEAR_TRI 7  // a triangle test of the near field
+#define LS_SIMD_SECTIONS 8
+#define LS_C_SIMD_BASE 21       // section k: passes at 21 + 4k (LO, HI), lanes at 23 + 4k (LO, HI)
+#define LS_C_SIMD_WIDTH 53      // the widest ballot at entry (0: no probe)
 
 // A frame whose light has more samples than samples_per_dispatch runs several dispatches; between
 // them each traced pixel keeps its state in the accumulation image (image unit LS_ACCUM_UNIT, R32UI,

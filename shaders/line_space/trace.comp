@@ -31,17 +31,35 @@
 // a NaN is false). GLSL does not promise that a loop ends; a GPU runs an endless one until its
 // driver's watchdog resets the device. A ray whose walk reaches its cap is blocked and its pixel
 // written shadowed and counted (LS_C_CAPPED, overflowCount()), never lit by mistake.
+#include "line_space/layout.glsl"
+#define SIMD_PROBE_SECTIONS LS_SIMD_SECTIONS
+#include "common/simd_probe.glsl"
 #include "common/instrumentation.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
-#include "line_space/layout.glsl"
 #define LS_START_NODE 0
 #define LS_START_DISTANCE 1
 #define LS_START_EXACT 2
+#define LS_START_BVH 3
+// (Includes expand once, whatever #if surrounds them: each file is included where every mode that
+// reads it sees it.)
+#if LS_START_MODE == LS_START_EXACT || LS_START_MODE == LS_START_BVH
+#include "common/watertight.glsl"
+#endif
 #if LS_START_MODE == LS_START_EXACT
 #define SCENE_POSITION_TEXELS 1
 #include "common/scene.glsl"
-#include "common/watertight.glsl"
+#endif
+#if LS_START_MODE == LS_START_BVH
+// The near field: the segment before the start region's end, traced exactly through bvh_raytrace's
+// BVH with its traversal (any hit ends it); the line space walks from the region's end as
+// LS_START_DISTANCE does, so nothing is ignored.
+#include "bvh_raytrace/layout.glsl"
+#define BVH_TRAVERSE_NODE_UNIT LS_BVH_NODE_UNIT
+#define BVH_TRAVERSE_TRI_UNIT LS_BVH_TRI_UNIT
+#define BVH_TICK_NODE() SIMD_TICK(LS_SIMD_NEAR_NODE)
+#define BVH_TICK_TRI() SIMD_TICK(LS_SIMD_NEAR_TRI)
+#include "bvh_raytrace/traverse.glsl"
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -65,16 +83,29 @@ layout(binding = LS_BITS_UNIT + 3) uniform usamplerBuffer uLsBitsTexels3;
 layout(binding = LS_OCC_UNIT) uniform usamplerBuffer uLsOccTexels;
 uint lsOcc(uint word) { return texelFetch(uLsOccTexels, int(word)).x; }
 #endif
-#if LS_START_MODE == LS_START_EXACT
-// The leaf lists (ls::LeafLists): per node and occupancy word the number of the occupied leaves
-// before it, per occupied leaf the start of its triangles (plus one end), the triangles (scene
-// indices, vertices from the scene's positions).
+#ifndef LS_LEAF_SPLIT
+#define LS_LEAF_SPLIT 1
+#endif
+#if LS_START_MODE == LS_START_EXACT || LS_LEAF_SPLIT > 1
+// Per node and occupancy word the number of the occupied leaves before it (ls::LeafLists): an
+// occupied leaf's rank, by which its list and its sub-cells are found.
 layout(binding = LS_LEAF_RANK_UNIT) uniform usamplerBuffer uLsLeafRankTexels;
+uint lsLeafRank(uint word) { return texelFetch(uLsLeafRankTexels, int(word)).x; }
+#endif
+#if LS_LEAF_SPLIT > 1
+layout(binding = LS_LEAF_SUB_UNIT) uniform usamplerBuffer uLsLeafSubTexels; // per occupied leaf: its sub-cells' bits
+#endif
+#if LS_START_MODE == LS_START_EXACT
+// The leaf lists (ls::LeafLists): per occupied leaf the start of its triangles (plus one end), the
+// triangles (scene indices, vertices from the scene's positions).
 layout(binding = LS_LEAF_PREFIX_UNIT) uniform usamplerBuffer uLsLeafPrefixTexels;
 layout(binding = LS_LEAF_TRIS_UNIT) uniform usamplerBuffer uLsLeafTrisTexels;
-uint lsLeafRank(uint word) { return texelFetch(uLsLeafRankTexels, int(word)).x; }
 uint lsLeafPrefix(uint leaf) { return texelFetch(uLsLeafPrefixTexels, int(leaf)).x; }
 uint lsLeafTri(uint i) { return texelFetch(uLsLeafTrisTexels, int(i)).x; }
+#if LS_CULL_TRIANGLES
+layout(binding = LS_TRI_PLANE_UNIT) uniform samplerBuffer uLsTriPlaneTexels; // per scene triangle: unit normal, offset
+vec4 lsTriPlane(uint tri) { return texelFetch(uLsTriPlaneTexels, int(tri)); }
+#endif
 #endif
 LsNode lsNode(uint i) {
     uvec4 a = texelFetch(uLsNodeTexels, int(2u * i)), b = texelFetch(uLsNodeTexels, int(2u * i + 1u));
@@ -108,7 +139,12 @@ uniform uint uNodesPerChunk; // nodes per line-space pool chunk (see layout.glsl
 uniform vec3 uLeafCell;      // world size of a leaf cell (level d)
 uniform float uStartCells;   // start_cells
 uniform float uStartMaxCells; // start_max_cells
+uniform float uPlaneEps;      // start_triangles culled: plane distances within this are too close to call
+uniform float uLeafMargin;    // start_triangles culled: the ray's part in a leaf, widened by this (world units)
 
+#ifndef LS_CULL_TRIANGLES
+#define LS_CULL_TRIANGLES 0
+#endif
 #ifndef LS_BIT_CHUNK_COUNT
 #define LS_BIT_CHUNK_COUNT LS_BIT_CHUNKS
 #endif
@@ -185,14 +221,48 @@ uint lineSpaceWord(uint index, uint w) {
 // geometry, none (the leaves the ray enters there block it).
 float startRegionEnd(vec3 nu, vec3 d) {
     float sinAngle = dot(nu, d), longest = uStartMaxCells * dot(abs(d), uLeafCell);
-    if (!(sinAngle > 0.0)) return LS_START_MODE == LS_START_EXACT ? longest : 0.0;
+    if (!(sinAngle > 0.0)) return LS_START_MODE == LS_START_EXACT || LS_START_MODE == LS_START_BVH ? longest : 0.0;
     return min(uStartCells * dot(abs(nu), uLeafCell) / sinAngle, longest);
 }
 
-uint leafCells = 0u, trianglesTested = 0u; // read by leafWalk (counters)
+uint leafCells = 0u, trianglesTested = 0u, nearNodes = 0u; // read by leafWalk, the near field (counters)
 
 #if LS_START_MODE == LS_START_EXACT
 WatertightRay exactRay = WatertightRay(vec3(0.0), 0.0, 2, false, vec3(0.0)); // the current ray, in the triangle test's frame
+#endif
+
+#if LS_LEAF_SPLIT > 1
+// Where an occupied leaf would block: does the ray's part [ta, tb] in leaf `leaf` of a last-level node
+// (`word`, `bits`: its occupancy word and its index there) cross an occupied sub-cell? A 3D DDA over
+// the leaf's S³ sub-cells (S = LS_LEAF_SPLIT), whose bits the build set by the triangle–box test on
+// sub-cells widened by the tree's margin, like every other box: conservative under the same
+// rounding. At most 3S - 2 sub-cells are crossed; a walk that has not left by then (a NaN step)
+// blocks.
+bool subCellsBlock(uint word, uint bits, uint leaf, vec3 leafLo, vec3 cellSize, Ray r, float ta, float tb) {
+    uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
+    uvec2 m = texelFetch(uLsLeafSubTexels, int(rank)).xy;
+    const int S = LS_LEAF_SPLIT;
+    vec3 sub = cellSize / float(S);
+    ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
+    ivec3 c = clamp(ivec3(floor((r.o + r.d * ta - leafLo) / sub)), ivec3(0), ivec3(S - 1));
+    vec3 tNext = (leafLo + vec3(c + up) * sub - r.o) * r.invD;
+    for (int k = 0; k < 3 * S; ++k) {
+        SIMD_TICK(LS_SIMD_SUB);
+        int b = (c.z * S + c.y) * S + c.x;
+        if ((((b < 32 ? m.x : m.y) >> uint(b & 31)) & 1u) != 0u) return true;
+        float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
+        if (cellEnd > tb) return false;
+        bvec3 axis = equal(tNext, vec3(cellEnd));
+        axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+        c += ivec3(axis) * stepDir;
+        if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(S)))) return false;
+        tNext = mix(tNext, (leafLo + vec3(c + up) * sub - r.o) * r.invD, axis);
+    }
+    return true;
+}
+#define LEAF_BLOCKS(word, bits, leaf, c, lo, cellSize, r, ta, tb) subCellsBlock(word, bits, leaf, (lo) + vec3(c) * (cellSize), cellSize, r, ta, tb)
+#else
+#define LEAF_BLOCKS(word, bits, leaf, c, lo, cellSize, r, ta, tb) true
 #endif
 
 #if LS_START_MODE != LS_START_NODE || LS_LAST_LEAVES
@@ -225,6 +295,7 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
 #if LS_START_MODE == LS_START_EXACT
         if (next < end) {
             ++trianglesTested;
+            SIMD_TICK(LS_SIMD_TRI);
             uint tri = lsLeafTri(next++);
             if (watertightHit(exactRay, sceneVertex(tri, 0u), sceneVertex(tri, 1u), sceneVertex(tri, 2u))) return true;
             continue;
@@ -242,21 +313,110 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
         }
         step = true;
         ++leafCells;
+        SIMD_TICK(LS_SIMD_LEAF);
         uint leaf = uint((c.z * LS_N + c.y) * LS_N + c.x);
         uint word = base + (leaf >> 5u), bits = lsOcc(word);
         if (((bits >> (leaf & 31u)) & 1u) != 0u) {
 #if LS_START_MODE == LS_START_EXACT
-            if (tEnter >= tS) return true;
+            if (tEnter >= tS) {
+                if (LEAF_BLOCKS(word, bits, leaf, c, lo, cellSize, r, tEnter, min(min(min(tNext.x, tNext.y), tNext.z), t1))) return true;
+                continue;
+            }
             uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
             next = lsLeafPrefix(rank);
             end = lsLeafPrefix(rank + 1u);
 #else
-            return true;
+            if (LEAF_BLOCKS(word, bits, leaf, c, lo, cellSize, r, tEnter, min(min(min(tNext.x, tNext.y), tNext.z), t1))) return true;
 #endif
         }
     }
     // The cap (or a driver's own loop limit, llvmpipe's) ended the walk before it did: blocked,
     // and the pixel written shadowed.
+    gCapped = true;
+    return true;
+}
+#endif
+
+#if LS_CULL_TRIANGLES
+// Does the ray hit one of the triangles tris[first, end) of a leaf it crosses on [ta, tb]? Each
+// triangle is first tested by its plane: if the ray's part in the leaf (widened by uLeafMargin) lies
+// on one side of it, beyond uPlaneEps, it cannot hit the triangle here, and where else it could
+// (another leaf the triangle touches) that leaf decides: tested itself before tS, occupied after.
+// The plane tests of up to 32 triangles mark the candidates in a mask; the watertight test runs
+// only for those, in a loop of its own, so that a SIMD group pays for it as often as its lane with
+// the most candidates needs, not once per triangle (most are the receiver's own surface, which the
+// ray leaves upwards). Both loops end by integer counts (32, the mask's set bits).
+bool leafTrianglesHit(uint first, uint end, Ray r, float ta, float tb) {
+    vec3 a = r.o + r.d * max(ta - uLeafMargin, 0.0), b = r.o + r.d * min(tb + uLeafMargin, r.tEnd);
+    for (uint i = first; i < end; i += 32u) {
+        uint k = min(end - i, 32u), candidates = 0u;
+        for (uint j = 0u; j < k; ++j) {
+            SIMD_TICK(LS_SIMD_PLANE);
+            vec4 pl = lsTriPlane(lsLeafTri(i + j));
+            float sa = dot(pl.xyz, a) + pl.w, sb = dot(pl.xyz, b) + pl.w;
+            bool apart = (sa > uPlaneEps && sb > uPlaneEps) || (sa < -uPlaneEps && sb < -uPlaneEps);
+            if (!apart) candidates |= 1u << j;
+        }
+        while (candidates != 0u) {
+            int j = findLSB(candidates);
+            candidates &= candidates - 1u;
+            ++trianglesTested;
+            SIMD_TICK(LS_SIMD_TRI);
+            uint tri = lsLeafTri(i + uint(j));
+            if (watertightHit(exactRay, sceneVertex(tri, 0u), sceneVertex(tri, 1u), sceneVertex(tri, 2u))) return true;
+        }
+    }
+    return false;
+}
+
+// leafWalk for the exact start region with start_triangles culled: the same decisions, the work
+// split by cost. The DDA steps over empty leaves in a loop of its own (a step and an occupancy
+// load each), so lanes reach an occupied leaf together; there an occupied leaf entered at or after
+// tS blocks, and one before it has its triangles tested (leafTrianglesHit). The cap counts leaf
+// visits as leafWalk's does (at most 3N - 1 before the cell leaves the node).
+bool leafWalkCulled(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, float tS) {
+    ivec3 c = cellOf(r.o + r.d * t0, lo, cellSize);
+    ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
+    vec3 tNext = (lo + vec3(c + up) * cellSize - r.o) * r.invD;
+#if SHADOWLAB_FAULT_NAN_STEP
+    if (gFaultPixel) tNext = vec3(uintBitsToFloat(0x7FC00000u));
+#endif
+    uint base = index * OCC_WORDS;
+    float tEnter = t0;
+    bool step = false;
+    uint pass = 0u;
+    while (pass < uLeafWalkCap) {
+        uint word = 0u, bits = 0u, leaf = 0u;
+        bool occupied = false;
+        while (pass < uLeafWalkCap) {
+            ++pass;
+            if (step) {
+                float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
+                if (cellEnd > t1) return false;
+                tEnter = cellEnd;
+                bvec3 axis = equal(tNext, vec3(cellEnd));
+                axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+                c += ivec3(axis) * stepDir;
+                if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(LS_N)))) return false;
+                tNext = mix(tNext, (lo + vec3(c + up) * cellSize - r.o) * r.invD, axis);
+            }
+            step = true;
+            ++leafCells;
+            SIMD_TICK(LS_SIMD_LEAF);
+            leaf = uint((c.z * LS_N + c.y) * LS_N + c.x);
+            word = base + (leaf >> 5u);
+            bits = lsOcc(word);
+            if (((bits >> (leaf & 31u)) & 1u) != 0u) { occupied = true; break; }
+        }
+        if (!occupied) break; // the cap
+        float tExit = min(min(min(tNext.x, tNext.y), tNext.z), t1);
+        if (tEnter >= tS) {
+            if (LEAF_BLOCKS(word, bits, leaf, c, lo, cellSize, r, tEnter, tExit)) return true;
+            continue;
+        }
+        uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
+        if (leafTrianglesHit(lsLeafPrefix(rank), lsLeafPrefix(rank + 1u), r, tEnter, tExit)) return true;
+    }
     gCapped = true;
     return true;
 }
@@ -296,6 +456,7 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
     }
     start = start || tIn < tS;
     ++rayVisited; // a ray that misses the scene box visits nothing
+    SIMD_TICK(LS_SIMD_NODE);
     vec3 cellSize = n.size / float(LS_N);
     // Where the walk of a start-region node begins: the start region's end (geometry before it is
     // ignored), or, when the start region is tested exactly, the node's entry.
@@ -308,7 +469,11 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #if LS_START_MODE != LS_START_NODE
         float tTo = min(tOut, r.tEnd);
         if (tFrom > tTo) return ENTER_SKIP; // the whole node lies in the start region
+#if LS_CULL_TRIANGLES
+        return leafWalkCulled(index, n.lo, cellSize, r, tFrom, tTo, tS) ? ENTER_OCCLUDED : ENTER_SKIP;
+#else
         return leafWalk(index, n.lo, cellSize, r, tFrom, tTo, tS) ? ENTER_OCCLUDED : ENTER_SKIP;
+#endif
 #else
         startNode = index; // the ray starts among this node's leaves: nothing can be said
         return ENTER_SKIP;
@@ -339,7 +504,11 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #if LS_LAST_LEAVES
             // The shaft is non-empty; the leaves the ray itself crosses decide (occupancy, one leaf
             // wide instead of the shaft's union of all lines between two sub-faces).
+#if LS_CULL_TRIANGLES
+            return leafWalkCulled(index, n.lo, cellSize, r, max(tIn, 0.0), min(tOut, r.tEnd), -kInf) ? ENTER_OCCLUDED : ENTER_SKIP;
+#else
             return leafWalk(index, n.lo, cellSize, r, max(tIn, 0.0), min(tOut, r.tEnd), -kInf) ? ENTER_OCCLUDED : ENTER_SKIP;
+#endif
 #else
             return ENTER_OCCLUDED; // the shaft stands for its leaves (Algorithm 1)
 #endif
@@ -384,14 +553,15 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #endif
 
 #if SHADOWLAB_INSTRUMENTATION
-shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated, sCapped;
+shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated, sCapped, sNearNodes;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 #endif
 
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
-    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = sCapped = 0u;
+    if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = sCapped = sNearNodes = 0u;
+    SIMD_PROBE_ENTER();
     barrier();
 #endif
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -432,6 +602,7 @@ void main() {
                 sumShafts = 0u;
                 leafCells = 0u;
                 trianglesTested = 0u;
+                nearNodes = 0u;
                 vec3 nu = normalize(n);
 #if LS_CLASSIFY
                 startNode = LS_NONE;
@@ -502,6 +673,7 @@ void main() {
                                     continue;
                                 }
                                 ++cells;
+                                SIMD_TICK(LS_SIMD_WALK);
                                 int cell = cur.child;
                                 nodeStart = cur.start;
                                 // Advance to the next cell before descending into this one. The axis
@@ -535,6 +707,20 @@ void main() {
                             }
                         }
                     }
+#if LS_START_MODE == LS_START_BVH
+                    // The near field, for the rays the line space left free (most blocked rays are
+                    // blocked farther out, so this order runs the BVH for fewer of them). An
+                    // overflowed or capped near field could have missed its blocker: blocked, and the
+                    // pixel written shadowed (overflow, cap), as in bvh_raytrace.
+                    if (!blocked && finished && !gCapped) {
+                        BvhTrace near = bvhTrace(bvhMakeRay(r.o, r.d, min(tS, r.tEnd)));
+                        nearNodes += near.visited;
+                        trianglesTested += near.tested;
+                        if (near.overflow) ++overflow;
+                        if (near.capped) gCapped = true;
+                        blocked = near.occluded || near.overflow;
+                    }
+#endif
                     // A walk cut short (here or in a leaf walk) could have met a blocker further on.
                     if (!finished || gCapped) {
                         blocked = true;
@@ -582,6 +768,7 @@ void main() {
                 atomicAdd(sCells, cells);
                 atomicAdd(sLeaves, leafCells);
                 atomicAdd(sTris, trianglesTested);
+                atomicAdd(sNearNodes, nearNodes);
                 atomicAdd(sOccluded, occluded);
                 if (overflow != 0u) atomicAdd(sOverflow, overflow);
                 if (lastDispatch) {
@@ -618,10 +805,12 @@ void main() {
         addWide(LS_C_CELLS_LO, sCells);
         addWide(LS_C_LEAVES_LO, sLeaves);
         addWide(LS_C_TRIS_LO, sTris);
+        addWide(LS_C_NEAR_NODES_LO, sNearNodes);
         addWide(LS_C_OCCLUDED_LO, sOccluded);
         if (sOverflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], sOverflow);
         if (sTruncated != 0u) atomicAdd(lsCounters[LS_C_TRUNCATED], sTruncated);
         if (sCapped != 0u) atomicAdd(lsCounters[LS_C_CAPPED], sCapped);
+        SIMD_PROBE_FLUSH(addWide, lsCounters, LS_C_SIMD_BASE, LS_C_SIMD_WIDTH);
     }
 #endif
 }
