@@ -390,8 +390,8 @@ TEST_F(LineSpaceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
     RunOptions options;
     options.resolution = 32;
     options.debugViews = {"loop_capped"};
-    AlgorithmRun split = runAlgorithm(lineSpaceInfo(), s, {}, options); // the default: 4 per dispatch
-    EXPECT_EQ(split.counters["sample_dispatches"], 256.0);
+    AlgorithmRun split = runAlgorithm(lineSpaceInfo(), s, {}, options); // the default: 8 per dispatch
+    EXPECT_EQ(split.counters["sample_dispatches"], 128.0);
     EXPECT_EQ(split.overflow, 0u);
     EXPECT_EQ(split.counters["rays"], 1024.0 * split.counters["traced_pixels"]);
     AlgorithmRun uneven = runAlgorithm(lineSpaceInfo(), s, {{"samples_per_dispatch", 100}}, options);
@@ -405,9 +405,9 @@ TEST_F(LineSpaceGLTest, MaxSamplesSplitOverDispatchesWithinTheBudget) {
         if (mask[i] > 0.5f) ++flagged;
         else differ += single.visibility[i] != split.visibility[i];
     }
-    std::printf("[line_space] 1024 samples at 32²: rmse %.4f; trace %.1f ms in 256 dispatches, %.1f ms in 11, %.1f ms in one "
+    std::printf("[line_space] 1024 samples at 32²: rmse %.4f; trace %.1f ms in %.0f dispatches, %.1f ms in 11, %.1f ms in one "
                 "(%zu pixels cut short: %.0f truncated, %.0f capped)\n",
-                split.accuracy.rmse, traceMs(split), traceMs(uneven), traceMs(single), flagged,
+                split.accuracy.rmse, traceMs(split), split.counters["sample_dispatches"], traceMs(uneven), traceMs(single), flagged,
                 single.counters["truncated_pixels"], single.counters["loop_capped_pixels"]);
     EXPECT_EQ(double(flagged), double(single.overflow));
     EXPECT_EQ(differ, 0u);

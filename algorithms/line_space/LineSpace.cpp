@@ -79,8 +79,8 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
         // The leaf of growth: an occupied leaf blocks every ray through it, so shadows grow by up to a
         // leaf around every occluder (docs/algorithms/line_space.md, "Where the error comes from").
         // Split, only the occupied sub-cells the ray crosses block it.
-        // 4 by measurement: RMSE 0.040 -> 0.015 on the 882 k-triangle side-by-side scene for ~25 % more
-        // trace time (docs/algorithms/line_space.md, "The leaf of growth").
+        // 4 by measurement: worst-frame RMSE 0.047 -> 0.016 on the 882 k-triangle side-by-side scene at
+        // 1024² for 1.33x the trace time (docs/algorithms/line_space.md, "The leaf of growth").
         .integer("leaf_split", &P::leafSplit, 4, 1, 4, "sub-cells per axis",
                  "where an occupied leaf would block a ray (last_level leaves, the start region after its end), "
                  "its leaf_split³ sub-cells decide instead, by their own occupancy bits (64 bits per occupied leaf "
@@ -108,10 +108,10 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
                  "allow a scene with moving parts: rebuild the N-tree and its line spaces from the posed triangles "
                  "every frame they move (the `rebuild` stage; the disk cache is bypassed)",
                  ParamChange::Update)
-        // 4: at the defaults one sample of every pixel of a 4K frame costs ~60 ms on a GPU (~6 s on
-        // llvmpipe here, ~100x slower), ~77 ms on a 2 M-triangle scene: at most ~0.3 s a dispatch, 6x
-        // under 2 s (docs/algorithms/line_space.md, "Dispatches").
-        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 4));
+        // 8: at the defaults one sample of every pixel of a 4K frame costs ~42 ms on a GPU (~4.2 s on
+        // llvmpipe here, ~100x slower) on an 882 k-triangle scene: ~0.34 s a dispatch, 6x under 2 s
+        // (docs/algorithms/line_space.md, "Dispatches").
+        .apply(samplesPerDispatchRow(&P::samplesPerDispatch, 8));
     return s;
 }
 

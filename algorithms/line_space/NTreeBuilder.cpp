@@ -60,6 +60,7 @@ public:
                 for (int y = i0.y; y <= i1.y; ++y)
                     for (int x = i0.x; x <= i1.x; ++x) {
                         const int ci = (z * n + y) * n + x;
+                        if (!lists && r.occupied[size_t(ci)]) continue; // occupancy only: known already
                         if (!single) {
                             const glm::vec3 clo(cellLo(node.lo.x, cell.x, x), cellLo(node.lo.y, cell.y, y),
                                                 cellLo(node.lo.z, cell.z, z));

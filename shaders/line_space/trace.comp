@@ -372,8 +372,11 @@ bool leafTrianglesHit(uint first, uint end, Ray r, float ta, float tb) {
 // leafWalk for the exact start region with start_triangles culled: the same decisions, the work
 // split by cost. The DDA steps over empty leaves in a loop of its own (a step and an occupancy
 // load each), so lanes reach an occupied leaf together; there an occupied leaf entered at or after
-// tS blocks, and one before it has its triangles tested (leafTrianglesHit). The cap counts leaf
-// visits as leafWalk's does (at most 3N - 1 before the cell leaves the node).
+// tS blocks, and one before it has its triangles tested (leafTrianglesHit). The cap counts passes as
+// leafWalk's does: one per leaf visit (at most 3N - 1 before the cell leaves the node) and, at an
+// occupied leaf, one per triangle of its list, so the walk's whole work stays within uLeafWalkCap =
+// (3N - 1) * (1 + the longest list) however its loops nest (llvmpipe's iteration budget is shared by
+// a vector's lanes: a walk stalled by a NaN step must not exhaust it for its neighbours).
 bool leafWalkCulled(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, float tS) {
     ivec3 c = cellOf(r.o + r.d * t0, lo, cellSize);
     ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
@@ -415,7 +418,10 @@ bool leafWalkCulled(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t
             continue;
         }
         uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
-        if (leafTrianglesHit(lsLeafPrefix(rank), lsLeafPrefix(rank + 1u), r, tEnter, tExit)) return true;
+        uint first = lsLeafPrefix(rank), end = lsLeafPrefix(rank + 1u);
+        if (end - first > uLeafWalkCap - pass) break; // the cap
+        pass += end - first;
+        if (leafTrianglesHit(first, end, r, tEnter, tExit)) return true;
     }
     gCapped = true;
     return true;
