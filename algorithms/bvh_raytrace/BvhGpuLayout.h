@@ -1,7 +1,7 @@
 #pragma once
 // Host mirror of the bvh_raytrace GPU structures. The constants live once, in
 // shaders/bvh_raytrace/layout.glsl (#defines only, valid C++ and GLSL); the node struct is
-// mirrored from BvhNode in shaders/bvh_raytrace/trace.comp.
+// mirrored from BvhNode in shaders/bvh_raytrace/traverse.glsl.
 #include "shaders/bvh_raytrace/layout.glsl"
 
 #include <cstddef>

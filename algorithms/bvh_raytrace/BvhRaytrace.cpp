@@ -3,6 +3,7 @@
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
 #include "algorithms/bvh_raytrace/BvhBuilder.h"
+#include "algorithms/bvh_raytrace/BvhGpu.h"
 #include "algorithms/bvh_raytrace/BvhGpuLayout.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
@@ -74,8 +75,7 @@ public:
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
-        nodeTexels_ = GlTexture(), triTexels_ = GlTexture(); // free the old tree before building the new one
-        nodes_ = GlBuffer(), triangles_ = GlBuffer();
+        gpu_ = bvh::BvhGpu(); // free the old tree before building the new one
         auto t0 = Clock::now();
         bvh::BuildOptions opt;
         opt.maxLeafSize = p_.leafSize;
@@ -83,23 +83,12 @@ public:
         opt.traversalCost = p_.traversalCost;
         bvh::Bvh tree = bvh::buildBvh(scene.cpu(), opt);
         buildMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-        const size_t limit = maxShaderStorageBlockBytes();
-        bvh::checkStorageBlock("the BVH nodes", tree.nodes.size() * sizeof(bvh::NodeGpu), limit);
-        bvh::checkStorageBlock("the leaf-ordered triangles", tree.triangles.size() * sizeof(glm::vec4), limit);
-        // The shader packs a leaf's first triangle in 27 bits of a stack entry (layout.glsl).
-        if (tree.triIndices.size() >= (size_t(1) << 27))
-            throw RuntimeError("bvh_raytrace: more than 2^27 triangles cannot be addressed by the traversal stack");
         const GLbitfield flags = scene.dynamic() ? GL_DYNAMIC_STORAGE_BIT : 0;  // refitted trees are re-uploaded
-        nodes_ = GlBuffer::fromVector(tree.nodes, flags);
-        triangles_ = GlBuffer::fromVector(tree.triangles, flags);
-        nodeTexels_ = makeBufferTexture(nodes_, GL_RGBA32UI, 16, "bvh_raytrace nodes");
-        triTexels_ = makeBufferTexture(triangles_, GL_RGBA32F, 16, "bvh_raytrace triangles");
+        gpu_ = bvh::uploadBvh(tree, maxShaderStorageBlockBytes(), flags, "bvh_raytrace");
         counters_.allocate();
         nodeCount_ = tree.nodes.size();
         depth_ = tree.depth;
         leaves_ = tree.leaves;
-        // A correct walk takes at most nodes + 2 * leaves + 1 loop passes (trace.comp, trace()).
-        stepCap_ = uint32_t(std::min<uint64_t>(uint64_t(nodeCount_) + 2 * uint64_t(leaves_) + 1, UINT32_MAX));
         sahCost_ = tree.sahCost;
         if (scene.dynamic()) {
             tree_ = std::move(tree);
@@ -117,8 +106,8 @@ public:
         bvh::refitBvh(tree_, posed_);
         f.timer.end();
         f.timer.begin("upload");
-        nodes_.upload(tree_.nodes.data(), tree_.nodes.size() * sizeof(bvh::NodeGpu));
-        triangles_.upload(tree_.triangles.data(), tree_.triangles.size() * sizeof(glm::vec4));
+        gpu_.nodes.upload(tree_.nodes.data(), tree_.nodes.size() * sizeof(bvh::NodeGpu));
+        gpu_.triangles.upload(tree_.triangles.data(), tree_.triangles.size() * sizeof(glm::vec4));
         f.timer.end();
     }
 
@@ -144,9 +133,8 @@ public:
         setLightUniforms(trace_, f.light);
         trace_.set("uRayOffset", rayOffsetLength(p_.rayOffset, *scene_));
         trace_.set("uSampleCount", sampleCount);
-        trace_.set("uBvhStepCap", unsigned(stepCap_));
-        glBindTextureUnit(BVH_NODE_UNIT, nodeTexels_.id());
-        glBindTextureUnit(BVH_TRI_UNIT, triTexels_.id());
+        trace_.set("uBvhStepCap", unsigned(gpu_.stepCap));
+        gpu_.bind(BVH_NODE_UNIT, BVH_TRI_UNIT);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
         bindPixelPassInputs(f);
@@ -175,8 +163,8 @@ public:
                                     {"bvh_depth", double(depth_)},
                                     {"bvh_sah_cost", sahCost_},
                                     {"bvh_build_ms", buildMs_},
-                                    {"node_bytes", double(nodes_.size())},
-                                    {"triangle_bytes", double(triangles_.size())}};
+                                    {"node_bytes", double(gpu_.nodes.size())},
+                                    {"triangle_bytes", double(gpu_.triangles.size())}};
         if (!options_.instrumentation) return out;
         out.insert(out.begin(), {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
                                  {"nodes_visited_max", double(c[BVH_C_VISITED_MAX])},
@@ -197,7 +185,7 @@ public:
     /// Nodes + the leaf-ordered triangles the rays read (a ray tracer needs them and line_space does
     /// not: the paper's Table 1 compares sizes on that basis, "the BVH needs the triangle
     /// information in addition"). Per-pixel debug images and the sample list are not counted.
-    size_t memoryBytes() const override { return nodes_.size() + triangles_.size(); }
+    size_t memoryBytes() const override { return gpu_.bytes(); }
 
     /// Pixels with a ray whose stack overflowed or whose walk reached its step cap, or whose sample
     /// loop the driver cut short (all written shadowed): 0 means the image is exact.
@@ -218,14 +206,13 @@ private:
     AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram trace_;
-    GlBuffer nodes_, triangles_, samples_;
-    GlTexture nodeTexels_, triTexels_; ///< nodes_ and triangles_ as buffer textures: how the trace reads them
+    bvh::BvhGpu gpu_; ///< the tree as the trace reads it
+    GlBuffer samples_;
     bvh::Bvh tree_;                  ///< kept for refits (moving scenes only)
     std::vector<glm::vec3> posed_;   ///< the posed scene positions the last refit used
     GpuCounters<BVH_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
     SampleBatches batches_; ///< the light's samples over dispatches, and their state between them
-    uint32_t stepCap_ = 1;           ///< most loop passes of one ray's walk
     size_t nodeCount_ = 0, leaves_ = 0;
     int depth_ = 0;
     double sahCost_ = 0, buildMs_ = 0;

@@ -2,8 +2,7 @@
 
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
-#include "algorithms/bvh_raytrace/BvhBuilder.h"
-#include "algorithms/bvh_raytrace/BvhGpuLayout.h"
+#include "algorithms/bvh_raytrace/BvhGpu.h"
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "algorithms/line_space/NTree.h"
 #include "algorithms/line_space/SampleClassifier.h"
@@ -150,14 +149,15 @@ public:
         // The occupancy pool is read (and counted) only by the distance and exact start regions; the
         // leaf lists and the scene's triangles only by the exact one.
         const ls::StartMode mode = startMode();
-        const bool occupancy = mode != ls::StartMode::Node || lastLeaves(), exact = mode == ls::StartMode::Exact;
+        const bool occupancy = readsOccupancy(), exact = mode == ls::StartMode::Exact;
         leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer(), triPlanes_ = GlBuffer(), leafSub_ = GlBuffer();
-        bvhNodeTexels_ = GlTexture(), bvhTriTexels_ = GlTexture(), bvhNodes_ = GlBuffer(), bvhTris_ = GlBuffer();
-        size_t nearBytes = 0; // start_region bvh: its nodes and leaf-ordered triangles
-        if (mode == ls::StartMode::Bvh) nearBytes = buildNearField(cpu, limit);
-        const int split = occupancy ? p_.leafSplit : 1;
+        near_ = bvh::BvhGpu();
+        // start_region bvh: bvh_raytrace's tree of the scene with its default build (SAH, leaves of 4).
+        if (mode == ls::StartMode::Bvh) near_ = bvh::uploadBvh(bvh::buildBvh(cpu, bvh::BuildOptions{}), limit, 0, "line_space");
+        const size_t nearBytes = mode == ls::StartMode::Bvh ? near_.bytes() : 0;
+        const int split = leafSplit();
         const bool lists_needed = exact || split > 1;
-        const bool culled = exact && culledTriangles();
+        const bool culled = culledStart();
         std::vector<glm::vec4> planes; // culled: per scene triangle its plane (unit normal, offset)
         if (culled) planes = ls::trianglePlanes(cpu);
         ls::LeafLists lists;
@@ -298,9 +298,8 @@ public:
         p.set("uLeafMargin", 0.0625f * std::max({region.leafCell.x, region.leafCell.y, region.leafCell.z}));
         if (region.mode == ls::StartMode::Exact) scene_->bindStorage(); // the positions' buffer texture
         if (region.mode == ls::StartMode::Bvh) {
-            p.set("uBvhStepCap", unsigned(nearStepCap_));
-            glBindTextureUnit(LS_BVH_NODE_UNIT, bvhNodeTexels_.id());
-            glBindTextureUnit(LS_BVH_TRI_UNIT, bvhTriTexels_.id());
+            p.set("uBvhStepCap", unsigned(near_.stepCap));
+            near_.bind(LS_BVH_NODE_UNIT, LS_BVH_TRI_UNIT);
         }
         for (size_t u = 0; u < kTexelUnits; ++u)
             if (texels_[u]) glBindTextureUnit(GLuint(LS_NODE_UNIT + u), texels_[u].id());
@@ -408,14 +407,19 @@ private:
                 {"LS_BIT_CHUNK_COUNT", std::to_string(bitChunks_)},
                 {"LS_START_MODE", std::to_string(int(startMode()))},
                 {"LS_LAST_LEAVES", lastLeaves() ? "1" : "0"},
-                {"LS_LEAF_SPLIT", std::to_string(startMode() != ls::StartMode::Node || lastLeaves() ? p_.leafSplit : 1)},
-                {"LS_CULL_TRIANGLES", startMode() == ls::StartMode::Exact && culledTriangles() ? "1" : "0"},
+                {"LS_LEAF_SPLIT", std::to_string(leafSplit())},
+                {"LS_CULL_TRIANGLES", culledStart() ? "1" : "0"},
                 simdProbeDefine(options_),
                 instrumentationDefine(options_)};
     }
 
     bool lastLeaves() const { return p_.lastLevel == "leaves"; }
-    bool culledTriangles() const { return p_.startTriangles == "culled"; }
+    /// The occupancy pool is read by every start region but the paper's, and by last_level leaves.
+    bool readsOccupancy() const { return startMode() != ls::StartMode::Node || lastLeaves(); }
+    /// Sub-cells per axis of an occupied leaf where occupancy is read at all (1 elsewhere).
+    int leafSplit() const { return readsOccupancy() ? p_.leafSplit : 1; }
+    /// The exact start region with its triangles culled by their planes.
+    bool culledStart() const { return startMode() == ls::StartMode::Exact && p_.startTriangles == "culled"; }
 
     ls::StartMode startMode() const {
         const std::string& m = p_.startRegion;
@@ -435,23 +439,6 @@ private:
             r.leafCell = glm::vec3(root.size[0], root.size[1], root.size[2]) / leaves;
         }
         return r;
-    }
-
-    /// start_region bvh: bvh_raytrace's tree of the scene (its default build: SAH, leaves of 4), the
-    /// near field's exact test. Returns its bytes on the GPU.
-    size_t buildNearField(const Scene& cpu, size_t limit) {
-        bvh::Bvh tree = bvh::buildBvh(cpu, bvh::BuildOptions{});
-        bvh::checkStorageBlock("the near-field BVH nodes", tree.nodes.size() * sizeof(bvh::NodeGpu), limit);
-        bvh::checkStorageBlock("the near-field BVH triangles", tree.triangles.size() * sizeof(glm::vec4), limit);
-        if (tree.triIndices.size() >= (size_t(1) << 27))
-            throw RuntimeError("line_space: more than 2^27 triangles cannot be addressed by the near field's traversal stack");
-        bvhNodes_ = GlBuffer::fromVector(tree.nodes, 0);
-        bvhTris_ = GlBuffer::fromVector(tree.triangles, 0);
-        bvhNodeTexels_ = makeBufferTexture(bvhNodes_, GL_RGBA32UI, 16, "line_space near-field BVH nodes");
-        bvhTriTexels_ = makeBufferTexture(bvhTris_, GL_RGBA32F, 16, "line_space near-field BVH triangles");
-        // As bvh_raytrace: a correct walk takes at most nodes + 2 * leaves + 1 loop passes.
-        nearStepCap_ = uint32_t(std::min<uint64_t>(uint64_t(tree.nodes.size()) + 2 * uint64_t(tree.leaves) + 1, UINT32_MAX));
-        return bvhNodes_.size() + bvhTris_.size();
     }
 
     /// The trace's buffer-texture views of the pools, one per texture unit from LS_NODE_UNIT on
@@ -517,9 +504,7 @@ private:
     /// A GlBuffer rounds empty ones up to 4 bytes; these are the bytes the shader uses.
     std::array<size_t, 5> poolBytes_{};
     GlBuffer nodesBuf_, treeBuf_, occBuf_, leafBase_, leafPrefix_, leafTris_, triPlanes_, leafSub_, samples_, classifyBuf_;
-    GlBuffer bvhNodes_, bvhTris_;        ///< start_region bvh
-    GlTexture bvhNodeTexels_, bvhTriTexels_;
-    uint32_t nearStepCap_ = 1;
+    bvh::BvhGpu near_; ///< start_region bvh: the near field's tree
     float planeEps_ = 0; ///< culled start region: distances to a triangle's plane within this are too close to call
     GpuCounters<LS_COUNTER_WORDS> counters_;
     std::array<GlBuffer, LS_BIT_CHUNKS> bitsBuf_; ///< the line-space pool, split at node boundaries
@@ -546,13 +531,14 @@ private:
 /// leaf (at most about one per triangle).
 Footprint lineSpaceFootprint(const FootprintQuery& q) {
     Footprint f;
-    const bool exact = std::get<std::string>(q.params->get("start_region")) == "exact";
+    const std::string& region = std::get<std::string>(q.params->get("start_region"));
+    const bool exact = region == "exact";
     const bool culled = exact && std::get<std::string>(q.params->get("start_triangles")) == "culled";
     const bool split = std::get<int>(q.params->get("leaf_split")) > 1;
     f.bytes = (8 + (culled ? 16 : 0) + (split ? 8 : 0)) * q.triangles;
     f.peakBytes = f.bytes + 8 * q.triangles;
     if (exact) f.refusal = storageRefusal(q, "the scene positions its exact start region reads", 36 * q.triangles, true);
-    if (std::get<std::string>(q.params->get("start_region")) == "bvh") {
+    if (region == "bvh") {
         // bvh_raytrace's tree with its default leaves of 4: triangles 48 bytes, nodes ~32 bytes a triangle.
         f.bytes += 80 * q.triangles;
         f.peakBytes += 152 * q.triangles;

@@ -33,7 +33,7 @@ struct BvhNode { // 64 bytes, mirrored by bvh::NodeGpu (algorithms/bvh_raytrace/
     vec3 hi1; uint count1;
 };
 // Nodes and leaf-ordered triangles (3 vec4 each) are read through buffer textures over their
-// buffers (BvhRaytrace binds them to BVH_NODE_UNIT, BVH_TRI_UNIT): a SIMD CPU back end (llvmpipe)
+// buffers (the host binds them to BVH_TRAVERSE_NODE_UNIT, _TRI_UNIT: bvh::BvhGpu::bind): a SIMD CPU back end (llvmpipe)
 // gathers a texel fetch for all its lanes at once but loads storage buffers lane by lane; a GPU
 // reads both through its caches.
 layout(binding = BVH_TRAVERSE_NODE_UNIT) uniform usamplerBuffer uBvhNodeTexels;  // RGBA32UI, 4 texels per node

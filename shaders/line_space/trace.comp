@@ -1,6 +1,7 @@
 #version 450
 // line_space: shadow rays answered from the precomputed line space alone (Keul et al. 2017,
-// Algorithm 1), one invocation per pixel. No triangle is ever read. Per ray (the reference's rays:
+// Algorithm 1), one invocation per pixel. No triangle is read outside the start region (and none at
+// all with LS_START_NODE or LS_START_DISTANCE). Per ray (the reference's rays:
 // origin p + n * offset, towards each light sample, ending `offset` short of it):
 //   * a node the ray crosses is looked up by the shaft between its entry and exit sub-faces:
 //     empty → skipped whole; non-empty on the last subdivided level (d - 1) → the ray is occluded;
@@ -14,11 +15,16 @@
 //         size, see startRegionEnd): geometry before tS ignored, its leaves walked from tS with the
 //         node's occupancy mask (an occupied leaf blocks);
 //       LS_START_EXACT (the same region, no geometry ignored): its occupied leaves' triangles are
-//         tested exactly against the ray (a hybrid: the start region exact, the rest line space).
+//         tested exactly against the ray (a hybrid: the start region exact, the rest line space);
+//         with LS_CULL_TRIANGLES ruled out by their planes first;
+//       LS_START_BVH (the distance region's walk, and the segment before tS traced exactly through
+//         bvh_raytrace's BVH: nothing ignored).
 //   * a non-empty shaft of a last-level node ("deep enough") blocks the ray (Algorithm 1), or with
-//     LS_LAST_LEAVES the leaves the ray crosses in that node decide, by the node's occupancy mask.
+//     LS_LAST_LEAVES the leaves the ray crosses in that node decide, by the node's occupancy mask;
+//     with LS_LEAF_SPLIT > 1 an occupied leaf's sub-cells decide in its place.
 // Compile-time: LS_N (branching factor), LS_DEPTH (d), LS_CLASSIFY (write per-sample results),
-// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE, LS_LAST_LEAVES.
+// LS_BIT_CHUNK_COUNT (storage blocks the line-space pool spans), LS_START_MODE, LS_LAST_LEAVES,
+// LS_LEAF_SPLIT, LS_CULL_TRIANGLES, SHADOWLAB_SIMD_PROBE.
 //
 // One dispatch traces the samples [uSampleFirst, uSampleEnd) of every pixel (at most
 // samples_per_dispatch of them, so that no dispatch runs into a GPU driver's watchdog); a light with
@@ -91,6 +97,9 @@ uint lsOcc(uint word) { return texelFetch(uLsOccTexels, int(word)).x; }
 // occupied leaf's rank, by which its list and its sub-cells are found.
 layout(binding = LS_LEAF_RANK_UNIT) uniform usamplerBuffer uLsLeafRankTexels;
 uint lsLeafRank(uint word) { return texelFetch(uLsLeafRankTexels, int(word)).x; }
+// The rank of occupied leaf `leaf` of a last-level node whose occupancy word `word` holds `bits`:
+// the occupied leaves before its word, plus those below it in the word.
+uint leafRank(uint word, uint bits, uint leaf) { return lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u))); }
 #endif
 #if LS_LEAF_SPLIT > 1
 layout(binding = LS_LEAF_SUB_UNIT) uniform usamplerBuffer uLsLeafSubTexels; // per occupied leaf: its sub-cells' bits
@@ -225,6 +234,15 @@ float startRegionEnd(vec3 nu, vec3 d) {
     return min(uStartCells * dot(abs(nu), uLeafCell) / sinAngle, longest);
 }
 
+// The axis a DDA steps along when it leaves its cell at cellEnd = min(tNext): one axis only, the
+// first of a tie, as a per-axis comparison picks it; by selects (indexing a vector by a variable
+// makes some compilers, llvmpipe's among them, keep the DDA's state in memory). None for a NaN
+// tNext (every comparison false): the cell stays, and the walk's integer cap ends it.
+bvec3 stepAxis(vec3 tNext, float cellEnd) {
+    bvec3 axis = equal(tNext, vec3(cellEnd));
+    return bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+}
+
 uint leafCells = 0u, trianglesTested = 0u, nearNodes = 0u; // read by leafWalk, the near field (counters)
 
 #if LS_START_MODE == LS_START_EXACT
@@ -239,8 +257,7 @@ WatertightRay exactRay = WatertightRay(vec3(0.0), 0.0, 2, false, vec3(0.0)); // 
 // rounding. At most 3S - 2 sub-cells are crossed; a walk that has not left by then (a NaN step)
 // blocks.
 bool subCellsBlock(uint word, uint bits, uint leaf, vec3 leafLo, vec3 cellSize, Ray r, float ta, float tb) {
-    uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
-    uvec2 m = texelFetch(uLsLeafSubTexels, int(rank)).xy;
+    uvec2 m = texelFetch(uLsLeafSubTexels, int(leafRank(word, bits, leaf))).xy;
     const int S = LS_LEAF_SPLIT;
     vec3 sub = cellSize / float(S);
     ivec3 up = ivec3(greaterThanEqual(r.d, vec3(0.0))), stepDir = up * 2 - 1;
@@ -252,8 +269,7 @@ bool subCellsBlock(uint word, uint bits, uint leaf, vec3 leafLo, vec3 cellSize, 
         if ((((b < 32 ? m.x : m.y) >> uint(b & 31)) & 1u) != 0u) return true;
         float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
         if (cellEnd > tb) return false;
-        bvec3 axis = equal(tNext, vec3(cellEnd));
-        axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+        bvec3 axis = stepAxis(tNext, cellEnd);
         c += ivec3(axis) * stepDir;
         if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(S)))) return false;
         tNext = mix(tNext, (leafLo + vec3(c + up) * sub - r.o) * r.invD, axis);
@@ -305,8 +321,7 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
             float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
             if (cellEnd > t1) return false;
             tEnter = cellEnd;
-            bvec3 axis = equal(tNext, vec3(cellEnd));
-            axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+            bvec3 axis = stepAxis(tNext, cellEnd);
             c += ivec3(axis) * stepDir;
             if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(LS_N)))) return false;
             tNext = mix(tNext, (lo + vec3(c + up) * cellSize - r.o) * r.invD, axis);
@@ -322,7 +337,7 @@ bool leafWalk(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t1, flo
                 if (LEAF_BLOCKS(word, bits, leaf, c, lo, cellSize, r, tEnter, min(min(min(tNext.x, tNext.y), tNext.z), t1))) return true;
                 continue;
             }
-            uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
+            uint rank = leafRank(word, bits, leaf);
             next = lsLeafPrefix(rank);
             end = lsLeafPrefix(rank + 1u);
 #else
@@ -397,8 +412,7 @@ bool leafWalkCulled(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t
                 float cellEnd = min(min(tNext.x, tNext.y), tNext.z);
                 if (cellEnd > t1) return false;
                 tEnter = cellEnd;
-                bvec3 axis = equal(tNext, vec3(cellEnd));
-                axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+                bvec3 axis = stepAxis(tNext, cellEnd);
                 c += ivec3(axis) * stepDir;
                 if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(LS_N)))) return false;
                 tNext = mix(tNext, (lo + vec3(c + up) * cellSize - r.o) * r.invD, axis);
@@ -417,7 +431,7 @@ bool leafWalkCulled(uint index, vec3 lo, vec3 cellSize, Ray r, float t0, float t
             if (LEAF_BLOCKS(word, bits, leaf, c, lo, cellSize, r, tEnter, tExit)) return true;
             continue;
         }
-        uint rank = lsLeafRank(word) + uint(bitCount(bits & ((1u << (leaf & 31u)) - 1u)));
+        uint rank = leafRank(word, bits, leaf);
         uint first = lsLeafPrefix(rank), end = lsLeafPrefix(rank + 1u);
         if (end - first > uLeafWalkCap - pass) break; // the cap
         pass += end - first;
@@ -686,9 +700,7 @@ void main() {
                                 // and every update are selects: indexing a vector by a variable makes
                                 // some compilers (llvmpipe's among them) keep the frame in memory.
                                 float cellEnd = min(min(cur.tNext.x, cur.tNext.y), cur.tNext.z);
-                                bvec3 axis = equal(cur.tNext, vec3(cellEnd));
-                                // One axis only: the first of a tie, as the per-axis comparison picked.
-                                axis = bvec3(axis.x, axis.y && !axis.x, axis.z && !axis.x && !axis.y);
+                                bvec3 axis = stepAxis(cur.tNext, cellEnd);
                                 ivec3 m = ivec3(axis);
                                 cur.cell += m * stepDir;
                                 cur.child += m.x * childStep.x + m.y * childStep.y + m.z * childStep.z;
