@@ -79,6 +79,7 @@ void expectSimdProbe(const AlgorithmRun& o, const std::vector<std::pair<std::str
         const double use = o.counters.at("simd_" + section + "_utilisation");
         EXPECT_GT(use, 0.0);
         EXPECT_LE(use, 1.0);
+        // Two 64-bit integer sums divided by the ray count: equal up to the doubles' rounding.
         EXPECT_NEAR(slots * use, o.counters.at(work), 1e-9 * o.counters.at(work));
     }
 }

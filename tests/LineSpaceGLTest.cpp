@@ -428,6 +428,8 @@ TEST_F(LineSpaceGLTest, CulledStartTrianglesGiveTheImageOfTestingAll) {
         std::printf("[line_space] culled start triangles: %.2f watertight tests per ray against %.2f\n",
                     culled.counters["triangles_tested_mean"], all.counters["triangles_tested_mean"]);
         EXPECT_EQ(culled.visibility, all.visibility);
+        // Measured 3–5 % of the watertight tests (0.08 against 1.60, 0.07 against 2.07); half is the
+        // bound that still says the plane test removes most of them.
         EXPECT_LT(culled.counters["triangles_tested_mean"], 0.5 * all.counters["triangles_tested_mean"]);
         EXPECT_EQ(culled.overflow, 0u);
     }
@@ -464,6 +466,8 @@ TEST_F(LineSpaceGLTest, SplitLeavesShrinkTheLeafOfGrowth) {
         AlgorithmRun split = run(make(), {{"n", 7}, {"d", 3}, {"leaf_split", 4}});
         print("leaf_split 1", whole);
         print("leaf_split 4", split);
+        // Measured: RMSE 0.31 and 0.38 of the whole leaves', over-occluded samples 0.25 and 0.26; a
+        // quarter leaf of growth predicts ~0.25, 0.7 leaves room for the margin and the rounding.
         EXPECT_LT(split.accuracy.rmse, 0.7 * whole.accuracy.rmse);
         EXPECT_LT(split.counters["over_occluded_share"], 0.7 * whole.counters["over_occluded_share"]);
         EXPECT_EQ(split.counters["under_occluded_share"], 0.0);
