@@ -25,6 +25,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.colors import LinearSegmentedColormap, Normalize  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import plot_style  # noqa: E402
+
+plot_style.plain_text()  # ids, heat map names and units are drawn as written: no mathtext
+
 # The colours of framework/metrics/Images.cpp's differenceImage(); grey's brightness is the
 # reference's visibility (0.25 + 0.5 v).
 DIFF_LEGEND = [("false lit", (1.0, 0.1, 0.1)), ("false shadowed", (0.1, 0.3, 1.0)),

@@ -26,6 +26,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import frame_figures  # noqa: E402
 import plot_style  # noqa: E402
 import report_html  # noqa: E402
+from report_html import link_target, literal  # noqa: E402
 
 PLOTS = [("plot_frame_time.png", "Frame time along the fly-through"), ("plot_stages.png", "Mean time per frame of each stage"),
          ("plot_accuracy.png", "Accuracy against the reference along the fly-through")]
@@ -122,16 +123,17 @@ def figures_section(directory, sheets, heats):
     lines = [FIGURES_HEADING, ""]
     for name, title in PLOTS:
         if os.path.exists(os.path.join(directory, name)):
-            lines += [f"![{title}]({name})", ""]
+            lines += [f"![{title}]({link_target(name)})", ""]
     for frame, sheet in sheets.items():
         lines += [f"### Frame {frame}", "",
                   "The reference's shaded image, then per algorithm: shaded image, difference against the reference "
                   "(red = false lit, blue = false shadowed, grey = agrees, black = not lit) and heat maps, each with "
                   "its colour bar, unit and scale (p99: the 99th percentile of the non-zero pixels; brighter pixels are "
                   "clipped to the top colour).", "",
-                  f"![Frame {frame}: every algorithm's images]({sheet})", ""]
+                  f"![Frame {frame}: every algorithm's images]({link_target(sheet)})", ""]
         if heats.get(frame):
-            links = ", ".join(f"[{aid} {name}]({path})" for aid, name, path in heats[frame])
+            # Ids and heat map names are user text: literal in the link text, %-encoded in the path.
+            links = ", ".join(f"[{literal(aid)} {literal(name)}]({link_target(path)})" for aid, name, path in heats[frame])
             lines += [f"Heat maps one by one: {links}.", ""]
     return lines
 

@@ -2,9 +2,21 @@
 keeps one colour everywhere, and each second grouping (the other axes of a sweep) one line style
 and marker. Stacked stage bars colour by stage instead (stage_styles): one colour and hatch per
 stage name, the same in every algorithm's bar, and no two stages alike.
+
+Text drawn from user text (ids, names, labels, stages, units) is drawn as written: importing this
+module turns off matplotlib's math parser (plain_text()), so that a '$' in a name neither renders
+as math nor fails the plot ("Expected \\frac{num}{den}").
 """
 import matplotlib
 import matplotlib.colors as mcolors
+
+
+def plain_text():
+    """Every text made from now on is plain text: '$...$' is not mathtext (matplotlib >= 3.5)."""
+    matplotlib.rcParams["text.parse_math"] = False
+
+
+plain_text()
 
 # Matplotlib's tab10 (colour-blind friendly, distinct in grey) then tab20's lighter set.
 COLOURS = list(mcolors.TABLEAU_COLORS.values()) + ["#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5", "#c49c94"]

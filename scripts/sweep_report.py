@@ -16,8 +16,12 @@ import csv
 import json
 import math
 import os
+import re
 import sys
 from collections import defaultdict
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from report_html import link_target, literal  # noqa: E402
 
 SIZE_SCALES = ("value", "triangles", "pixels")
 
@@ -96,23 +100,47 @@ def fmt(v, spec):
     return "" if v is None else format(v, spec)
 
 
+# Every name, id, label, stage, counter, ratio and source below comes from the sweep file or the
+# runs: it reaches sweep.md only through literal() (or code()), so that it shows as written and
+# never as a link, an image, markup or a table cell's end.
+
+def code(name):
+    """An axis name as `code` (as the C++ side checks them: letters, digits and '_'); any other
+    name as literal text, since a code span shows backslashes as they are."""
+    name = str(name)
+    return f"`{name}`" if re.fullmatch(r"[A-Za-z0-9_]+", name) else literal(name)
+
+
+def plot_file(s, axis):
+    """The file of an axis's plot: sweep_AXIS.png, AXIS being an identifier as the C++ side checks
+    them; any other name (a plan.json not written by `sweep merge`) never becomes part of a path."""
+    name = str(axis["name"])
+    return f"sweep_{name}.png" if re.fullmatch(r"[A-Za-z0-9_]+", name) else f"sweep_axis{s.axes.index(axis)}.png"
+
+
+def row_line(values):
+    """One table row of already escaped cells."""
+    return "| " + " | ".join(values) + " |"
+
+
 def axis_table(s, axis):
     others = s.others(axis)
-    head = [a["name"] for a in others] + ["id", axis["name"], "triangles"] + s.stages + s.counters + \
-        ["memory (MiB)", "mismatch (worst frame)", "overflow"]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(others) + "---|---|" + "---:|" * (len(head) - len(others) - 2)]
+    head = [literal(a["name"]) for a in others] + ["id", literal(axis["name"]), "triangles"] + \
+        [literal(st) for st in s.stages] + [literal(c) for c in s.counters] + ["memory (MiB)", "mismatch (worst frame)", "overflow"]
+    lines = [row_line(head), "|" + "---|" * len(others) + "---|---|" + "---:|" * (len(head) - len(others) - 2)]
     for aid in s.algorithms:
         for run in s.ordered_runs(axis):
             v = run["values"].get(aid)
             if v is None:
                 continue
             mm = v.get("accuracy.mismatch_ratio_max")
-            cells = [run["axes"][a["name"]] for a in others] + [aid, run["axes"][axis["name"]], f"{run['triangles']:,}"]
+            cells = [literal(run["axes"][a["name"]]) for a in others] + \
+                [literal(aid), literal(run["axes"][axis["name"]]), f"{run['triangles']:,}"]
             cells += [fmt(v.get(f"time_ms.{st}"), ".2f") for st in s.stages]
             cells += [fmt(v.get(f"counters.{c}"), ".2f") for c in s.counters]
             cells += [fmt(v["memory_bytes"] / 2 ** 20, ".1f"), "" if mm is None else f"{100 * mm:.4f} %",
                       fmt(v.get("overflow"), ".0f")]
-            lines.append("| " + " | ".join(cells) + " |")
+            lines.append(row_line(cells))
     return lines
 
 
@@ -122,28 +150,29 @@ def ratio_table(s, ratio):
     paper = s.merge.get("paper", {})
     times = paper.get("times_ms", {})
     paper_ratio = times[num] / times[den] if num in times and den in times else None
-    head = [a["name"] for a in s.axes] + ["triangles", f"{num} / {den}"]
+    head = [literal(a["name"]) for a in s.axes] + ["triangles", f"{literal(num)} / {literal(den)}"]
     if paper_ratio is not None:
         head += ["paper", "ours / paper"]
-    lines = [f"## {num} / {den}: total time per frame, same run", ""]
+    lines = [f"## {literal(num)} / {literal(den)}: total time per frame, same run", ""]
     if paper_ratio is not None:
-        lines += [f"Paper: {paper['source']}: {num} {times[num]:g} ms, {den} {times[den]:g} ms, ratio {paper_ratio:.2f}.", ""]
-    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(s.axes) + "---:|" * (len(head) - len(s.axes))]
+        lines += [f"Paper: {literal(paper.get('source', ''))}: {literal(num)} {times[num]:g} ms, "
+                  f"{literal(den)} {times[den]:g} ms, ratio {paper_ratio:.2f}.", ""]
+    lines += [row_line(head), "|" + "---|" * len(s.axes) + "---:|" * (len(head) - len(s.axes))]
     for run in sorted(s.runs.values(), key=lambda r: r["index"]):
         a, b = run["values"].get(num, {}).get("time_ms.total"), run["values"].get(den, {}).get("time_ms.total")
         if a is not None and b:
-            row = [run["axes"][x["name"]] for x in s.axes] + [f"{run['triangles']:,}", f"{a / b:.2f}"]
+            row = [literal(run["axes"][x["name"]]) for x in s.axes] + [f"{run['triangles']:,}", f"{a / b:.2f}"]
             if paper_ratio is not None:
                 row += [f"{paper_ratio:.2f}", f"{a / b / paper_ratio:.2f}"]
-            lines.append("| " + " | ".join(row) + " |")
+            lines.append(row_line(row))
     return lines
 
 
 def fit_table(s, axis):
     others = s.others(axis)
-    xname = {"triangles": "n = triangles", "pixels": "n = pixels", "value": f"n = {axis['name']}"}[axis["scale"]]
-    lines = [f"## Power-law fits along `{axis['name']}`: time = c · n^k ({xname}; least squares in log-log)", "",
-             "| " + " | ".join([a["name"] for a in others] + ["id", "stage", "k", "t / (n log n), normalised to the smallest n"]) + " |",
+    xname = {"triangles": "n = triangles", "pixels": "n = pixels", "value": f"n = {literal(axis['name'])}"}[axis["scale"]]
+    lines = [f"## Power-law fits along {code(axis['name'])}: time = c · n^k ({xname}; least squares in log-log)", "",
+             row_line([literal(a["name"]) for a in others] + ["id", "stage", "k", "t / (n log n), normalised to the smallest n"]),
              "|" + "---|" * len(others) + "---|---|---:|---|"]
     groups = defaultdict(list)
     for run in s.ordered_runs(axis):
@@ -156,7 +185,7 @@ def fit_table(s, axis):
                 fit = power_fit([p[0] for p in pts], [p[1] for p in pts])
                 if fit:
                     ratios = ", ".join(f"{x:.2f}" for x in nlogn_ratio([p[0] for p in pts], [p[1] for p in pts]))
-                    lines.append("| " + " | ".join(list(key) + [aid, st, f"{fit[0]:.2f}", ratios]) + " |")
+                    lines.append(row_line([literal(k) for k in key] + [literal(aid), literal(st), f"{fit[0]:.2f}", ratios]))
     return lines
 
 
@@ -166,18 +195,19 @@ def report(s, directory):
     renderers = sorted({r.get("renderer", "") for r in complete})
     sources = sorted({r.get("stage_time_source", "") for r in complete})
     src = "; ".join("wall clock per stage" if x == "wall" else "GPU timer queries" for x in sources)
-    lines = [f"# Sweep {s.plan['name']}", "",
+    lines = [f"# Sweep {literal(s.plan['name'])}", "",
              f"- runs: {len(statuses)}, merged {statuses.count('complete')}, failed {statuses.count('failed')}, "
              f"missing {statuses.count('missing')}",
-             f"- renderer: {', '.join(renderers)}",
+             f"- renderer: {', '.join(literal(r) for r in renderers)}",
              f"- stage times: {src}, mean ms per frame",
-             "- axes: " + ("; ".join(f"`{a['name']}` ({a['scale']}): {', '.join(a['labels'])}" for a in s.axes) or "none"), ""]
+             "- axes: " + ("; ".join(f"{code(a['name'])} ({literal(a['scale'])}): {', '.join(literal(x) for x in a['labels'])}"
+                                     for a in s.axes) or "none"), ""]
     for r in s.plan["runs"]:
         if r.get("status") != "complete":
-            labels = " ".join(f"{k}={v}" for k, v in r["axes"].items())
-            lines.append(f"- **run {r['index']} {r['id']} ({labels}): {r.get('status', 'missing')}**")
+            labels = " ".join(f"{literal(k)}={literal(v)}" for k, v in r["axes"].items())
+            lines.append(f"- **run {literal(r['index'])} {literal(r['id'])} ({labels}): {literal(r.get('status', 'missing'))}**")
     for axis in s.axes:
-        lines += ["", f"## By `{axis['name']}`", ""] + axis_table(s, axis)
+        lines += ["", f"## By {code(axis['name'])}", ""] + axis_table(s, axis)
     if not s.axes:
         lines += ["", "## Results", ""] + axis_table_flat(s)
     for ratio in s.merge.get("ratios", []):
@@ -191,13 +221,13 @@ def report(s, directory):
 
 def axis_table_flat(s):
     """A sweep without axes is one run: its table has no axis column."""
-    head = ["id", "triangles"] + s.stages + ["memory (MiB)", "mismatch (worst frame)"]
-    lines = ["| " + " | ".join(head) + " |", "|---|" + "---:|" * (len(head) - 1)]
+    head = ["id", "triangles"] + [literal(st) for st in s.stages] + ["memory (MiB)", "mismatch (worst frame)"]
+    lines = [row_line(head), "|---|" + "---:|" * (len(head) - 1)]
     for run in s.runs.values():
         for aid, v in run["values"].items():
             mm = v.get("accuracy.mismatch_ratio_max")
-            lines.append("| " + " | ".join([aid, f"{run['triangles']:,}"] + [fmt(v.get(f"time_ms.{st}"), ".2f") for st in s.stages] +
-                                           [fmt(v["memory_bytes"] / 2 ** 20, ".1f"), "" if mm is None else f"{100 * mm:.4f} %"]) + " |")
+            lines.append(row_line([literal(aid), f"{run['triangles']:,}"] + [fmt(v.get(f"time_ms.{st}"), ".2f") for st in s.stages] +
+                                  [fmt(v["memory_bytes"] / 2 ** 20, ".1f"), "" if mm is None else f"{100 * mm:.4f} %"]))
     return lines
 
 
@@ -251,7 +281,7 @@ def plots(s, directory):
             ax.legend(fontsize=7)
         fig.suptitle(f"{s.plan['name']}: time per frame against {axis['name']}")
         fig.tight_layout()
-        fig.savefig(os.path.join(directory, f"sweep_{axis['name']}.png"), dpi=110)
+        fig.savefig(os.path.join(directory, plot_file(s, axis)), dpi=110)
         plt.close(fig)
 
 
@@ -299,7 +329,7 @@ def stage_plot(s, directory):
 
 def figures(s, directory):
     """Appends a "## Figures" section to sweep.md showing every plot drawn (replacing an earlier one)."""
-    names = [(f"sweep_{a['name']}.png", f"Time per frame of each stage against {a['name']}") for a in s.axes]
+    names = [(plot_file(s, a), f"Time per frame of each stage against {a['name']}") for a in s.axes]
     names.append(("sweep_stages.png", "The stages of each run, per algorithm id"))
     shown = [(n, title) for n, title in names if os.path.exists(os.path.join(directory, n))]
     path = os.path.join(directory, "sweep.md")
@@ -310,7 +340,7 @@ def figures(s, directory):
         text = text[:cut + 1]
     if shown:
         text = text.rstrip("\n") + "\n\n## Figures\n\n" + "\n\n".join(
-            f"![{title}]({n})" for n, title in shown) + "\n"
+            f"![{literal(title)}]({link_target(n)})" for n, title in shown) + "\n"
         with open(path, "w", encoding="utf-8") as f:
             f.write(text)
 
@@ -324,8 +354,9 @@ def html_report(directory):
 def plain_text():
     """Names, ids and labels are drawn as written: a '$' in a label must not start matplotlib's
     math parser, whose errors ("Expected \\frac{num}{den}") would fail the whole report."""
-    import matplotlib
-    matplotlib.rcParams["text.parse_math"] = False
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plot_style
+    plot_style.plain_text()
 
 
 def main():

@@ -73,7 +73,13 @@ const ParamStruct<PsvParams>& psvParams() {
         .boolean("transparency", &P::transparency, false,
                  "x-ray shadows (paper 4.3): multiply (1 - opacity) of every frustum containing the point",
                  ParamChange::Recompile)
-        .apply(rayOffsetRow(&P::rayOffset));
+        .apply(rayOffsetRow(&P::rayOffset))
+        .rule("traversal", [](const P& p) {
+            return p.transparency && (p.traversal == "stackless" || p.traversal == "hybrid")
+                       ? "traversal = " + p.traversal + " cannot take transparency (a capping plane's negative child would be "
+                         "a second pending side of one node): use traversal = stack or auto"
+                       : std::string();
+        });
     return s;
 }
 

@@ -107,7 +107,11 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  "record every job's traversal iterations and report the mean of the 1024 largest (Figure 7)",
                  ParamChange::Recompile)
         .boolean("heat_map", &P::heatMap, false,
-                 "count test-and-set operations per pixel (debug view, costs one atomic per test)", ParamChange::Recompile);
+                 "count test-and-set operations per pixel (debug view, costs one atomic per test)", ParamChange::Recompile)
+        .rule("lanes", [](const P& p) {
+            const bool supported = p.lanes == 0 || p.lanes == 4 || p.lanes == 8 || p.lanes == 16 || p.lanes == 32 || p.lanes == 64;
+            return supported ? std::string() : "lanes must be 0 (auto), 4, 8, 16, 32 or 64, not " + std::to_string(p.lanes);
+        });
     return s;
 }
 

@@ -11,7 +11,11 @@
 #include "framework/sweep/SweepCli.h"
 #include "framework/sweep/SweepText.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
@@ -129,6 +133,9 @@ int run(const std::vector<std::string>& args) {
         if (isHelp(a)) return commandUsage(kRunUsage);
         if (a == "--out") {
             if (++i >= args.size()) usageError("--out needs a directory");
+            if (args[i].empty()) usageError("--out must not be empty (leave it out for the config's output.dir)");
+            // The folder's name reaches summary.json and the report, which hold UTF-8 text only.
+            if (const std::string why = textProblem(args[i], 0); !why.empty()) usageError("--out: the folder's name " + why);
             opt.outputDir = args[i];
         } else if (a == "--force") {
             opt.force = true;
@@ -251,8 +258,41 @@ int info(const std::vector<std::string>& args) {
 
 } // namespace
 
+/// A standard stream the caller closed is opened again, so that no file this process opens
+/// takes its number (a results file receiving the summary table): standard input and error on
+/// /dev/null, standard output on /dev/full, where every write fails and checkStandardOutput()
+/// reports it.
+static void reopenClosedStandardStreams() {
+    for (int fd : {0, 1, 2})
+        if (fcntl(fd, F_GETFD) < 0 && errno == EBADF) {
+            const int opened = open(fd == 1 ? "/dev/full" : "/dev/null", fd == 0 ? O_RDONLY : O_WRONLY);
+            if (opened >= 0 && opened != fd) {
+                dup2(opened, fd);
+                close(opened);
+            }
+        }
+}
+
+/// Whatever a command printed reached standard output: a full disk or a closed stream is an
+/// output place that cannot take the result, reported like any other (exit 2), never exit 0 with
+/// nothing written.
+static int checkStandardOutput(int rc) {
+    std::cout.flush();
+    errno = 0;
+    if (std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good()) return rc;
+    std::fprintf(stderr, "shadowlab: error: standard output: cannot write what the command printed (%s)\n",
+                 errno ? std::strerror(errno) : "write error");
+    return rc == 0 ? 2 : rc;
+}
+
+static int dispatch(std::vector<std::string> args);
+
 int main(int argc, char** argv) {
-    std::vector<std::string> args(argv + 1, argv + argc);
+    reopenClosedStandardStreams();
+    return checkStandardOutput(dispatch(std::vector<std::string>(argv + 1, argv + argc)));
+}
+
+static int dispatch(std::vector<std::string> args) {
     try {
         if (args.empty() || isHelp(args[0]) || args[0] == "help") {
             std::fputs(fullUsage().c_str(), args.empty() ? stderr : stdout);

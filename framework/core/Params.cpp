@@ -65,6 +65,11 @@ ParamSchema& ParamSchema::choice(std::string key, std::string def, std::vector<s
     return *this;
 }
 
+ParamSchema& ParamSchema::rule(std::string key, std::function<std::string(const ParamValues&)> problem) {
+    rules_.push_back({std::move(key), std::move(problem)});
+    return *this;
+}
+
 const ParamSpec* ParamSchema::find(const std::string& key) const {
     for (const auto& s : specs_)
         if (s.key == key) return &s;
@@ -116,8 +121,25 @@ ParamValues ParamValues::parse(const ParamSchema& schema, JsonNode node) {
         case ParamType::Enum: out.values_[s.key] = node.getEnum(s.key, std::get<std::string>(s.def), s.choices); break;
         }
     }
+    std::string why;
+    if (const ParamRule* r = out.brokenRule(&why)) node.fail(r->key, why);
     node.finish();
     return out;
+}
+
+const ParamRule* ParamValues::brokenRule(std::string* why) const {
+    if (!schema_) return nullptr;
+    for (const ParamRule& r : schema_->rules())
+        if (std::string p = r.problem(*this); !p.empty()) {
+            if (why) *why = std::move(p);
+            return &r;
+        }
+    return nullptr;
+}
+
+void ParamValues::checkRules(const std::string& file, const std::string& pathPrefix) const {
+    std::string why;
+    if (const ParamRule* r = brokenRule(&why)) throw InputError(file, pathPrefix + "/" + r->key, why);
 }
 
 const ParamSpec& ParamValues::spec(const std::string& key) const {

@@ -36,6 +36,16 @@ struct ParamSpec {
     std::function<void(void* params, const ParamValue& value)> assign;
 };
 
+class ParamValues;
+
+/// A rule between parameters that no single range or choice list can state (psv: the stackless
+/// walk cannot take transparency). Checked wherever values are validated (configs, --set, the
+/// GUI), so what validation accepts, an algorithm can run.
+struct ParamRule {
+    std::string key;  ///< the parameter an error points at (its JSON path)
+    std::function<std::string(const ParamValues&)> problem; ///< "" when the values obey the rule, else why not
+};
+
 class ParamSchema {
 public:
     ParamSchema& boolean(std::string key, bool def, std::string doc, ParamChange change);
@@ -45,7 +55,11 @@ public:
     ParamSchema& choice(std::string key, std::string def, std::vector<std::string> choices, std::string doc,
                         ParamChange change);
 
+    /// Adds a rule over several parameters; `key` names the one an error points at.
+    ParamSchema& rule(std::string key, std::function<std::string(const ParamValues&)> problem);
+
     const std::vector<ParamSpec>& specs() const { return specs_; }
+    const std::vector<ParamRule>& rules() const { return rules_; }
     /// Sets how the last row declared is stored into a typed struct (used by ParamStruct).
     void bindLast(std::function<void(void*, const ParamValue&)> assign) { specs_.back().assign = std::move(assign); }
     const ParamSpec* find(const std::string& key) const;
@@ -57,6 +71,7 @@ public:
 
 private:
     std::vector<ParamSpec> specs_;
+    std::vector<ParamRule> rules_;
 };
 
 /// Values for every key of a schema (defaults filled in).
@@ -74,6 +89,11 @@ public:
     /// The same from a JSON value, validated exactly as in a config file (type, range, choices).
     void setJson(const std::string& key, const Json& value);
     const ParamValue& get(const std::string& key) const;
+
+    /// The first rule of the schema these values break, or nullptr (with `why` its reason).
+    const ParamRule* brokenRule(std::string* why) const;
+    /// Throws InputError(file, `pathPrefix` + "/" + key, why) for the first broken rule.
+    void checkRules(const std::string& file, const std::string& pathPrefix) const;
 
     Json toJson() const;
     const ParamSchema* schema() const { return schema_; }
@@ -123,6 +143,15 @@ public:
                         std::string doc, ParamChange change) {
         schema_.choice(std::move(key), std::move(def), std::move(choices), std::move(doc), change);
         return bind([member](T& t, const ParamValue& v) { t.*member = std::get<std::string>(v); });
+    }
+    /// A rule over the typed values (see ParamRule); `key` names the parameter an error points at.
+    ParamStruct& rule(std::string key, std::function<std::string(const T&)> problem) {
+        schema_.rule(std::move(key), [problem](const ParamValues& values) {
+            T t{};
+            for (const ParamSpec& s : values.schema()->specs()) s.assign(&t, values.get(s.key));
+            return problem(t);
+        });
+        return *this;
     }
     /// Adds rows declared elsewhere once (shared rows such as ray_offset), `row(*this)`.
     template <class Row> ParamStruct& apply(Row row) {

@@ -1,5 +1,6 @@
 #include "framework/experiment/Config.h"
 
+#include "framework/core/Text.h"
 #include "framework/scene/SceneConfig.h"
 
 #include <algorithm>
@@ -11,6 +12,11 @@
 namespace shadowlab {
 
 namespace {
+
+/// Whether `name` can be one component of a path: the default output folder is results/NAME.
+bool isFileName(const std::string& name) {
+    return name != "." && name != ".." && name.find_first_of("/\\") == std::string::npos;
+}
 
 const std::vector<std::string> kLightTypes = {"point", "spot", "directional", "area"};
 
@@ -213,6 +219,9 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     c.resolved = Json::object();
     JsonNode root(file, &json, "", &c.resolved);
     c.name = root.getString("name", "experiment");
+    // The name titles the report and every progress line: plain text of one line (Text.h's rule).
+    if (const std::string why = userTextProblem(c.name); !why.empty()) root.fail("name", "the name \"" + shortText(c.name, 60) + "\" " + why);
+    if (c.name.empty()) root.fail("name", "must not be empty (it titles the report)");
     c.resolution = root.getIVec2("resolution", {256, 256}, 8, 8192);
     c.frames = root.getInt("frames", 30, 1, 1000000);
     c.warmupFrames = root.getInt("warmup_frames", 3, 0, 1000);
@@ -266,7 +275,11 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     JsonNode out = root.child("output");
     if (out.has("dir") && out.raw()["dir"].is_string() && out.raw()["dir"].get<std::string>().empty())
         out.fail("dir", "must not be empty (it names the output directory)");
+    if (!out.has("dir") && !isFileName(c.name))
+        root.fail("name", "\"" + shortText(c.name, 60) + "\" cannot name the default output folder results/NAME (it holds '/' or "
+                          "'\\', or is '.' or '..'): give output.dir");
     c.outputDir = out.getPath("dir", "results/" + c.name);
+    if (const std::string why = textProblem(c.outputDir, 0); !why.empty()) out.fail("dir", "the folder's name " + why);
     c.imagesAtFrames = out.getIntList("images_at_frames", {0});
     for (int f : c.imagesAtFrames)
         if (f < 0 || f >= c.frames)

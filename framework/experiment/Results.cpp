@@ -1,5 +1,7 @@
 #include "framework/experiment/Results.h"
 
+#include "framework/core/Text.h"
+
 #include "framework/core/Error.h"
 
 #include <algorithm>
@@ -231,7 +233,7 @@ void writeMemorySection(std::ostream& os, const Json& s) {
            << " GiB available.\n\n";
     os << "| part | MiB | bytes per triangle | estimate (MiB) |\n|---|---:|---:|---:|\n";
     for (const auto& [name, v] : m["parts"].items()) {
-        os << "| " << name << " | " << double(v["bytes"].get<size_t>()) / mib << " | " << std::setprecision(1)
+        os << "| " << markdownLiteral(name) << " | " << double(v["bytes"].get<size_t>()) / mib << " | " << std::setprecision(1)
            << v["bytes_per_triangle"].get<double>() << std::setprecision(2) << " | ";
         if (!plan.is_null() && plan["held_bytes"].contains(name)) os << double(plan["held_bytes"][name].get<size_t>()) / mib;
         os << " |\n";
@@ -243,14 +245,17 @@ void writeMemorySection(std::ostream& os, const Json& s) {
 void ExperimentResults::writeReport(const std::string& path, const Json& s) const {
     std::ostringstream os;
     os << std::fixed;
-    os << "# " << s.value("name", std::string("experiment")) << "\n\n";
-    os << "- renderer: " << s.value("renderer", std::string()) << " (" << s.value("backend", std::string()) << ")\n";
-    if (s.contains("device")) os << "- device: " << deviceLine(s["device"]) << "\n";
+    // Text from the config or the driver is written as literal text (markdownLiteral): a name can
+    // never become a link, an image, a table cell or markup in report.md or report.html.
+    os << "# " << markdownLiteral(s.value("name", std::string("experiment"))) << "\n\n";
+    os << "- renderer: " << markdownLiteral(s.value("renderer", std::string())) << " (" << markdownLiteral(s.value("backend", std::string()))
+       << ")\n";
+    if (s.contains("device")) os << "- device: " << markdownLiteral(deviceLine(s["device"])) << "\n";
     os << "- resolution: " << s["resolution"][0] << "×" << s["resolution"][1] << ", frames: " << s["frames"]
        << ", triangles: " << s["triangles"] << "\n";
     os << "- wall time: " << std::setprecision(1) << s.value("wall_time_s", 0.0) << " s\n";
     if (s.contains("warnings"))
-        for (const auto& w : s["warnings"]) os << "- **warning**: " << w.get<std::string>() << "\n";
+        for (const auto& w : s["warnings"]) os << "- **warning**: " << markdownLiteral(w.get<std::string>()) << "\n";
     os << "\n";
 
     if (std::any_of(algorithms.begin(), algorithms.end(), [](const AlgorithmResults& a) { return !a.resolvedParams.empty(); })) {
@@ -259,9 +264,9 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
               "| id | algorithm | resolved |\n|---|---|---|\n";
         for (const auto& a : algorithms) {
             if (a.resolvedParams.empty()) continue;
-            os << "| " << a.id << " | " << a.algorithm << " | ";
+            os << "| " << markdownLiteral(a.id) << " | " << a.algorithm << " | ";
             for (size_t i = 0; i < a.resolvedParams.size(); ++i)
-                os << (i ? ", " : "") << a.resolvedParams[i].first << " = " << a.resolvedParams[i].second;
+                os << (i ? ", " : "") << markdownLiteral(a.resolvedParams[i].first + " = " + a.resolvedParams[i].second);
             os << " |\n";
         }
         os << "\n";
@@ -276,12 +281,12 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
     os << "| id | algorithm | stage | mean | min | max | median |\n|---|---|---|---:|---:|---:|---:|\n";
     for (const auto& a : algorithms) {
         const Json& j = s["algorithms"][a.id];
-        os << "| " << a.id << " | " << a.algorithm << " | preprocess | " << std::setprecision(2) << j["preprocess_ms"].get<double>()
+        os << "| " << markdownLiteral(a.id) << " | " << a.algorithm << " | preprocess | " << std::setprecision(2) << j["preprocess_ms"].get<double>()
            << " | | | |\n";
         // Stages in the order the algorithm ran them (JSON objects sort their keys).
         for (const auto& stage : stageOrder(a.frames)) {
             const Json& st = j["time_ms"][stage];
-            os << "| " << a.id << " | " << a.algorithm << " | " << (stage == "total" ? "**total**" : stage) << " | "
+            os << "| " << markdownLiteral(a.id) << " | " << a.algorithm << " | " << (stage == "total" ? "**total**" : markdownLiteral(stage)) << " | "
                << std::setprecision(3) << st["mean"].get<double>() << " | " << st["min"].get<double>() << " | "
                << st["max"].get<double>() << " | " << st["median"].get<double>() << " |\n";
         }
@@ -291,7 +296,7 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
     for (const auto& a : algorithms) {
         const Json& acc = s["algorithms"][a.id]["accuracy"];
         if (acc.is_null()) continue;
-        os << "| " << a.id << " | " << std::setprecision(4) << 100.0 * acc["mismatch_ratio"].get<double>() << " % | "
+        os << "| " << markdownLiteral(a.id) << " | " << std::setprecision(4) << 100.0 * acc["mismatch_ratio"].get<double>() << " % | "
            << 100.0 * acc["mismatch_ratio_max"].get<double>() << " % | " << 100.0 * acc["false_lit"].get<double>() << " % | "
            << 100.0 * acc["false_shadowed"].get<double>() << " % | " << std::setprecision(5) << acc["rmse"].get<double>() << " |\n";
     }
@@ -308,13 +313,13 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
           "|---|---:|---:|---:|---:|---|\n";
     for (const auto& a : algorithms) {
         const Json& j = s["algorithms"][a.id];
-        os << "| " << a.id << " | " << std::setprecision(2) << double(j["memory_bytes"].get<size_t>()) / (1024.0 * 1024.0)
+        os << "| " << markdownLiteral(a.id) << " | " << std::setprecision(2) << double(j["memory_bytes"].get<size_t>()) / (1024.0 * 1024.0)
            << " | " << j["overflow"] << " | " << std::setprecision(3) << j["time_ms"]["total"]["mean"].get<double>() << " | ";
         if (j.contains("statistics_pass")) os << j["statistics_pass"]["time_ms"]["total"]["mean"].get<double>();
         os << " | ";
         bool first = true;
         for (const auto& [k, v] : j["counters"].items()) {
-            os << (first ? "" : "; ") << k << " " << std::setprecision(3) << v["mean"].get<double>() << " / " << v["max"].get<double>();
+            os << (first ? "" : "; ") << markdownLiteral(k) << " " << std::setprecision(3) << v["mean"].get<double>() << " / " << v["max"].get<double>();
             first = false;
         }
         os << " |\n";

@@ -47,6 +47,9 @@ AutomationPlan planAutomation(const GuiOptions& opts, const ExperimentConfig& co
         }
         plan.sets.push_back({key, trial.get(key)});
     }
+    // Rules between parameters, once every --set is in (their order does not matter).
+    std::string why;
+    if (const ParamRule* r = trial.brokenRule(&why)) throw InputError("--set", r->key, why);
     if (opts.startFrame >= config.frames)
         throw InputError("--frame", "", "frame " + std::to_string(opts.startFrame) + " is outside [0, " +
                                             std::to_string(config.frames - 1) + "]");

@@ -130,6 +130,7 @@ void applyParamChanges(Viewer& viewer, const std::vector<std::pair<std::string, 
     AlgorithmChoice& choice = viewer.choices_[size_t(viewer.active_)];
     ParamValues next = choice.params;
     for (const auto& [key, value] : changes) next.set(key, value);  // throws on a bad value; nothing changed yet
+    next.checkRules("", "");  // a combination no config could hold is refused too, before anything changes
     choice.params = next;
     viewer.host_->setParams(choice.params);
 }

@@ -152,7 +152,7 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
                 node.fail("labels", "expected non-empty strings, got " + shortText(l.dump(), 80));
             // A label is a cell of the plan's TSV, of sweep.csv and of the report's tables, and part
             // of every progress line: one short line of text.
-            if (const std::string why = textProblem(l.get<std::string>(), kMaxLabelChars); !why.empty())
+            if (const std::string why = userTextProblem(l.get<std::string>()); !why.empty())
                 throw InputError(node.file(), node.childPath("labels") + "/" + std::to_string(k),
                                  "the label \"" + shortText(l.get<std::string>(), 60) + "\" " + why);
             axis.labels.push_back(l.get<std::string>());
@@ -162,8 +162,10 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
     } else {
         for (size_t k = 0; k < axis.values.front().size(); ++k) {
             const Json& v = axis.values.front()[k];
-            // A string with a newline or tab is shown as JSON text (escaped): the label stays one cell.
-            std::string label = v.is_string() && textProblem(v.get<std::string>(), 0).empty() ? v.get<std::string>() : v.dump();
+            // A string that is not plain one-line text is shown as JSON text with every non-ASCII
+            // character escaped: the label stays one visible cell.
+            std::string label = v.is_string() && userTextProblem(v.get<std::string>()).empty() ? v.get<std::string>()
+                                                                                               : v.dump(-1, ' ', true);
             if (label.size() > kMaxLabelChars)
                 node.fail("labels", "value " + std::to_string(k) + " (" + shortText(label, 60) + ") is longer than " +
                                         std::to_string(kMaxLabelChars) + " characters as a label: give the axis labels");
@@ -217,6 +219,42 @@ Json resolveRun(const Json& config, const std::string& file) {
                      e.cause() + " (run " + std::to_string(run.index) + ": " + runLabel(s, run) + ")");
 }
 
+
+/// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
+void collectIds(const Json& resolved, std::set<std::string>& ids) {
+    if (resolved.value("reference", Json(true)) != Json(false)) ids.insert("reference");
+    if (resolved.contains("algorithms") && resolved["algorithms"].is_array())
+        for (const Json& a : resolved["algorithms"])
+            if (a.is_object() && a.contains("id") && a["id"].is_string()) ids.insert(a["id"].get<std::string>());
+}
+
+std::string idList(const std::set<std::string>& ids) {
+    std::string list;
+    for (const std::string& id : ids) list += (list.empty() ? "" : ", ") + id;
+    return shortText(list, 300);
+}
+
+/// merge.ratios and merge.paper name algorithm ids: each must be one that some run measures, or
+/// the table it asks for would be empty.
+void checkMergeIds(const Sweep& s, const std::set<std::string>& ids) {
+    if (!s.merge.is_object()) return;
+    const auto unknown = [&](const std::string& where, const std::string& id) {
+        throw InputError(s.file, where, "\"" + shortText(id, 60) + "\" is not the id of an algorithm in any run (ids: " + idList(ids) + ")");
+    };
+    if (s.merge.contains("ratios"))
+        for (size_t k = 0; k < s.merge["ratios"].size(); ++k) {
+            const std::string ratio = s.merge["ratios"][k].get<std::string>();
+            const size_t slash = ratio.find('/');
+            const std::string where = "/merge/ratios/" + std::to_string(k);
+            if (ratio.find('/', slash + 1) != std::string::npos)
+                throw InputError(s.file, where, "\"" + shortText(ratio, 60) + "\" is not ID/ID (one slash: ids hold none)");
+            for (const std::string& id : {ratio.substr(0, slash), ratio.substr(slash + 1)})
+                if (!ids.count(id)) unknown(where, id);
+        }
+    if (s.merge.contains("paper"))
+        for (const auto& [id, ms] : s.merge["paper"]["times_ms"].items())
+            if (!ids.count(id)) unknown("/merge/paper/times_ms/" + id, id);
+}
 } // namespace
 
 std::string toString(AxisScale scale) { return kScales[size_t(scale)]; }
@@ -293,7 +331,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     const bool named = root.has("name");
     s.name = root.getString("name", defaultName(file));
     // The name titles the report, names the Slurm job and the default output folder.
-    if (const std::string why = textProblem(s.name, kMaxLabelChars); !why.empty()) {
+    if (const std::string why = userTextProblem(s.name); !why.empty()) {
         if (named) root.fail("name", "the name \"" + shortText(s.name, 60) + "\" " + why);
         throw InputError(file, "", "the file name, the sweep's default name, " + why + ": give the sweep a \"name\"");
     }
@@ -336,7 +374,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
         const Json& list = merge.raw()[key];
         merge.markRead(key);
         bool ok = list.is_array();
-        for (const Json& v : list) ok = ok && v.is_string() && textProblem(v.get<std::string>(), kMaxLabelChars).empty();
+        for (const Json& v : list) ok = ok && v.is_string() && userTextProblem(v.get<std::string>()).empty();
         if (!ok) merge.fail(key, "expected a list of strings (one line each, at most " + std::to_string(kMaxLabelChars) + " characters)");
         if (std::string(key) == "ratios")
             for (const Json& v : list)
@@ -348,12 +386,12 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     if (merge.has("paper")) {
         JsonNode paper = merge.child("paper");
         const std::string source = paper.requireString("source");
-        if (const std::string why = textProblem(source, kMaxLabelChars); !why.empty()) paper.fail("source", why);
+        if (const std::string why = userTextProblem(source); !why.empty()) paper.fail("source", "the source " + why);
         JsonNode times = paper.child("times_ms");
         if (!paper.raw().contains("times_ms") || !paper.raw()["times_ms"].is_object() || paper.raw()["times_ms"].empty())
             paper.fail("times_ms", "expected an object of algorithm id: milliseconds");
         for (const auto& [id, value] : paper.raw()["times_ms"].items()) {
-            if (const std::string why = textProblem(id, kMaxLabelChars); !why.empty()) times.fail(id, "the id " + why);
+            if (const std::string why = userTextProblem(id); !why.empty()) times.fail(id, "the id " + why);
             times.getFloat(id, 0.0, 1e-9, 1e9);
         }
         times.finish();
@@ -378,6 +416,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     // One run at a time: its config is made, validated and dropped before the next, so memory is
     // the base's a few times over, whatever the number of runs.
     std::map<std::string, size_t> ids;
+    std::set<std::string> idsInRuns;
     s.runs.reserve(total);
     for (size_t index = 0; index < total; ++index) {
         SweepRun run;
@@ -400,6 +439,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
                 }
             }
             s.runs.back().id = runId(resolved);
+            collectIds(resolved, idsInRuns);
         } catch (const Json::exception& e) {
             // Text that JSON cannot hold (a path that is not UTF-8) or a value of the wrong type
             // deep in a config: bad input, not a crash.
@@ -410,6 +450,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
                                   std::to_string(index) + " (" + runLabel(s, run) +
                                   ") resolve to the same config (an axis repeats a value, or sets one to its default)");
     }
+    checkMergeIds(s, idsInRuns);
     return s;
 }
 

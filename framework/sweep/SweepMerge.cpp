@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <sstream>
 
 namespace shadowlab {
@@ -83,7 +84,7 @@ const char* measureKind(const std::string& m) {
 }
 
 /// sweep.csv's rows of one complete run (BadSummary when its summary.json lacks what they need).
-std::string runRows(const Sweep& sweep, const SweepRun& run, const Json& s) {
+std::string runRows(const Sweep& sweep, const SweepRun& run, const Json& s, std::set<std::string>& measured) {
     std::ostringstream prefix, rows;
     prefix << run.id << "," << run.index;
     for (size_t a = 0; a < sweep.axes.size(); ++a) prefix << "," << csvField(sweep.axes[a].labels[run.point[a]]);
@@ -96,11 +97,35 @@ std::string runRows(const Sweep& sweep, const SweepRun& run, const Json& s) {
     for (const auto& [id, a] : field(s, "algorithms", "", "object").items()) {
         const std::string where = "/algorithms/" + id;
         const std::string algorithm = field(a, "algorithm", where, "string").get<std::string>();
-        for (const auto& [measure, value] : measures(a, where))
+        for (const auto& [measure, value] : measures(a, where)) {
+            measured.insert(measure);
             rows << prefix.str() << "," << csvField(id) << "," << csvField(algorithm) << "," << csvField(measure) << ","
                  << measureKind(measure) << "," << number(value) << "\n";
+        }
     }
     return rows.str();
+}
+
+/// merge.stages and merge.counters name what the report's tables show: each must be something a
+/// merged run measured, or its column would be empty (a misspelled stage, say). Checked against
+/// the runs' results, since a stage exists only once an algorithm has run it.
+void checkMergeMeasures(const Sweep& sweep, const std::string& snapshot, const std::set<std::string>& measured) {
+    if (!sweep.merge.is_object()) return;
+    for (const auto& [key, prefix] : {std::pair<std::string, std::string>{"stages", "time_ms."}, {"counters", "counters."}}) {
+        if (!sweep.merge.contains(key)) continue;
+        const Json& list = sweep.merge[key];
+        for (size_t k = 0; k < list.size(); ++k) {
+            const std::string name = list[k].get<std::string>();
+            if (measured.count(prefix + name)) continue;
+            std::string known;
+            for (const std::string& m : measured)
+                if (m.rfind(prefix, 0) == 0) known += (known.empty() ? "" : ", ") + m.substr(prefix.size());
+            throw InputError(snapshot, "/merge/" + key + "/" + std::to_string(k),
+                             "no merged run measured the " + std::string(key == "stages" ? "stage" : "counter") + " \"" +
+                                 shortText(name, 60) + "\" (measured: " + shortText(known, 300) +
+                                 "); sweep.csv is written, the report is not: correct merge." + key + " here and merge again");
+        }
+    }
 }
 
 } // namespace
@@ -120,6 +145,7 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
     for (const auto& axis : sweep.axes) csv << "," << axis.name;
     csv << ",triangles,pixels,id,algorithm,measure,kind,value\n";
     Json plan = planJson(sweep);
+    std::set<std::string> measured;
     for (size_t i = 0; i < sweep.runs.size(); ++i) {
         const SweepRun& run = sweep.runs[i];
         RunPaths p(dir, run.id);
@@ -147,7 +173,7 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
         std::string rows;
         try {
             s = JsonNode::parseFile(p.dir + "/summary.json");
-            rows = runRows(sweep, run, s);
+            rows = runRows(sweep, run, s, measured);
         } catch (const InputError& e) {
             fail("failed", "results unreadable: " + e.cause());
             continue;
@@ -164,6 +190,7 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
     }
     writeFileAtomic(dir + "/plan.json", plan.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
     writeFileAtomic(dir + "/sweep.csv", csv.str());
+    if (r.merged > 0) checkMergeMeasures(sweep, snapshot, measured);
 
     // An argv, never a shell command line: the folder's name is passed as it is, whatever it holds.
     const std::string script = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/sweep_report.py";

@@ -1,0 +1,149 @@
+#include "framework/core/Text.h"
+
+#include <cstdint>
+#include <cstdio>
+
+namespace shadowlab {
+
+namespace {
+
+/// Length of the UTF-8 sequence starting at text[i], 0 when it is malformed there.
+size_t utf8Length(const std::string& text, size_t i) {
+    const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+    const unsigned char c = byte(i);
+    if (c < 0x80) return 1;
+    size_t n = 0;
+    uint32_t cp = 0;
+    if (c >= 0xC2 && c <= 0xDF) n = 2, cp = c & 0x1F;
+    else if (c >= 0xE0 && c <= 0xEF) n = 3, cp = c & 0x0F;
+    else if (c >= 0xF0 && c <= 0xF4) n = 4, cp = c & 0x07;
+    else return 0;
+    if (i + n > text.size()) return 0;
+    for (size_t k = 1; k < n; ++k) {
+        if ((byte(i + k) & 0xC0) != 0x80) return 0;
+        cp = (cp << 6) | (byte(i + k) & 0x3F);
+    }
+    // Overlong forms, UTF-16 surrogates and code points past U+10FFFF are not UTF-8.
+    if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10FFFF)) || (cp >= 0xD800 && cp <= 0xDFFF)) return 0;
+    return n;
+}
+
+bool isControl(unsigned char c) { return c < 0x20 || c == 0x7F; }
+
+} // namespace
+
+bool isValidUtf8(const std::string& text) {
+    for (size_t i = 0; i < text.size();) {
+        const size_t n = utf8Length(text, i);
+        if (n == 0) return false;
+        i += n;
+    }
+    return true;
+}
+
+int firstControlChar(const std::string& text) {
+    for (char c : text)
+        if (isControl(static_cast<unsigned char>(c))) return static_cast<unsigned char>(c);
+    return -1;
+}
+
+std::string textProblem(const std::string& text, size_t maxChars) {
+    if (maxChars && text.size() > maxChars)
+        return "is " + std::to_string(text.size()) + " bytes long, more than " + std::to_string(maxChars);
+    if (!isValidUtf8(text)) return "is not valid UTF-8";
+    if (const int c = firstControlChar(text); c >= 0) {
+        const char* names[] = {"NUL", "a newline", "a tab", "a carriage return"};
+        const char* name = c == 0 ? names[0] : c == '\n' ? names[1] : c == '\t' ? names[2] : c == '\r' ? names[3] : nullptr;
+        return std::string("holds a control character (") + (name ? name : ("byte " + std::to_string(c)).c_str()) + ")";
+    }
+    return "";
+}
+
+std::string shortText(const std::string& text, size_t maxChars) {
+    std::string out;
+    for (size_t i = 0; i < text.size();) {
+        if (out.size() >= maxChars) return out + "...";
+        const size_t n = utf8Length(text, i);
+        if (n == 0 || (n == 1 && isControl(static_cast<unsigned char>(text[i])))) {
+            out += '?';
+            i += n ? n : 1;
+        } else {
+            out.append(text, i, n);
+            i += n;
+        }
+    }
+    return out;
+}
+
+std::string validUtf8(const std::string& text) {
+    std::string out;
+    out.reserve(text.size());
+    for (size_t i = 0; i < text.size();) {
+        const size_t n = utf8Length(text, i);
+        if (n == 0) {
+            out += '?';
+            ++i;
+        } else {
+            out.append(text, i, n);
+            i += n;
+        }
+    }
+    return out;
+}
+
+
+namespace {
+/// The code point of the well-formed UTF-8 sequence of `n` bytes at text[i].
+uint32_t codePoint(const std::string& text, size_t i, size_t n) {
+    const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+    if (n == 1) return byte(i);
+    uint32_t cp = byte(i) & (n == 2 ? 0x1F : n == 3 ? 0x0F : 0x07);
+    for (size_t k = 1; k < n; ++k) cp = (cp << 6) | (byte(i + k) & 0x3F);
+    return cp;
+}
+
+/// Characters that change how a line reads without being seen (userTextProblem's list).
+bool isInvisibleFormatting(uint32_t cp) {
+    return (cp >= 0x80 && cp <= 0x9F) || cp == 0x061C || (cp >= 0x200B && cp <= 0x200F) || (cp >= 0x2028 && cp <= 0x202E) ||
+           (cp >= 0x2060 && cp <= 0x2069) || cp == 0xFEFF;
+}
+
+bool isAsciiAlnum(char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
+} // namespace
+
+std::string userTextProblem(const std::string& text) {
+    if (std::string why = textProblem(text, kMaxLabelChars); !why.empty()) return why;
+    for (size_t i = 0; i < text.size();) {
+        const size_t n = utf8Length(text, i);
+        if (const uint32_t cp = codePoint(text, i, n); isInvisibleFormatting(cp)) {
+            char hex[16];
+            std::snprintf(hex, sizeof hex, "U+%04X", unsigned(cp));
+            return std::string("holds the invisible formatting character ") + hex +
+                   " (a bidirectional override, zero-width character, separator or C1 control)";
+        }
+        i += n;
+    }
+    return "";
+}
+
+std::string markdownLiteral(const std::string& text) {
+    static const std::string kMarkup = "\\`*[]()!|<>#~&{}+-.=$:";
+    std::string out;
+    out.reserve(text.size() + text.size() / 4);
+    for (size_t i = 0; i < text.size();) {
+        const size_t n = utf8Length(text, i);
+        if (n == 0 || (n == 1 && isControl(static_cast<unsigned char>(text[i])))) {
+            out += "\xEF\xBF\xBD"; // U+FFFD: a line break or stray byte would end the cell or the line
+            i += n ? n : 1;
+            continue;
+        }
+        const char c = text[i];
+        const bool intraword = c == '_' && i > 0 && i + 1 < text.size() && isAsciiAlnum(text[i - 1]) && isAsciiAlnum(text[i + 1]);
+        if (n == 1 && (kMarkup.find(c) != std::string::npos || (c == '_' && !intraword))) out += '\\';
+        out.append(text, i, n);
+        i += n;
+    }
+    return out;
+}
+
+} // namespace shadowlab
