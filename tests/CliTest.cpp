@@ -97,7 +97,8 @@ TEST(CliTest, ARunAnAlgorithmCannotTakeIsRefusedBeforeTheSceneIsMade) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/out")) << "a refused run left an output";
     const test::Ran plan = test::runArgs({bin(), "plan", config});
     EXPECT_EQ(plan.rc, 2) << plan.err;
-    EXPECT_NE(plan.out.find("scene: up to 1260000 triangles"), std::string::npos) << plan.out;
+    // 120 spheres of 10,000: that request tessellates to exactly 50 bands × 100 segments.
+    EXPECT_NE(plan.out.find("scene: up to 1200000 triangles"), std::string::npos) << plan.out;
     EXPECT_NE(plan.out.find("metric_tree (metric_tree): "), std::string::npos) << plan.out;
     EXPECT_NE(plan.out.find("ptsv (ptsv): refuses: its shadow-volume planes"), std::string::npos) << plan.out;
     // Without ptsv the same scene plans, and a hypothetical size is asked with --triangles.
@@ -107,6 +108,47 @@ TEST(CliTest, ARunAnAlgorithmCannotTakeIsRefusedBeforeTheSceneIsMade) {
     const test::Ran asked = test::runArgs({bin(), "plan", config, "--triangles", "1000"});
     EXPECT_EQ(asked.rc, 0) << asked.err;
     EXPECT_NE(asked.out.find("scene: up to 1000 triangles"), std::string::npos) << asked.out;
+}
+
+// A count the plan cannot hold is refused with one line naming where it came from: a --triangles
+// that is past any scene, negative or zero, and a grid whose counts multiply past the scene's
+// budget or past 64 bits (2^64 wraps to 0, 1e45 is past any integer), never planned as "nothing".
+TEST(CliTest, PlanRefusesCountsPastTheSceneOrPast64Bits) {
+    const std::string dir = test::makeTempDir("cli-plan-overflow");
+    const std::string config = dir + "/small.json";
+    std::ofstream(config) << R"({"name": "small", "resolution": [32, 32], "frames": 1,
+      "scene": {"objects": [{"procedural": "sphere", "triangles": 100}]},
+      "camera": {"position": [0, 3, 6], "target": [0, 0, 0]},
+      "light": {"type": "point", "position": [0, 5, 0]}})";
+    for (const char* count : {"4611686018427387904", "18446744073709551616", "-1", "0", "200000001", "1e9", ""}) {
+        const test::Ran r = test::runArgs({bin(), "plan", config, "--triangles", count});
+        EXPECT_EQ(r.rc, 2) << count << ": " << r.out << r.err;
+        EXPECT_NE(r.err.find("--triangles: expected a whole number in [1, 200000000]"), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_EQ(r.out, "") << count;
+    }
+    // Nested grids: 2^48 copies of 2^15 or 2^16 triangles (2^63, 2^64), and three levels of 10^15
+    // copies (10^45, refused at the innermost grid, already past the budget).
+    const std::string sphere16 = R"({"procedural": "sphere", "triangles": 1})"; // 16 triangles
+    auto gridOf = [](const std::string& object, const std::string& count) {
+        return R"({"procedural": "grid", "count": )" + count + R"(, "object": )" + object + "}";
+    };
+    const std::string huge = "[65536, 65536, 65536]", cube = "[100000, 100000, 100000]";
+    const std::pair<std::string, std::string> scenes[] = {
+        {gridOf(gridOf(sphere16, "[2048, 1, 1]"), huge), "at /scene/objects/0/count"},
+        {gridOf(gridOf(sphere16, "[4096, 1, 1]"), huge), "at /scene/objects/0/count"},
+        {gridOf(gridOf(gridOf(sphere16, cube), cube), cube), "at /scene/objects/0/object/object/count"},
+    };
+    for (const auto& [object, where] : scenes) {
+        const test::Ran r = test::runArgs({bin(), "plan", config, "--set", "scene.objects=[" + object + "]"});
+        EXPECT_EQ(r.rc, 2) << where << ": " << r.out << r.err;
+        EXPECT_NE(r.err.find(config + ": " + where + ": the grid would have"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("max_triangles"), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        // The same scene asked at a size that fits is still refused: the config's own scene is.
+        const test::Ran asked = test::runArgs({bin(), "plan", config, "--set", "scene.objects=[" + object + "]", "--triangles", "1000"});
+        EXPECT_EQ(asked.rc, 2) << asked.err;
+    }
 }
 
 // `info` says what a run would run on: the implementation, the subgroup width and what each auto

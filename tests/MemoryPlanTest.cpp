@@ -1,7 +1,11 @@
 // The memory plan a run is checked against before its scene exists: the scene's predicted size, each
 // algorithm's estimate or refusal, and the refusal of a run that cannot fit (bad input, exit 2).
+#include "framework/algorithm/ShadowAlgorithm.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
+#include "framework/core/Params.h"
 #include "framework/experiment/MemoryPlan.h"
+#include "framework/scene/Procedural.h"
 #include "framework/scene/SceneConfig.h"
 
 #include <gtest/gtest.h>
@@ -30,8 +34,8 @@ ExperimentConfig planned(const Json& algorithms, int engines, ScenePrediction& p
 TEST(MemoryPlanTest, PredictsTheSceneWithoutMakingIt) {
     ScenePrediction p;
     planned(Json::array(), 74, p); // 740 spheres of 100,000: 74 M triangles, counted in a moment
-    EXPECT_GE(p.triangles, size_t(74'000'000));
-    EXPECT_LE(p.triangles, size_t(74'000'000 * 1.05) + 2);
+    // Exactly what the generators make: the plane's 2 and each sphere's tessellation of the request.
+    EXPECT_EQ(p.triangles, 2 + 740 * sphereTessellation(100000).triangles());
     EXPECT_FALSE(p.moving);
 }
 
@@ -67,7 +71,8 @@ TEST(MemoryPlanTest, EachAlgorithmRefusesPastItsDeviceLimitByName) {
     };
     const Row rows[] = {
         {"psv", 2, nullptr},      {"psv", 20, "node pool"},
-        {"ptsv", 1, "planes"},    {"bvh_raytrace", 3, "leaf-ordered triangles"},
+        // ptsv's planes (128 bytes a triangle) pass the reported 128 MiB past 1,048,576 triangles: 2 M do.
+        {"ptsv", 2, "planes"},    {"bvh_raytrace", 3, "leaf-ordered triangles"},
         {"izb", 50, "positions' view"}, {"shadow_volumes", 50, "positions' view"},
         {"metric_tree", 74, nullptr},   {"metric_tree", 200, nullptr},
     };
@@ -97,6 +102,48 @@ TEST(MemoryPlanTest, AMovingScenePastThePosingBlockIsRefused) {
     const DeviceLimits strict{size_t(128) << 20, 134217728, size_t(128) << 20};
     EXPECT_THROW(checkMemoryPlan(cfg, p.triangles, true, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}), InputError);
     EXPECT_NO_THROW(checkMemoryPlan(cfg, 1'000'000, true, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}));
+}
+
+// A plan whose byte totals would pass 64 bits is refused, naming the scene, instead of wrapping to
+// a small number that fits any machine.
+TEST(MemoryPlanTest, APlanPast64BitsIsRefusedNotWrapped) {
+    ScenePrediction p;
+    const ExperimentConfig cfg = planned(Json::array({{{"algorithm", "metric_tree"}}}), 1, p);
+    const SystemMemory roomy{1024 * kGiB, 1024 * kGiB};
+    const DeviceLimits unlimited{}; // no device limit: only the arithmetic can stop the plan
+    for (size_t triangles : {size_t(1) << 62, size_t(1) << 63, SIZE_MAX}) {
+        try {
+            checkMemoryPlan(cfg, triangles, false, unlimited, roomy);
+            ADD_FAILURE() << triangles << " triangles were planned";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.file(), "plan.json");
+            EXPECT_EQ(e.jsonPath(), "/scene");
+            EXPECT_NE(e.cause().find("overflows"), std::string::npos) << e.what();
+        }
+    }
+}
+
+// Every algorithm's estimate grows with the scene up to 64 bits and then stays at kSaturated: a
+// scene too large for the arithmetic never reads as one that needs little.
+TEST(MemoryPlanTest, NoFootprintWrapsPast64Bits) {
+    for (const AlgorithmInfo& a : algorithmRegistry()) {
+        if (!a.footprint) continue;
+        const ParamValues params(a.schema());
+        FootprintQuery q;
+        q.resolution = {8192, 8192}; // the largest image a config may ask for
+        q.params = &params;
+        q.triangles = 1'000'000;
+        const Footprint small = a.footprint(q);
+        for (size_t triangles : {size_t(1) << 40, size_t(1) << 62, size_t(1) << 63, SIZE_MAX}) {
+            for (bool moving : {false, true}) {
+                q.triangles = triangles;
+                q.moving = moving;
+                const Footprint f = a.footprint(q);
+                EXPECT_GE(f.bytes, small.bytes) << a.name << " at " << triangles;
+                EXPECT_GE(f.peakBytes, small.peakBytes) << a.name << " at " << triangles;
+            }
+        }
+    }
 }
 
 } // namespace

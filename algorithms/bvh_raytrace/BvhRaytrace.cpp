@@ -5,6 +5,7 @@
 #include "algorithms/bvh_raytrace/BvhBuilder.h"
 #include "algorithms/bvh_raytrace/BvhGpu.h"
 #include "algorithms/bvh_raytrace/BvhGpuLayout.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
@@ -228,11 +229,11 @@ Footprint bvhRaytraceFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t n = q.triangles;
     // Leaves hold leaf_size triangles at most and about half that on average: 2 n / leaf_size nodes.
-    const size_t nodes = std::min(n, 2 * n / size_t(std::max(1, std::get<int>(q.params->get("leaf_size")))) + 1);
-    f.bytes = 48 * n + 64 * nodes + (q.moving ? 152 * n : 0);
-    f.peakBytes = 152 * n;
-    f.refusal = storageRefusal(q, "its leaf-ordered triangles", 48 * n, true);
-    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its nodes", 64 * nodes, true);
+    const size_t nodes = std::min(n, saturatingMul(2, n) / size_t(std::max(1, std::get<int>(q.params->get("leaf_size")))) + 1);
+    f.bytes = saturatingSum({saturatingMul(48, n), saturatingMul(64, nodes), q.moving ? saturatingMul(152, n) : 0});
+    f.peakBytes = saturatingMul(152, n);
+    f.refusal = storageRefusal(q, "its leaf-ordered triangles", saturatingMul(48, n), true);
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its nodes", saturatingMul(64, nodes), true);
     return f;
 }
 AlgorithmInfo bvhRaytraceInfo() {

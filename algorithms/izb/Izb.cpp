@@ -6,6 +6,7 @@
 
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
@@ -252,7 +253,7 @@ private:
 Footprint izbFootprint(const FootprintQuery& q) {
     Footprint f;
     f.bytes = 32 * size_t(q.resolution.x) * size_t(q.resolution.y) + 6 * 24 * 1024 * 1024;
-    f.refusal = texelRefusal(q, "the scene positions' view it reads", 3 * q.triangles);
+    f.refusal = texelRefusal(q, "the scene positions' view it reads", saturatingMul(3, q.triangles));
     return f;
 }
 AlgorithmInfo izbInfo() {

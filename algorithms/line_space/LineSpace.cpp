@@ -6,6 +6,7 @@
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "algorithms/line_space/NTree.h"
 #include "algorithms/line_space/SampleClassifier.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/DiskCache.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
@@ -535,14 +536,15 @@ Footprint lineSpaceFootprint(const FootprintQuery& q) {
     const bool exact = region == "exact";
     const bool culled = exact && std::get<std::string>(q.params->get("start_triangles")) == "culled";
     const bool split = std::get<int>(q.params->get("leaf_split")) > 1;
-    f.bytes = (8 + (culled ? 16 : 0) + (split ? 8 : 0)) * q.triangles;
-    f.peakBytes = f.bytes + 8 * q.triangles;
-    if (exact) f.refusal = storageRefusal(q, "the scene positions its exact start region reads", 36 * q.triangles, true);
+    const size_t n = q.triangles;
+    f.bytes = saturatingMul(8 + (culled ? 16 : 0) + (split ? 8 : 0), n);
+    f.peakBytes = saturatingSum({f.bytes, saturatingMul(8, n)});
+    if (exact) f.refusal = storageRefusal(q, "the scene positions its exact start region reads", saturatingMul(36, n), true);
     if (region == "bvh") {
         // bvh_raytrace's tree with its default leaves of 4: triangles 48 bytes, nodes ~32 bytes a triangle.
-        f.bytes += 80 * q.triangles;
-        f.peakBytes += 152 * q.triangles;
-        f.refusal = storageRefusal(q, "the near field's leaf-ordered triangles", 48 * q.triangles, true);
+        f.bytes = saturatingSum({f.bytes, saturatingMul(80, n)});
+        f.peakBytes = saturatingSum({f.peakBytes, saturatingMul(152, n)});
+        f.refusal = storageRefusal(q, "the near field's leaf-ordered triangles", saturatingMul(48, n), true);
     }
     return f;
 }

@@ -7,6 +7,7 @@
 #include "algorithms/metric_tree/CpuTree.h"
 #include "algorithms/metric_tree/MetricTreeGpuLayout.h"
 #include "algorithms/metric_tree/MetricTreeMath.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/DiskCache.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
@@ -600,18 +601,19 @@ int autoTilePixels(int subgroupWidth) {
 Footprint metricTreeFootprint(const FootprintQuery& q) {
     const MetricTreeParams p = metricTreeParams().read(*q.params);
     const size_t n = q.triangles, pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
-    const size_t clusters = std::min(n, 2 * n / size_t(p.clusterSize) + 1);
+    const size_t clusters = std::min(n, saturatingMul(2, n) / size_t(p.clusterSize) + 1);
     const bool rigid = q.moving && p.motion == "rigid";
     Footprint f;
-    f.bytes = 36 * n + 128 * clusters + 16 * pixels + (rigid ? 68 * clusters + 4 * n : 0);
-    f.peakBytes = 24 * n + 36 * (size_t(1) << 20);
+    f.bytes = saturatingSum({saturatingMul(36, n), saturatingMul(128, clusters), 16 * pixels,
+                             rigid ? saturatingSum({saturatingMul(68, clusters), saturatingMul(4, n)}) : 0});
+    f.peakBytes = saturatingSum({saturatingMul(24, n), 36 * (size_t(1) << 20)});
     size_t block = p.geometryBlock > 0 ? size_t(p.geometryBlock)
                    : rigid            ? q.reportedStorageBlockBytes / 36 / 16 * 16
                                       : q.textureBufferTexels / 3 / 16 * 16;
-    if (block > 0 && n > MT_GEOMETRY_CHUNKS * block)
+    if (block > 0 && n > saturatingMul(MT_GEOMETRY_CHUNKS, block))
         f.refusal = "its " + std::to_string(MT_GEOMETRY_CHUNKS) + " geometry blocks of " + std::to_string(block) +
                     " triangles hold " + std::to_string(MT_GEOMETRY_CHUNKS * block);
-    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its clusters and nodes", 64 * clusters);
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its clusters and nodes", saturatingMul(64, clusters));
     return f;
 }
 

@@ -4,6 +4,7 @@
 #include "framework/algorithm/SharedParams.h"
 #include "algorithms/psv/PsvGpuLayout.h"
 #include "algorithms/psv/PsvPermutation.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
@@ -274,10 +275,10 @@ private:
 Footprint psvFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t n = q.triangles;
-    f.bytes = psv::memoryBytes(n) + 8 * size_t(q.resolution.x) * size_t(q.resolution.y);
-    f.refusal = storageRefusal(q, "its node pool", psv::nodeCount(n) * PSV_NODE_BYTES);
-    if (f.refusal.empty()) f.refusal = texelRefusal(q, "its node pool's view", 2 * psv::nodeCount(n));
-    if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", 3 * n);
+    f.bytes = saturatingSum({psv::memoryBytes(n), 8 * size_t(q.resolution.x) * size_t(q.resolution.y)});
+    f.refusal = storageRefusal(q, "its node pool", saturatingMul(psv::nodeCount(n), PSV_NODE_BYTES));
+    if (f.refusal.empty()) f.refusal = texelRefusal(q, "its node pool's view", saturatingMul(2, psv::nodeCount(n)));
+    if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", saturatingMul(3, n));
     return f;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Host mirror of the PSV GPU structures. The constants live once, in shaders/psv/layout.glsl
 // (#defines only, valid C++ and GLSL); the node struct is mirrored from shaders/psv/tree.glsl.
+#include "framework/core/CheckedMath.h"
 #include "shaders/psv/layout.glsl"
 
 #include <cstddef>
@@ -21,10 +22,14 @@ static_assert(sizeof(NodeGpu) == PSV_NODE_BYTES, "PsvNode is 32 bytes in std430"
 constexpr size_t kCounterBytes = PSV_COUNTER_WORDS * sizeof(uint32_t);
 static_assert(kCounterBytes == 96, "memory_bytes = 128 (n + 1) relies on a 96-byte counter block");
 
-/// Nodes for n triangles: the sentinel (root pointer) plus four per triangle.
-constexpr size_t nodeCount(size_t triangles) { return PSV_NODES_PER_TRIANGLE * triangles + 1; }
-/// GPU bytes PSV holds for n triangles: 32 (4n + 1) + 96 = 128 (n + 1), the paper's figure.
-constexpr size_t memoryBytes(size_t triangles) { return nodeCount(triangles) * PSV_NODE_BYTES + kCounterBytes; }
+/// Nodes for n triangles: the sentinel (root pointer) plus four per triangle (kSaturated past size_t).
+constexpr size_t nodeCount(size_t triangles) { return saturatingSum({saturatingMul(PSV_NODES_PER_TRIANGLE, triangles), 1}); }
+/// GPU bytes PSV holds for n triangles: 32 (4n + 1) + 96 = 128 (n + 1), the paper's figure
+/// (kSaturated past size_t).
+constexpr size_t memoryBytes(size_t triangles) {
+    return saturatingSum({saturatingMul(nodeCount(triangles), PSV_NODE_BYTES), kCounterBytes});
+}
 static_assert(memoryBytes(1000) == 128 * 1001);
+static_assert(memoryBytes(SIZE_MAX / 4) == kSaturated, "a size past 64 bits saturates instead of wrapping");
 
 } // namespace shadowlab::psv

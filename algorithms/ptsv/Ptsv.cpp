@@ -3,6 +3,7 @@
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
 #include "algorithms/ptsv/PtsvLayout.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
@@ -540,8 +541,8 @@ private:
 /// setScene does), the view-sample hierarchy and job lists per pixel.
 Footprint ptsvFootprint(const FootprintQuery& q) {
     Footprint f;
-    const size_t planes = q.triangles * PTSV_PLANES_PER_TRIANGLE * 16;
-    f.bytes = planes + 40 * size_t(q.resolution.x) * size_t(q.resolution.y);
+    const size_t planes = saturatingMul(q.triangles, PTSV_PLANES_PER_TRIANGLE * 16);
+    f.bytes = saturatingSum({planes, 40 * size_t(q.resolution.x) * size_t(q.resolution.y)});
     f.refusal = storageRefusal(q, "its shadow-volume planes", planes, true);
     return f;
 }

@@ -2,6 +2,7 @@
 
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/reference/EmbreeTracer.h"
 
 #include <algorithm>
@@ -125,11 +126,11 @@ Footprint referenceFootprint(const FootprintQuery& q) {
     const size_t pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
     const std::string layout = std::get<std::string>(q.params->get("bvh"));
     const bool compact = layout == "compact" || (layout == "auto" && q.triangles >= kCompactBvhTriangles);
-    f.bytes = q.triangles * ((compact ? kEmbreeCompactBytesPerTriangle : kEmbreeBytesPerTriangle) + (q.moving ? 36 + 36 : 0)) +
-              48 * pixels;
+    const size_t perTriangle = (compact ? kEmbreeCompactBytesPerTriangle : kEmbreeBytesPerTriangle) + (q.moving ? 36 + 36 : 0);
+    f.bytes = saturatingSum({saturatingMul(q.triangles, perTriangle), 48 * pixels});
     // Embree's builder holds primitive references and temporary nodes while it builds: at 74 M
     // triangles the run's peak stayed within 0.4 GiB of what was held after setup, so this is margin.
-    f.peakBytes = q.triangles * 32;
+    f.peakBytes = saturatingMul(q.triangles, 32);
     return f;
 }
 

@@ -9,6 +9,7 @@
 #include "algorithms/shadow_volumes/EdgeAdjacency.h"
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
@@ -385,10 +386,10 @@ private:
 Footprint shadowVolumesFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t n = q.triangles;
-    f.bytes = 44 * n + 28 * size_t(q.resolution.x) * size_t(q.resolution.y);
-    f.peakBytes = 130 * n;
-    f.refusal = storageRefusal(q, "its edge sides", 12 * n);
-    if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", 3 * n);
+    f.bytes = saturatingSum({saturatingMul(44, n), 28 * size_t(q.resolution.x) * size_t(q.resolution.y)});
+    f.peakBytes = saturatingMul(130, n);
+    f.refusal = storageRefusal(q, "its edge sides", saturatingMul(12, n));
+    if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", saturatingMul(3, n));
     return f;
 }
 AlgorithmInfo shadowVolumesInfo() {

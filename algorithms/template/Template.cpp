@@ -6,6 +6,7 @@
 
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
 #include "shaders/template/layout.glsl"
@@ -147,8 +148,8 @@ private:
 /// storage block.
 Footprint templateFootprint(const FootprintQuery& q) {
     Footprint f;
-    f.bytes = 4 * q.triangles;
-    f.refusal = storageRefusal(q, "the scene positions it reads", 36 * q.triangles);
+    f.bytes = saturatingMul(4, q.triangles);
+    f.refusal = storageRefusal(q, "the scene positions it reads", saturatingMul(36, q.triangles));
     return f;
 }
 AlgorithmInfo templateInfo() {

@@ -8,6 +8,7 @@
 #include "framework/experiment/Runner.h"
 #include "framework/gl/DeviceInfo.h"
 #include "framework/gl/GlContext.h"
+#include "framework/scene/SceneConfig.h"
 #include "framework/sweep/SweepCli.h"
 #include "framework/sweep/SweepText.h"
 
@@ -39,8 +40,9 @@ const char* kValidateUsage = R"(  shadowlab validate CONFIG.json [--set PATH=VAL
 )";
 const char* kPlanUsage = R"(  shadowlab plan CONFIG.json [--set PATH=VALUE]... [--triangles N]
       The memory a run would need, without making the scene: the scene's predicted triangles (or
-      N), each algorithm's estimate or why it refuses the scene on this device, and the total
-      against the memory available. Exit 2 when the run would be refused (as run would refuse it).
+      N, 1 to 200000000), each algorithm's estimate or why it refuses the scene on this device, and
+      the total against the memory available. Exit 2 when the run would be refused (as run would
+      refuse it).
 )";
 const char* kListUsage = R"(  shadowlab list [--json | --markdown [NAME]]
       Lists the registered algorithms and their parameters; --markdown prints each parameter table
@@ -203,10 +205,8 @@ int plan(const std::vector<std::string>& args) {
             overrides.push_back(args[i]);
         } else if (args[i] == "--triangles") {
             if (++i >= args.size()) usageError("--triangles needs a count");
-            char* end = nullptr;
-            const unsigned long long v = std::strtoull(args[i].c_str(), &end, 10);
-            if (args[i].empty() || *end != '\0' || v == 0) usageError("--triangles needs a positive count, got " + shortText(args[i], 40));
-            triangles = size_t(v);
+            // No scene may hold more (max_triangles' ceiling), so no plan is asked past it.
+            triangles = parseCount(args[i], "--triangles", 1, kMaxSceneTriangles);
         } else if (config.empty() && !args[i].empty() && args[i][0] != '-') {
             config = args[i];
         } else {

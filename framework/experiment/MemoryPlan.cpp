@@ -1,5 +1,6 @@
 #include "framework/experiment/MemoryPlan.h"
 
+#include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/core/SystemMemory.h"
 #include "framework/gl/GlObjects.h"
@@ -43,7 +44,7 @@ DeviceLimits currentDeviceLimits(size_t triangles) {
     const size_t reported = maxShaderStorageBlockBytes();
     // Only a scene whose largest per-triangle block (psv's 128 bytes) could pass the reported size
     // pays for the probe (its buffer is resident while it runs).
-    const size_t storage = triangles * 128 + 4096 > reported ? addressableStorageBytes() : reported;
+    const size_t storage = saturatingSum({saturatingMul(triangles, 128), 4096}) > reported ? addressableStorageBytes() : reported;
     return {storage, maxTextureBufferTexels(), reported};
 }
 
@@ -94,6 +95,20 @@ Footprint footprintOf(const AlgorithmEntry& e, const ExperimentConfig& cfg, size
     q.reportedStorageBlockBytes = limits.reportedStorageBlockBytes;
     return e.info->footprint(q);
 }
+
+/// A byte total of the plan that reached kSaturated does not fit 64 bits: the plan cannot be
+/// trusted past it, so the run is refused (at `where`) instead of planned with a wrapped number.
+void refuseOverflow(const ExperimentConfig& cfg, const std::string& where, const std::string& what, size_t bytes,
+                    size_t triangles) {
+    if (bytes != kSaturated) return;
+    throw InputError(cfg.file, where, what + " for " + std::to_string(triangles) +
+                                          " triangles overflows a 64-bit byte count: use fewer triangles");
+}
+
+std::string entryPath(const ExperimentConfig& cfg, const AlgorithmEntry& e) {
+    if (!e.jsonPath.empty()) return e.jsonPath;
+    return &e == &cfg.referenceEntry ? "/reference" : "/algorithms";
+}
 } // namespace
 
 std::vector<std::string> describeFootprints(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits) {
@@ -128,24 +143,26 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool m
                              std::to_string(limits.storageBlockBytes >> 20) + " MiB on this device, " +
                              std::to_string(poseLimit) + " triangles; this one has up to " + std::to_string(triangles));
 
-    plan.held.emplace_back("scene", triangles * kSceneBytesPerTriangle);
-    plan.held.emplace_back("scene_gpu", triangles * kSceneGpuBytesPerTriangle);
+    plan.held.emplace_back("scene", saturatingMul(triangles, kSceneBytesPerTriangle));
+    plan.held.emplace_back("scene_gpu", saturatingMul(triangles, kSceneGpuBytesPerTriangle));
     // The largest object (a grid's copies) is made whole and then appended to the scene.
-    plan.loadPeak = 2 * triangles * kSceneBytesPerTriangle;
+    plan.loadPeak = saturatingMul(2, plan.held[0].second);
+    refuseOverflow(cfg, "/scene", "the scene", plan.loadPeak, triangles);
 
     // Algorithms set up one after the other (the reference first): each one's transient sits on
     // top of the scene and of what it and the ones before it hold, not of what comes after.
-    size_t held = plan.held[0].second + plan.held[1].second, setupPeak = 0;
+    size_t held = saturatingSum({plan.held[0].second, plan.held[1].second}), setupPeak = 0;
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         if (!e->info->footprint) continue;
         const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
-        const std::string where = e->jsonPath.empty() ? (e == &cfg.referenceEntry ? "/reference" : "/algorithms") : e->jsonPath;
+        const std::string where = entryPath(cfg, *e);
         if (!f.refusal.empty())
             throw InputError(cfg.file, where, e->info->name + " cannot run this scene (up to " + std::to_string(triangles) +
                                                   " triangles) on this device: " + f.refusal);
         plan.held.emplace_back(e->id, f.bytes);
-        held += f.bytes;
-        setupPeak = std::max(setupPeak, held + f.peakBytes);
+        held = saturatingSum({held, f.bytes});
+        setupPeak = std::max(setupPeak, saturatingSum({held, f.peakBytes}));
+        refuseOverflow(cfg, where, e->info->name + "'s estimate with what is held before it", setupPeak, triangles);
     }
     plan.peak = std::max({plan.loadPeak, held, setupPeak});
     if (plan.available > 0 && plan.peak > plan.available)

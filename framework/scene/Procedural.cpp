@@ -51,10 +51,76 @@ int roundPositive(double x, int minimum) { return std::max(minimum, static_cast<
 
 } // namespace
 
+size_t planeTriangles(int subdivisions) {
+    const size_t s = size_t(std::max(1, subdivisions));
+    return 2 * s * s;
+}
+
+SphereTessellation sphereTessellation(int triangles) {
+    // A UV sphere with `stacks` latitude bands and `slices` longitude segments has a fan of
+    // `slices` triangles at each pole and 2·slices per inner band: T = 2·slices·(stacks − 1).
+    // Near-square cells want slices ≈ 2·stacks, so T ≈ 4·stacks·(stacks − 1), i.e.
+    // stacks = (1 + √(1 + T)) / 2; slices is then re-fitted to T / (2·(stacks − 1)). The remaining
+    // error comes from rounding slices: at most 1 / (2·slices), under 1.6 % for T ≥ 1000.
+    // Minimum 3 stacks × 4 slices = 16 triangles.
+    const double t = std::max(1, triangles);
+    SphereTessellation s;
+    s.stacks = roundPositive((1.0 + std::sqrt(1.0 + t)) / 2.0, 3);
+    s.slices = roundPositive(t / (2.0 * (s.stacks - 1)), 4);
+    return s;
+}
+
+TorusTessellation torusTessellation(float majorRadius, float minorRadius, int triangles) {
+    // A (major × minor) grid of quads: T = 2·U·V. Cells are kept roughly square by making the
+    // segment counts proportional to the circumferences, U/V = k = R/r (clamped to [1, 8]):
+    // V = √(T / (2k)), then U re-fitted to T / (2V). The error is at most 1 / (2U): under 2 %
+    // for T ≥ 1000 (U ≥ 22 there). Minimum 3 × 3 = 18 triangles.
+    const double t = std::max(1, triangles);
+    const double k = std::clamp(double(majorRadius) / std::max(double(minorRadius), 1e-9), 1.0, 8.0);
+    TorusTessellation s;
+    s.minor = roundPositive(std::sqrt(t / (2.0 * k)), 3);
+    s.major = roundPositive(t / (2.0 * s.minor), 3);
+    return s;
+}
+
+CylinderTessellation cylinderTessellation(float radius, float height, int triangles) {
+    // `slices` around, `stacks` bands up the side, a fan on each cap: T = 2·slices·(stacks + 1).
+    // Near-square side cells want stacks ≈ slices·h / (2πr), so T ≈ slices²·h / (πr):
+    // slices = √(T·πr / h); then stacks + 1 = T / (2·slices) and slices is re-fitted to
+    // T / (2·(stacks + 1)). Rounding leaves under 1.5 % for T ≥ 1000 (for height/radius from
+    // 0.01 to 10^4: long thin cylinders get few slices and many stacks, and vice versa).
+    // Minimum 3 slices × 1 stack = 12 triangles.
+    const double t = std::max(1, triangles);
+    const double aspect = double(height) / std::max(double(radius), 1e-9);
+    CylinderTessellation s;
+    s.slices = roundPositive(std::sqrt(t * kPi / std::max(aspect, 1e-9)), 3);
+    s.stacks = roundPositive(t / (2.0 * s.slices) - 1.0, 1);
+    s.slices = roundPositive(t / (2.0 * (s.stacks + 1)), 3);
+    return s;
+}
+
+FenceLayout fenceLayout(int posts, float spacing, float height, float radius, int rails, int trianglesPerCylinder) {
+    FenceLayout f;
+    f.posts = std::max(1, posts);
+    f.firstX = -0.5f * float(f.posts - 1) * spacing;
+    f.length = float(f.posts - 1) * spacing;
+    f.rails = f.length > 0.0f ? std::max(0, rails) : 0; // a single post has nothing to join
+    f.post = cylinderTessellation(radius, height, trianglesPerCylinder);
+    if (f.rails > 0) f.rail = cylinderTessellation(radius, f.length, trianglesPerCylinder);
+    return f;
+}
+
+size_t soupTriangles(int triangles) { return size_t(std::max(0, triangles)); }
+
+size_t gridCopies(glm::ivec3 count) {
+    const glm::ivec3 c = glm::max(count, glm::ivec3(1));
+    return size_t(c.x) * size_t(c.y) * size_t(c.z);
+}
+
 Scene makePlane(glm::vec2 size, int subdivisions, const Material& m) {
     int s = std::max(1, subdivisions);
     Scene scene;
-    Writer w(scene, m, 2 * size_t(s) * size_t(s));
+    Writer w(scene, m, planeTriangles(s));
     auto x = [&](int i) { return size.x * (float(i) / float(s) - 0.5f); };
     auto z = [&](int k) { return size.y * (float(k) / float(s) - 0.5f); };
     for (int k = 0; k < s; ++k)
@@ -65,15 +131,8 @@ Scene makePlane(glm::vec2 size, int subdivisions, const Material& m) {
 }
 
 Scene makeSphere(float radius, int triangles, const Material& m) {
-    // A UV sphere with `stacks` latitude bands and `slices` longitude segments has a fan of
-    // `slices` triangles at each pole and 2·slices per inner band: T = 2·slices·(stacks − 1).
-    // Near-square cells want slices ≈ 2·stacks, so T ≈ 4·stacks·(stacks − 1), i.e.
-    // stacks = (1 + √(1 + T)) / 2; slices is then re-fitted to T / (2·(stacks − 1)). The remaining
-    // error comes from rounding slices: at most 1 / (2·slices), under 1.6 % for T ≥ 1000.
-    // Minimum 3 stacks × 4 slices = 16 triangles.
-    double t = std::max(1, triangles);
-    int stacks = roundPositive((1.0 + std::sqrt(1.0 + t)) / 2.0, 3);
-    int slices = roundPositive(t / (2.0 * (stacks - 1)), 4);
+    const SphereTessellation tess = sphereTessellation(triangles);
+    const int stacks = tess.stacks, slices = tess.slices;
     // Ring vertices once: rings 1..stacks-1, poles separate. Column `slices` wraps to column 0.
     std::vector<glm::vec3> ring(size_t(stacks - 1) * size_t(slices));
     for (int i = 1; i < stacks; ++i) {
@@ -87,7 +146,7 @@ Scene makeSphere(float radius, int triangles, const Material& m) {
     auto v = [&](int i, int j) -> const glm::vec3& { return ring[size_t(i - 1) * size_t(slices) + size_t(j % slices)]; };
     glm::vec3 north(0, radius, 0), south(0, -radius, 0);
     Scene scene;
-    Writer w(scene, m, 2 * size_t(slices) * size_t(stacks - 1));
+    Writer w(scene, m, tess.triangles());
     // With θ growing southwards and φ eastwards, (p, p + dφ, p + dθ) is counter-clockwise from outside.
     for (int j = 0; j < slices; ++j) w.add(north, v(1, j + 1), v(1, j));
     for (int i = 1; i + 1 < stacks; ++i)
@@ -97,15 +156,9 @@ Scene makeSphere(float radius, int triangles, const Material& m) {
 }
 
 Scene makeTorus(float majorRadius, float minorRadius, int triangles, const Material& m) {
-    // A (major × minor) grid of quads: T = 2·U·V. Cells are kept roughly square by making the
-    // segment counts proportional to the circumferences, U/V = k = R/r (clamped to [1, 8]):
-    // V = √(T / (2k)), then U re-fitted to T / (2V). The error is at most 1 / (2U): under 2 %
-    // for T ≥ 1000 (worst measured 1.7 %, U ≥ 22 there). Minimum 3 × 3 = 18 triangles.
     // With minorRadius ≥ majorRadius the tube reaches the axis and triangles there degenerate.
-    double t = std::max(1, triangles);
-    double k = std::clamp(double(majorRadius) / std::max(double(minorRadius), 1e-9), 1.0, 8.0);
-    int minor = roundPositive(std::sqrt(t / (2.0 * k)), 3);
-    int major = roundPositive(t / (2.0 * minor), 3);
+    const TorusTessellation tess = torusTessellation(majorRadius, minorRadius, triangles);
+    const int major = tess.major, minor = tess.minor;
     std::vector<glm::vec3> grid(size_t(major) * size_t(minor));
     for (int i = 0; i < major; ++i) {
         float u = kTwoPi * float(i) / float(major);
@@ -117,7 +170,7 @@ Scene makeTorus(float majorRadius, float minorRadius, int triangles, const Mater
     }
     auto p = [&](int i, int j) -> const glm::vec3& { return grid[size_t(i % major) * size_t(minor) + size_t(j % minor)]; };
     Scene scene;
-    Writer w(scene, m, 2 * size_t(major) * size_t(minor));
+    Writer w(scene, m, tess.triangles());
     // Outward normal is ∂v × ∂u here, so walk v first: (p, p + dv, p + du + dv, p + du).
     for (int i = 0; i < major; ++i)
         for (int j = 0; j < minor; ++j) w.quad(p(i, j), p(i, j + 1), p(i + 1, j + 1), p(i + 1, j));
@@ -125,17 +178,8 @@ Scene makeTorus(float majorRadius, float minorRadius, int triangles, const Mater
 }
 
 Scene makeCylinder(float radius, float height, int triangles, const Material& m) {
-    // `slices` around, `stacks` bands up the side, a fan on each cap: T = 2·slices·(stacks + 1).
-    // Near-square side cells want stacks ≈ slices·h / (2πr), so T ≈ slices²·h / (πr):
-    // slices = √(T·πr / h); then stacks + 1 = T / (2·slices) and slices is re-fitted to
-    // T / (2·(stacks + 1)). Rounding leaves under 1.5 % for T ≥ 1000 (measured for height/radius
-    // from 0.01 to 10^4: long thin cylinders get few slices and many stacks, and vice versa).
-    // Minimum 3 slices × 1 stack = 12 triangles.
-    double t = std::max(1, triangles);
-    double aspect = double(height) / std::max(double(radius), 1e-9);
-    int slices = roundPositive(std::sqrt(t * kPi / std::max(aspect, 1e-9)), 3);
-    int stacks = roundPositive(t / (2.0 * slices) - 1.0, 1);
-    slices = roundPositive(t / (2.0 * (stacks + 1)), 3);
+    const CylinderTessellation tess = cylinderTessellation(radius, height, triangles);
+    const int slices = tess.slices, stacks = tess.stacks;
     std::vector<glm::vec3> grid(size_t(stacks + 1) * size_t(slices));
     for (int i = 0; i <= stacks; ++i)
         for (int j = 0; j < slices; ++j) {
@@ -146,7 +190,7 @@ Scene makeCylinder(float radius, float height, int triangles, const Material& m)
         }
     auto p = [&](int i, int j) -> const glm::vec3& { return grid[size_t(i) * size_t(slices) + size_t(j % slices)]; };
     Scene scene;
-    Writer w(scene, m, 2 * size_t(slices) * size_t(stacks + 1));
+    Writer w(scene, m, tess.triangles());
     glm::vec3 bottom(0, 0, 0), top(0, height, 0);
     for (int j = 0; j < slices; ++j) {
         w.add(bottom, p(0, j), p(0, j + 1));         // faces −Y
@@ -158,19 +202,18 @@ Scene makeCylinder(float radius, float height, int triangles, const Material& m)
 }
 
 Scene makeFence(int posts, float spacing, float height, float radius, int rails, int trianglesPerCylinder, const Material& m) {
-    posts = std::max(1, posts);
-    float firstX = -0.5f * float(posts - 1) * spacing;
-    float length = float(posts - 1) * spacing;
-    rails = length > 0.0f ? std::max(0, rails) : 0;  // a single post has nothing to join
+    const FenceLayout layout = fenceLayout(posts, spacing, height, radius, rails, trianglesPerCylinder);
+    const float firstX = layout.firstX;
     Scene post = makeCylinder(radius, height, trianglesPerCylinder, m);
-    Scene rail = rails ? makeCylinder(radius, length, trianglesPerCylinder, m) : Scene{};
+    Scene rail = layout.rails ? makeCylinder(radius, layout.length, trianglesPerCylinder, m) : Scene{};
     Scene scene;
-    for (int i = 0; i < posts; ++i) scene.append(post, glm::translate(glm::mat4(1.0f), {firstX + float(i) * spacing, 0, 0}));
+    for (int i = 0; i < layout.posts; ++i)
+        scene.append(post, glm::translate(glm::mat4(1.0f), {firstX + float(i) * spacing, 0, 0}));
     // A cylinder along +Y turned −90° about Z lies along +X, starting at the first post.
     glm::mat4 toX = glm::rotate(glm::mat4(1.0f), -0.5f * kPi, glm::vec3(0, 0, 1));
     // Rails split the height evenly and leave a gap at the ground: y = height·(k + 1)/(rails + 1).
-    for (int k = 0; k < rails; ++k) {
-        float y = height * float(k + 1) / float(rails + 1);
+    for (int k = 0; k < layout.rails; ++k) {
+        float y = height * float(k + 1) / float(layout.rails + 1);
         scene.append(rail, glm::translate(glm::mat4(1.0f), {firstX, y, 0}) * toX);
     }
     // append() copies the material per copy; one material is enough since they are all `m`.
@@ -189,10 +232,10 @@ Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint
     glm::vec3 half = glm::max(0.5f * extent - glm::vec3(r), glm::vec3(0.0f));
     glm::vec3 boxHalf = 0.5f * extent;
     Scene scene;
-    int n = std::max(0, triangles);
-    Writer w(scene, m, size_t(n));
+    const size_t n = soupTriangles(triangles);
+    Writer w(scene, m, n);
     float minCross = 1e-4f * triangleSize * triangleSize;
-    for (int t = 0; t < n; ++t) {
+    for (size_t t = 0; t < n; ++t) {
         // Retry the rare (near) degenerate draw so the count is exactly the request; a box too flat to
         // hold any triangle (zero extent in two axes) gives up instead of looping forever.
         size_t before = scene.triangleCount();
@@ -213,7 +256,7 @@ Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint
 Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg) {
     count = glm::max(count, glm::ivec3(1));
     Scene scene;
-    size_t copies = size_t(count.x) * size_t(count.y) * size_t(count.z);
+    const size_t copies = gridCopies(count);
     scene.positions.reserve(copies * object.positions.size() + 1); // + 1: see Scene::append
     scene.normals.reserve(copies * object.normals.size());
     scene.materialIds.reserve(copies * object.materialIds.size());

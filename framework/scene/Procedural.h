@@ -3,9 +3,55 @@
 // parameters whose count is as close as it can get (see each function), and returns the real count.
 #include "framework/scene/Scene.h"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace shadowlab {
+
+// How each generator tessellates a request. The generator and the scene's prediction
+// (predictScene) both take their counts from these, so the memory plan counts exactly the
+// triangles a generator makes, minimums and rounding included. (Triangles that come out
+// degenerate, from a zero or overflowing size, are dropped when made: the count is then a bound.)
+
+/// 2·subdivisions² triangles.
+size_t planeTriangles(int subdivisions);
+
+/// `stacks` latitude bands and `slices` longitude segments: 2·slices·(stacks − 1) triangles.
+struct SphereTessellation {
+    int stacks = 3, slices = 4;
+    size_t triangles() const { return 2 * size_t(slices) * size_t(stacks - 1); }
+};
+SphereTessellation sphereTessellation(int triangles);
+
+/// `major` segments around the axis and `minor` around the tube: 2·major·minor triangles.
+struct TorusTessellation {
+    int major = 3, minor = 3;
+    size_t triangles() const { return 2 * size_t(major) * size_t(minor); }
+};
+TorusTessellation torusTessellation(float majorRadius, float minorRadius, int triangles);
+
+/// `slices` around, `stacks` bands up the side and a fan on each cap: 2·slices·(stacks + 1) triangles.
+struct CylinderTessellation {
+    int slices = 3, stacks = 1;
+    size_t triangles() const { return 2 * size_t(slices) * size_t(stacks + 1); }
+};
+CylinderTessellation cylinderTessellation(float radius, float height, int triangles);
+
+/// A fence's parts: `posts` posts and `rails` rails (none for a single post: nothing to join), each
+/// a cylinder tessellated for its own length.
+struct FenceLayout {
+    int posts = 1, rails = 0;
+    float firstX = 0.0f, length = 0.0f; ///< the first post's x and the rails' length
+    CylinderTessellation post, rail;
+    size_t triangles() const { return size_t(posts) * post.triangles() + size_t(rails) * rail.triangles(); }
+};
+FenceLayout fenceLayout(int posts, float spacing, float height, float radius, int rails, int trianglesPerCylinder);
+
+/// A soup makes exactly its request (none for a negative one).
+size_t soupTriangles(int triangles);
+
+/// A grid's copies: count.x · count.y · count.z (each at least 1).
+size_t gridCopies(glm::ivec3 count);
 
 /// A rectangle in the XZ plane at y = 0 centred on the origin, facing +Y; 2·subdivisions² triangles.
 Scene makePlane(glm::vec2 size, int subdivisions, const Material& m);

@@ -28,7 +28,8 @@
 //               spacing [sx, sy, sz] = [2, 2, 2], rotate_step_deg [rx, ry, rz] = [0, 0, 0] (copy i, counted
 //               along x, then z, then y, is turned by i × step about its own origin, Euler as in T);
 //               M replaces the object's materials only if given
-//     triangle requests are 1..max_triangles; generated counts are within 5 % of them (>= 1000)
+//     triangle requests are 1..max_triangles; generated counts are within 5 % of them (>= 1000),
+//     below that each shape's closed minimum (sphere 16, torus 18, cylinder 12 triangles)
 //   T = {"translate": [0, 0, 0], "rotate_deg": [0, 0, 0] (Euler degrees: X first, then Y, then Z),
 //        "scale": 1 or [sx, sy, sz] (non-zero; negative mirrors),
 //        "fit_size": 0 (off; > 0: scale uniformly so the largest bounding-box extent is fit_size and
@@ -39,6 +40,7 @@
 // loaded, so a typo in the last object fails at once instead of after building a 10 M triangle sphere.
 #include "framework/scene/SceneConfig.h"
 
+#include "framework/core/CheckedMath.h"
 #include "framework/core/JsonParse.h"
 #include "framework/core/SystemMemory.h"
 #include "framework/scene/GltfLoader.h"
@@ -58,8 +60,7 @@ namespace shadowlab {
 namespace {
 
 const std::vector<std::string> kKinds = {"plane", "sphere", "torus", "cylinder", "fence", "soup", "grid"};
-// The hard ceiling: 32-bit vertex indices (Embree's) and GLsizei draw counts stay far from overflow.
-constexpr int kMaxTrianglesCeiling = 200'000'000;
+constexpr int kMaxTrianglesCeiling = int(kMaxSceneTriangles);
 /// The default max_triangles follows the machine: the triangles whose least possible footprint
 /// (kMinBytesPerTriangle: the Scene's 52 bytes on the host and its 52 on the GPU, which a software
 /// renderer also keeps in host memory) fits in its memory. It guards against a typo (a grid of
@@ -72,17 +73,38 @@ int defaultMaxTriangles() {
 }
 constexpr int kMaxGridDepth = 8;
 
-/// An object's generator (run later) and an upper bound of the triangles it will make, known
-/// without making them (a glTF file is loaded to be counted), so the memory a scene needs can be
-/// checked before anything that size exists.
+/// An object's generator (run later) and the triangles it will make, known without making them
+/// (generated objects from the tessellation their generator uses, a glTF file by loading it), so
+/// the memory a scene needs can be checked before anything that size exists. Only triangles made
+/// degenerate by a size or transform are dropped when made: the count is then an upper bound.
 struct Builder {
     std::function<Scene()> make;
-    std::function<double()> count;
+    std::function<size_t()> count;
     bool moves = false; ///< it has a path, an animation or node paths (or holds an object that does)
     Scene operator()() const { return make(); }
 };
-/// Generated counts are within 5 % of the request (docs/scene.md).
-constexpr double kGeneratedSlack = 1.05;
+
+/// The triangles of a grid of `copies` copies of an object of `objectTriangles`; a grid past the
+/// scene's budget (a product past 2^64 included) is refused at its "count", whether it is being
+/// made or only predicted.
+size_t gridTriangles(const JsonNode& grid, size_t objectTriangles, size_t copies, int budget) {
+    const std::optional<size_t> total = checkedMul(objectTriangles, copies);
+    if (!total || *total > size_t(budget))
+        grid.fail("count", "the grid would have " + (total ? std::to_string(*total) : "more than 2^64") + " triangles (" +
+                               std::to_string(copies) + " copies of " + std::to_string(objectTriangles) +
+                               "), more than the scene's max_triangles (" + std::to_string(budget) + ")");
+    return *total;
+}
+
+/// The scene's triangles once `objectTriangles` more are added to `sceneTriangles`, refused at the
+/// object that takes the scene past its budget.
+size_t addWithinBudget(const JsonNode& object, size_t sceneTriangles, size_t objectTriangles, int budget) {
+    const std::optional<size_t> total = checkedAdd(sceneTriangles, objectTriangles);
+    if (!total || *total > size_t(budget))
+        object.failHere("the scene would have " + (total ? std::to_string(*total) : "more than 2^64") +
+                        " triangles with this object, more than max_triangles (" + std::to_string(budget) + ")");
+    return *total;
+}
 
 float positive(JsonNode& node, const std::string& key, double def) {
     double v = node.getFloat(key, def, 0.0);
@@ -161,24 +183,25 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         glm::vec2 size = node.getVec2("size", glm::vec2(10.0f));
         if (!(size.x > 0.0f && size.y > 0.0f)) node.fail("size", "both sizes must be greater than 0");
         int sub = node.getInt("subdivisions", 1, 1, 4096);
-        return Builder{[=] { return makePlane(size, sub, m); }, [=] { return 2.0 * sub * sub; }};
+        return Builder{[=] { return makePlane(size, sub, m); }, [=] { return planeTriangles(sub); }};
     }
     if (kind == "sphere") {
         float r = positive(node, "radius", 1.0);
         int n = triangles(2000);
-        return Builder{[=] { return makeSphere(r, n, m); }, [=] { return kGeneratedSlack * n; }};
+        return Builder{[=] { return makeSphere(r, n, m); }, [=] { return sphereTessellation(n).triangles(); }};
     }
     if (kind == "torus") {
         float major = positive(node, "major_radius", 1.0), minor = positive(node, "minor_radius", 0.3);
         // A tube reaching the axis (horn or spindle torus) is not a closed surface any more.
         if (!(minor < major)) node.fail("minor_radius", "must be smaller than major_radius");
         int n = triangles(2000);
-        return Builder{[=] { return makeTorus(major, minor, n, m); }, [=] { return kGeneratedSlack * n; }};
+        return Builder{[=] { return makeTorus(major, minor, n, m); },
+                       [=] { return torusTessellation(major, minor, n).triangles(); }};
     }
     if (kind == "cylinder") {
         float r = positive(node, "radius", 0.5), h = positive(node, "height", 1.0);
         int n = triangles(500);
-        return Builder{[=] { return makeCylinder(r, h, n, m); }, [=] { return kGeneratedSlack * n; }};
+        return Builder{[=] { return makeCylinder(r, h, n, m); }, [=] { return cylinderTessellation(r, h, n).triangles(); }};
     }
     if (kind == "fence") {
         int posts = node.getInt("posts", 10, 1, 100000);
@@ -186,12 +209,13 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         float radius = positive(node, "radius", 0.03);
         int rails = node.getInt("rails", 2, 0, 1000);
         int perCylinder = node.getInt("triangles_per_cylinder", 64, 1, 1'000'000);
-        if (double(posts + rails) * perCylinder > budget)
-            node.fail("triangles_per_cylinder",
-                      "(posts + rails) × triangles_per_cylinder exceeds the scene's max_triangles (" +
-                          std::to_string(budget) + ")");
+        const size_t fenceTriangles = fenceLayout(posts, spacing, height, radius, rails, perCylinder).triangles();
+        if (fenceTriangles > size_t(budget))
+            node.fail("triangles_per_cylinder", "the fence would have " + std::to_string(fenceTriangles) +
+                                                    " triangles, more than the scene's max_triangles (" +
+                                                    std::to_string(budget) + ")");
         return Builder{[=] { return makeFence(posts, spacing, height, radius, rails, perCylinder, m); },
-                       [=] { return kGeneratedSlack * double(posts + rails) * perCylinder; }};
+                       [=] { return fenceTriangles; }};
     }
     if (kind == "soup") {
         int n = triangles(1000);
@@ -199,7 +223,7 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         if (glm::any(glm::lessThan(extent, glm::vec3(0.0f)))) node.fail("extent", "extents must not be negative");
         float size = positive(node, "triangle_size", 0.2);
         uint32_t seed = uint32_t(node.getInt("seed", 1, 0));
-        return Builder{[=] { return makeTriangleSoup(n, extent, size, seed, m); }, [=] { return double(n); }};
+        return Builder{[=] { return makeTriangleSoup(n, extent, size, seed, m); }, [=] { return soupTriangles(n); }};
     }
     // grid
     if (depth >= kMaxGridDepth) node.fail("object", "grids nest deeper than " + std::to_string(kMaxGridDepth) + " levels");
@@ -208,15 +232,12 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
     glm::ivec3 count = node.getIVec3("count", glm::ivec3(2, 1, 2), 1, 100000);
     glm::vec3 spacing = node.getVec3("spacing", glm::vec3(2.0f));
     glm::vec3 rotateStep = node.getVec3("rotate_step_deg", glm::vec3(0.0f));
-    const double copies = double(count.x) * count.y * count.z;
+    const size_t copies = gridCopies(count);
     return Builder{[=] {
         Scene object = inner();
-        double total = double(object.triangleCount()) * copies;
-        if (total > budget)
-            node.fail("count", "the grid would have " + std::to_string(size_t(total)) +
-                                   " triangles (the scene's max_triangles is " + std::to_string(budget) + ")");
+        gridTriangles(node, object.triangleCount(), copies, budget);
         return makeGrid(object, count, spacing, rotateStep);
-    }, [=] { return inner.count() * copies; }, inner.moves};
+    }, [=] { return gridTriangles(node, inner.count(), copies, budget); }, inner.moves};
 }
 
 /// The built object must be usable: an overflowing radius or scale turns every triangle into
@@ -287,7 +308,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
                 throw InputError(e.file(), e.jsonPath(), e.cause() + " (loaded from " + where + ")");
             }
         };
-        build.count = [make = build.make] { return double(make().triangleCount()); };
+        build.count = [make = build.make] { return make().triangleCount(); };
         build.moves = !motion.animation.empty() || !motion.nodes.empty();
     } else {
         build = parseGenerator(node, kind, material, depth, budget);
@@ -355,10 +376,11 @@ void checkScene(JsonNode sceneNode) { parseScene(sceneNode); }
 
 ScenePrediction predictScene(JsonNode sceneNode) {
     ParsedScene parsed = parseScene(sceneNode);
-    double total = 0;
     ScenePrediction p;
-    for (const Builder& b : parsed.builders) total += b.count(), p.moving |= b.moves;
-    p.triangles = size_t(std::ceil(total));
+    for (size_t i = 0; i < parsed.builders.size(); ++i) {
+        p.triangles = addWithinBudget(parsed.objects[i], p.triangles, parsed.builders[i].count(), parsed.budget);
+        p.moving |= parsed.builders[i].moves;
+    }
     return p;
 }
 
@@ -384,10 +406,7 @@ Scene buildScene(JsonNode sceneNode) {
     size_t total = 0;
     for (size_t i = 0; i < builders.size(); ++i) {
         made.push_back(builders[i]());
-        total += made.back().triangleCount();
-        if (double(total) > budget)
-            objects[i].failHere("the scene would have " + std::to_string(total) +
-                                " triangles with this object, more than max_triangles (" + std::to_string(budget) + ")");
+        total = addWithinBudget(objects[i], total, made.back().triangleCount(), budget);
     }
     Scene scene;
     if (made.size() == 1) {

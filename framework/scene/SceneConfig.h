@@ -5,6 +5,10 @@
 
 namespace shadowlab {
 
+/// The most triangles any scene may have (its max_triangles' ceiling): 32-bit vertex indices
+/// (Embree's) and GLsizei draw counts stay far from overflow.
+constexpr size_t kMaxSceneTriangles = 200'000'000;
+
 /// Reads {"objects": [...]} (schema: docs/scene.md) and returns the world-space triangle soup.
 /// Every error (unknown keys, bad values, unreadable or malformed glTF) is an InputError.
 Scene buildScene(JsonNode sceneNode);
@@ -12,9 +16,11 @@ Scene buildScene(JsonNode sceneNode);
 /// generating or loading anything, so thousands of scenes can be checked in a moment. A malformed
 /// glTF file is found only when it is loaded.
 void checkScene(JsonNode sceneNode);
-/// An upper bound of the scene's triangles, from the same checks plus each object's count, without
-/// making anything big: generated objects are counted from their keys (within the 5 % they may
-/// differ by), grids multiply their object's count, and glTF files are loaded to be counted.
+/// The scene's triangles, from the same checks plus each object's count, without making anything
+/// big: generated objects are counted from the tessellation their generators use (minimums and
+/// rounding included), grids multiply their object's count, and glTF files are loaded to be
+/// counted. Exact, except that triangles a size or transform makes degenerate are dropped when
+/// made. A scene (or grid) past max_triangles is refused here, as buildScene would refuse it.
 struct ScenePrediction {
     size_t triangles = 0;
     bool moving = false; ///< some object has a path, an animation or node paths
