@@ -273,6 +273,8 @@ OutputPlace::~OutputPlace() {
     release();
 }
 
+void OutputPlace::refuseNestedPlace(const std::string& dir) { checkAncestors(normalize(dir)); }
+
 void OutputPlace::release() {
     if (lockFd_ < 0) return;
     ::unlink(lockPath_.c_str());  // while still holding it: see acquireLock

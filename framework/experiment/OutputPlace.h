@@ -27,6 +27,9 @@ public:
     /// Throws InputError (exit 2) for a place that cannot be used; `notes` receives what was
     /// cleaned up or recovered, one line each, for the user.
     static OutputPlace open(const std::string& dir, bool force, std::vector<std::string>* notes = nullptr);
+    /// InputError when `dir` lies inside a run in progress, a run's temporary folder, another run's
+    /// output or a sweep (but for a sweep's own runs/ID): checked before anything is created there.
+    static void refuseNestedPlace(const std::string& dir);
 
     OutputPlace(OutputPlace&& other) noexcept;
     OutputPlace& operator=(OutputPlace&&) = delete;

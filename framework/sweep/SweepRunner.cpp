@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/Interrupt.h"
+#include "framework/experiment/OutputPlace.h"
 #include "framework/sweep/SweepProcess.h"
 #include "framework/sweep/SweepText.h"
 
@@ -66,6 +67,8 @@ std::string describeStatus(int status) {
 /// DIR and DIR/runs, made where absent; InputError where something else than a folder is there.
 void makeFolders(const std::string& outputDir) {
     if (outputDir.empty()) throw InputError("--out", "", "the output folder must not be empty");
+    // Inside a run's output a sweep would be deleted by that run's next --force, and would make it refuse.
+    OutputPlace::refuseNestedPlace(outputDir);
     for (const std::string& d : {outputDir, outputDir + "/runs"}) {
         std::error_code ec;
         const fs::file_status st = fs::status(d, ec);

@@ -1,0 +1,146 @@
+// User text is data: the one rule for text that reaches a report (framework/core/Text.h), the
+// Markdown it is written as, and each way a hostile or careless config reached a report, a plan or
+// standard output before, kept as a test.
+#include "framework/core/Text.h"
+#include "SweepTestData.h"
+#include "TestSupport.h"
+
+#include <filesystem>
+#include <gtest/gtest.h>
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kBin = SHADOWLAB_BINARY;
+const std::string kSmoke = std::string(SHADOWLAB_SOURCE_DIR) + "/configs/smoke.json";
+
+struct Result {
+    int rc;
+    std::string out;
+};
+
+/// Runs `args` (quoted for the shell by the caller: test-made paths and fixed text only).
+Result shell(const std::string& args) {
+    std::string out;
+    const int rc = test::runCommand(args + " 2>&1", out);
+    return {rc, out};
+}
+
+void expectOneLineNaming(const Result& r, const std::string& path) {
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find(path), std::string::npos) << r.out;
+    EXPECT_LE(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+}
+
+TEST(UserTextTest, MarkdownLiteralEscapesEveryMarkupCharacter) {
+    EXPECT_EQ(markdownLiteral("[click me](javascript:alert`1`)"), "\\[click me\\]\\(javascript\\:alert\\`1\\`\\)");
+    EXPECT_EQ(markdownLiteral("![x](/etc/hostname)"), "\\!\\[x\\]\\(/etc/hostname\\)");
+    EXPECT_EQ(markdownLiteral("a|b"), "a\\|b");
+    EXPECT_EQ(markdownLiteral("psv_stack"), "psv_stack") << "intraword '_' is never emphasis";
+    EXPECT_EQ(markdownLiteral("_x_"), "\\_x\\_");
+    EXPECT_EQ(markdownLiteral("a\nb"), "a\xEF\xBF\xBD" "b") << "no line break survives";
+    EXPECT_EQ(markdownLiteral("<!--"), "\\<\\!\\-\\-");
+}
+
+TEST(UserTextTest, TheRuleRefusesInvisibleAndLineBreakingText) {
+    EXPECT_EQ(userTextProblem("engine orbit, 512² [ZFAIL]"), "");
+    EXPECT_NE(userTextProblem("probe\n<!--"), "");
+    EXPECT_NE(userTextProblem(std::string("a\0b", 3)), "");
+    EXPECT_NE(userTextProblem("abc\xE2\x80\xAE" "def"), "") << "U+202E right-to-left override";
+    EXPECT_NE(userTextProblem("a\xE2\x81\xA6" "b"), "") << "U+2066 isolate";
+    EXPECT_NE(userTextProblem("a\xC2\x85" "b"), "") << "U+0085, a C1 line break";
+    EXPECT_NE(userTextProblem("\xff"), "");
+    EXPECT_NE(userTextProblem(std::string(201, 'n')), "");
+}
+
+// Reproduction 4 (and 12's non-UTF-8 name): a name that is not one line of plain text is bad input.
+TEST(UserTextTest, ANameThatIsNotPlainTextIsRefusedAtItsPath) {
+    for (const std::string& name : {std::string("probe\\n<!--"), std::string("a\\u202eb"), std::string("nul\\u0000"),
+                                    std::string(300, 'n')}) {
+        const Result r = shell(kBin + " validate " + kSmoke + " --set 'name=\"" + name + "\"'");
+        expectOneLineNaming(r, "/name");
+    }
+}
+
+// Reproductions 1-3: the name is shown as text, never read as a link or an image, in report.md and
+// in the self-contained report.html.
+TEST(UserTextTest, AMarkdownNameRendersAsTextInTheReport) {
+    const std::string dir = test::makeTempDir("user-text-report");
+    const Result r = shell(kBin + " run " + kSmoke + " --out " + dir + "/out --no-progress" +
+                           " --set 'name=\"[click me](javascript:alert`1`) ![x](/etc/hostname) ![y](/dev/zero)\"'" +
+                           " --set resolution=[32,32] --set frames=1 --set warmup_frames=0 --set output.images_at_frames=[0]" +
+                           " --set 'algorithms=[{\"algorithm\": \"psv\"}]'");
+    ASSERT_EQ(r.rc, 0) << r.out;
+    std::string md, html;
+    ASSERT_EQ(test::runCommand("cat " + dir + "/out/report.md", md), 0);
+    ASSERT_EQ(test::runCommand("cat " + dir + "/out/report.html", html), 0);
+    EXPECT_NE(md.find("# \\[click me\\]\\(javascript\\:alert"), std::string::npos) << md.substr(0, 400);
+    EXPECT_EQ(html.find("href=\"javascript"), std::string::npos);
+    // The only links are the run's own images (the labelled heat maps).
+    size_t anchors = 0, own = 0;
+    for (size_t at = html.find("<a "); at != std::string::npos; at = html.find("<a ", at + 1), ++anchors)
+        own += html.compare(at, 16, "<a href=\"images/") == 0 ? 1 : 0;
+    EXPECT_EQ(anchors, own);
+    // Every embedded image is a PNG the run made; /etc/hostname would be text/plain or octet-stream.
+    EXPECT_EQ(html.find("data:text"), std::string::npos);
+    EXPECT_EQ(html.find("data:application"), std::string::npos);
+    EXPECT_NE(html.find("[click me](javascript:alert`1`)"), std::string::npos) << "the name, as typed, is the title";
+}
+
+// Reproduction 8: what a command prints reaches standard output, or the command fails.
+TEST(UserTextTest, AFullOrClosedStandardOutputIsAnError) {
+    for (const std::string& command : {std::string(" list --json"), std::string(" validate ") + kSmoke,
+                                       std::string(" plan ") + kSmoke}) {
+        std::string out;
+        EXPECT_EQ(test::runCommand(kBin + command + " > /dev/full 2>/dev/null", out), 2) << command;
+        EXPECT_EQ(test::runCommand(kBin + command + " >&- 2>/dev/null", out), 2) << command;
+    }
+}
+
+// Reproduction 9: a rule between parameters is part of validation, with its JSON path.
+TEST(UserTextTest, ParameterRulesAreValidated) {
+    for (const char* walk : {"stackless", "hybrid"}) {
+        const Result r = shell(kBin + " validate " + kSmoke + " --set algorithms.1.params.traversal=" + walk +
+                               " --set algorithms.1.params.transparency=true");
+        expectOneLineNaming(r, "/algorithms/1/params/traversal");
+    }
+    const Result ok = shell(kBin + " validate " + kSmoke + " --set algorithms.1.params.traversal=stack" +
+                            " --set algorithms.1.params.transparency=true > /dev/null");
+    EXPECT_EQ(ok.rc, 0) << ok.out;
+    const Result lanes = shell(kBin + " validate " + kSmoke + " --set algorithms.4.params.lanes=5");
+    expectOneLineNaming(lanes, "/algorithms/4/params/lanes");
+}
+
+// Reproduction 10: merge entries name ids the sweep's runs have.
+TEST(UserTextTest, MergeIdsAreCheckedAgainstTheRuns) {
+    const std::string dir = test::makeTempDir("user-text-merge");
+    Json s = test::smallSweep();
+    s["merge"] = {{"ratios", {"psv/shadow_map", "psv/absent"}}};
+    const std::string file = test::writeJson(dir + "/ratio.sweep.json", s);
+    expectOneLineNaming(shell(kBin + " sweep plan " + file), "/merge/ratios/1");
+    s["merge"] = {{"paper", {{"source", "a paper"}, {"times_ms", {{"psv", 1.0}, {"psw", 2.0}}}}}};
+    const std::string paper = test::writeJson(dir + "/paper.sweep.json", s);
+    expectOneLineNaming(shell(kBin + " sweep plan " + paper), "/merge/paper/times_ms/psw");
+}
+
+// Reproduction 11: a sweep inside a complete run's output is refused before anything is written.
+TEST(UserTextTest, ASweepInsideARunsOutputIsRefusedUpFront) {
+    const std::string dir = test::makeTempDir("user-text-nest");
+    fs::create_directories(dir + "/A");
+    test::writeJson(dir + "/A/summary.json", Json{{"complete", true}});
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep());
+    const Result r = shell(kBin + " sweep run " + file + " --out " + dir + "/A/sw");
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("inside"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir + "/A/sw"));
+}
+
+TEST(UserTextTest, AnEmptyOutIsRefused) {
+    const Result r = shell(kBin + " run " + kSmoke + " --out ''");
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("--out"), std::string::npos) << r.out;
+}
+
+} // namespace
+} // namespace shadowlab
