@@ -320,7 +320,7 @@ const EdgeSweep kEdgeSweeps[] = {
     {"ValueScaleNumericLabels", R"([{"name": "f", "values": {"frames": [2, 3]}, "labels": ["1e3", "2.5"], "scale": "value"}])"},
     {"LabelsThatBreakCsvAndMarkdown", R"([{"name": "l", "values": {"frames": [2, 3, 4]},
         "labels": ["a,b", "say \"hi\" | there", "$\\frac{x}{$ ×é"]}])"},
-    {"MarkupStringLabels", R"json([{"name": "n", "values": {"name": ["a*b](x)", "![c](/etc/hostname) | d"]}}])json"},
+    {"MarkupStringLabels", R"json([{"name": "n", "values": {"name": ["a*b](x)", "![c](etc-hostname) | d"]}}])json"},
     {"PixelsAndCategory", R"([{"name": "res", "values": {"resolution": [[64, 64], [96, 96]]}, "scale": "pixels"},
         {"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])"},
 };
