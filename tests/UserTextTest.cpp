@@ -136,6 +136,24 @@ TEST(UserTextTest, ASweepInsideARunsOutputIsRefusedUpFront) {
     EXPECT_FALSE(fs::exists(dir + "/A/sw"));
 }
 
+// Reproduction 12: a long path on an object that a grid copies is held once, not once per copy (a
+// 30×30 grid of a 20,000-key path took 1.78 GB; validate builds the scene). The address-space cap
+// is what the binary maps with its libraries plus a few hundred MB of scene, far below that.
+TEST(UserTextTest, AGridOfALongPathHoldsThePathOnce) {
+    const std::string dir = test::makeTempDir("user-text-path");
+    Json keys = Json::array();
+    for (int k = 0; k < 20000; ++k) keys.push_back({{"time", k * 0.01}, {"translate", {0.001 * k, 0, 0}}});
+    Json c = Json::parse(std::string(R"({"resolution": [32, 32], "frames": 2, "algorithms": [{"algorithm": "shadow_map"}],
+        "camera": {"position": [0, 30, 40], "target": [0, 0, 0]}, "light": {"position": [5, 40, 5]},
+        "scene": {"objects": [{"procedural": "plane", "size": [80, 80]}]}})"));
+    c["scene"]["objects"].push_back({{"procedural", "grid"}, {"count", {30, 1, 30}}, {"spacing", {2, 2, 2}},
+                                     {"object", {{"procedural", "sphere"}, {"radius", 0.5}, {"triangles", 20},
+                                                 {"path", {{"keyframes", keys}}}}}});
+    const std::string file = test::writeJson(dir + "/path.json", c);
+    const Result r = shell("ulimit -v 1200000; " + kBin + " validate " + file + " > /dev/null");
+    EXPECT_EQ(r.rc, 0) << r.out;
+}
+
 TEST(UserTextTest, AnEmptyOutIsRefused) {
     const Result r = shell(kBin + " run " + kSmoke + " --out ''");
     EXPECT_EQ(r.rc, 2) << r.out;

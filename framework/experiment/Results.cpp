@@ -266,7 +266,7 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
             if (a.resolvedParams.empty()) continue;
             os << "| " << markdownLiteral(a.id) << " | " << a.algorithm << " | ";
             for (size_t i = 0; i < a.resolvedParams.size(); ++i)
-                os << (i ? ", " : "") << markdownLiteral(a.resolvedParams[i].first + " = " + a.resolvedParams[i].second);
+                os << (i ? ", " : "") << a.resolvedParams[i].first << " = " << a.resolvedParams[i].second; // the plugin's words
             os << " |\n";
         }
         os << "\n";

@@ -275,22 +275,29 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     results.meta["memory"] = memoryRecord(cfg, sceneGpu, results, rssAfterSetup, opt.memoryPlan);
     results.meta["frames_without_lit_pixels"] = framesWithoutLit;
     results.meta["warnings"] = Json::array();
-    if (cfg.reference && !framesWithoutLit.empty()) {
-        std::string w = std::to_string(framesWithoutLit.size()) + " of " + std::to_string(cfg.frames) +
-                        " frames have no lit pixel (none covered, facing the light and inside its reach): accuracy "
-                        "is not measured on them" +
-                        (int(framesWithoutLit.size()) == cfg.frames ? ", so it is not measured at all" : "");
+    const auto warn = [&](const std::string& w) {
         results.meta["warnings"].push_back(w);
         std::fprintf(stderr, "shadowlab: warning: %s\n", w.c_str());
+    };
+    if (cfg.reference && !framesWithoutLit.empty())
+        warn(std::to_string(framesWithoutLit.size()) + " of " + std::to_string(cfg.frames) +
+             " frames have no lit pixel (none covered, facing the light and inside its reach): accuracy "
+             "is not measured on them" +
+             (int(framesWithoutLit.size()) == cfg.frames ? ", so it is not measured at all" : ""));
+    for (const auto& a : results.algorithms) {
+        if (!a.visibilityDiffers.empty())
+            warn(a.id + ": the statistics pass's visibility differs from the timed pass's on " + std::to_string(a.visibilityDiffers.size()) +
+                 " of " + std::to_string(statFrames.size()) +
+                 " frames (instrumentation must only count; the timed pass's images and accuracy are reported)");
+        // A structure that overflowed, or a walk that was capped, leaves pixels decided conservatively
+        // rather than measured: the images and accuracy of those frames are not the method's.
+        size_t frames = 0;
+        uint64_t total = 0;
+        for (const auto& f : a.frames) frames += f.overflow ? 1 : 0, total += f.overflow;
+        if (frames)
+            warn(a.id + ": " + std::to_string(total) + " overflows or capped walks on " + std::to_string(frames) + " of " +
+                 std::to_string(a.frames.size()) + " timed frames (see its overflow counters): those frames' images are not the method's own");
     }
-    for (const auto& a : results.algorithms)
-        if (!a.visibilityDiffers.empty()) {
-            std::string w = a.id + ": the statistics pass's visibility differs from the timed pass's on " +
-                            std::to_string(a.visibilityDiffers.size()) + " of " + std::to_string(statFrames.size()) +
-                            " frames (instrumentation must only count; the timed pass's images and accuracy are reported)";
-            results.meta["warnings"].push_back(w);
-            std::fprintf(stderr, "shadowlab: warning: %s\n", w.c_str());
-        }
     if (!opt.writeOutputs) return results;
     throwIfInterrupted();
 
