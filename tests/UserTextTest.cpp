@@ -154,6 +154,28 @@ TEST(UserTextTest, AGridOfALongPathHoldsThePathOnce) {
     EXPECT_EQ(r.rc, 0) << r.out;
 }
 
+// A glTF path that names a FIFO or a device is refused for what it is, not as "not found".
+TEST(UserTextTest, AGltfThatIsNotARegularFileIsNamedSo) {
+    for (const char* path : {"/dev/zero", "/dev/null"}) {
+        const Result r = shell(kBin + " validate " + kSmoke + " --set 'scene.objects.0={\"gltf\": \"" + path + "\"}'");
+        expectOneLineNaming(r, "/scene/objects/0/gltf");
+        EXPECT_NE(r.out.find("not a regular file"), std::string::npos) << r.out;
+    }
+}
+
+// Reproduction 10, its other half: a stage or counter no run measured is named when merging,
+// after sweep.csv is written.
+TEST(UserTextTest, MergeStagesAreCheckedAgainstWhatTheRunsMeasured) {
+    const std::string dir = test::makeTempDir("user-text-stages");
+    Json s = test::smallSweep();
+    s["merge"] = {{"ratios", {"psv/shadow_map"}}, {"stages", {"build", "biuld"}}};
+    const std::string file = test::writeJson(dir + "/stages.sweep.json", s), out = dir + "/out";
+    ASSERT_FALSE(test::fakeSweepRuns(kBin, file, out).is_null());
+    expectOneLineNaming(shell(kBin + " sweep merge " + out), "/merge/stages/1");
+    EXPECT_TRUE(fs::exists(out + "/sweep.csv"));
+    EXPECT_FALSE(fs::exists(out + "/sweep.md"));
+}
+
 TEST(UserTextTest, AnEmptyOutIsRefused) {
     const Result r = shell(kBin + " run " + kSmoke + " --out ''");
     EXPECT_EQ(r.rc, 2) << r.out;

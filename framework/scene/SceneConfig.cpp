@@ -43,6 +43,7 @@
 #include "framework/core/CheckedMath.h"
 #include "framework/core/JsonParse.h"
 #include "framework/core/SystemMemory.h"
+#include "framework/core/Text.h"
 #include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
 
@@ -271,7 +272,10 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         std::string path = node.getPath("gltf", "");
         if (path.empty()) node.fail("gltf", "expected the path of a .gltf or .glb file");
         std::error_code ec;
-        if (!std::filesystem::is_regular_file(path, ec)) node.fail("gltf", "glTF file not found: " + path);
+        const std::filesystem::file_status status = std::filesystem::status(path, ec);
+        if (!std::filesystem::exists(status)) node.fail("gltf", "glTF file not found: " + shortText(path, 300));
+        if (!std::filesystem::is_regular_file(status))
+            node.fail("gltf", "not a regular file (a folder, FIFO or device cannot be a glTF file): " + shortText(path, 300));
         std::string where = node.file() + " at " + node.childPath("gltf");
         std::string animation;  // a name, or an index written as a decimal string
         if (node.has("animation")) {
