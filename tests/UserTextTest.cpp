@@ -63,6 +63,19 @@ TEST(UserTextTest, ANameThatIsNotPlainTextIsRefusedAtItsPath) {
     }
 }
 
+// Reproduction 12's other half: a config whose folder is not UTF-8 names an output folder that no
+// summary.json can hold; refused at validation, not after the run.
+TEST(UserTextTest, AnOutputFolderThatIsNotUtf8IsRefusedAtValidation) {
+    const std::string dir = test::makeTempDir("user-text-utf8") + "/cfg\xff";
+    fs::create_directories(dir);
+    Json c = Json::parse(R"({"name": "n", "resolution": [32, 32], "frames": 1, "algorithms": [{"algorithm": "shadow_map"}],
+        "camera": {"position": [0, 3, 5], "target": [0, 0, 0]}, "light": {"position": [1, 4, 1]},
+        "scene": {"objects": [{"procedural": "plane", "size": [6, 6]}]}})");
+    const std::string file = test::writeJson(dir + "/c.json", c);
+    const Result r = shell(kBin + " validate '" + file + "'");
+    expectOneLineNaming(r, "/output/dir");
+}
+
 // Reproductions 1-3: the name is shown as text, never read as a link or an image, in report.md and
 // in the self-contained report.html.
 TEST(UserTextTest, AMarkdownNameRendersAsTextInTheReport) {
