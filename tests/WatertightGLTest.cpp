@@ -1,0 +1,71 @@
+// The watertight ray–triangle test that every exact GPU algorithm decides by
+// (shaders/common/watertight.glsl), shot at a ray through an edge two triangles share. Without
+// `precise`, GLSL 4.50 section 4.7.1 lets a compiler contract `a*b - c*d` into
+// `fma(a, b, -(c*d))`, and NVIDIA and AMD do by default: then each triangle rounds the other
+// product, both edge values can come out negative and the ray slips between the triangles. The
+// fault SHADOWLAB_FAULT_FMA_EDGES writes every edge function in that contracted form, which
+// llvmpipe never produces by itself.
+#include "framework/gl/GlObjects.h"
+#include "framework/gl/Shader.h"
+#include "framework/reference/EmbreeTracer.h"
+#include "tests/TestSupport.h"
+
+#include <glm/glm.hpp>
+#include <vector>
+
+namespace shadowlab {
+namespace {
+
+using namespace test;
+
+// Two triangles in z = 0 sharing the edge B–C: (A, B, C) and (D, C, B). The ray runs along +z
+// through the origin, where the edge passes within a rounding error: B.x·C.y and B.y·C.x differ by
+// 3.9e-8 and round to the same float, so uncontracted the edge value is exactly 0 (decided in
+// double: triangle 0 is hit), while contracted each triangle's edge value is negative (found by a
+// search over such pairs; any pair with both contracted values negative will do).
+const glm::vec3 kA{-0x1.7c7888p+1f, 0x1.a30bd8p+0f, 0.0f};
+const glm::vec3 kB{0x1.46db84p-1f, 0x1.28c4bcp+0f, 0.0f};
+const glm::vec3 kC{-0x1.ff3c2cp-1f, -0x1.d02c52p+0f, 0.0f};
+const glm::vec3 kD{0x1.7c7888p+1f, -0x1.a30bd8p+0f, 0.0f};
+const glm::vec3 kOrigin{0.0f, 0.0f, -1.0f};
+const glm::vec3 kDirection{0.0f, 0.0f, 1.0f};
+constexpr float kTfar = 2.0f;
+
+/// The mask of the triangles the probe shader's ray hits.
+uint32_t gpuHits(const std::vector<glm::vec3>& triangles, glm::vec3 origin, glm::vec3 dir, float tfar) {
+    std::vector<glm::vec4> vertices;
+    for (glm::vec3 v : triangles) vertices.emplace_back(v, 1.0f);
+    const std::vector<glm::vec4> rays{glm::vec4(origin, tfar), glm::vec4(dir, 0.0f)};
+    GlBuffer tris = GlBuffer::fromVector(vertices);
+    GlBuffer rayBuffer = GlBuffer::fromVector(rays);
+    GlBuffer hits = GlBuffer::fromVector(std::vector<uint32_t>{0xDEADu});
+    ShaderProgram probe = ShaderProgram::compute("tests/watertight_probe.comp");
+    probe.set("uTriangles", unsigned(triangles.size() / 3));
+    tris.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+    rayBuffer.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+    hits.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
+    probe.use();
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    return hits.read<uint32_t>(1)[0];
+}
+
+class WatertightGLTest : public GLTest {};
+
+TEST_F(WatertightGLTest, ARayThroughASharedEdgeHitsOneTriangleAsTheReferenceDoes) {
+    const std::vector<glm::vec3> quad{kA, kB, kC, kD, kC, kB};
+    Scene scene;
+    scene.addTriangles(quad, Material{});
+    EXPECT_TRUE(EmbreeTracer(scene).occluded(kOrigin, kDirection, kTfar)) << "the reference sees the quad";
+    EXPECT_EQ(gpuHits(quad, kOrigin, kDirection, kTfar), 1u) << "triangle 0 alone, as decided in double";
+}
+
+TEST_F(WatertightGLTest, FaultContractedEdgeFunctionsStillHitOneTriangle) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_FMA_EDGES", "1"}});
+    const std::vector<glm::vec3> quad{kA, kB, kC, kD, kC, kB};
+    const uint32_t hits = gpuHits(quad, kOrigin, kDirection, kTfar);
+    EXPECT_TRUE(hits == 1u || hits == 2u) << "hit mask " << hits << ": the ray slipped between the triangles";
+}
+
+} // namespace
+} // namespace shadowlab
