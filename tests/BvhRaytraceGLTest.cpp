@@ -218,6 +218,26 @@ TEST_F(BvhRaytraceGLTest, FaultWalkThatCannotEndIsCappedAndWrittenShadowed) {
     }
 }
 
+// A leaf loop a driver ends early (a fault site, test-only: every leaf loop stops after its first
+// triangle, as llvmpipe's loop limit would) leaves triangles untested: the ray is capped, its pixel
+// counted and written shadowed, never lit by a triangle nobody tested.
+TEST_F(BvhRaytraceGLTest, FaultCutLeafLoopIsCappedAndWrittenShadowed) {
+    const Shot shot = pointShot();
+    const AlgorithmRun clean = run(shot);
+    AlgorithmRun o;
+    {
+        ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_CUT_LEAF_LOOP", "1"}});
+        o = run(shot);
+    }
+    const double capped = o.counters["loop_capped_pixels"];
+    EXPECT_GT(capped, 0.0);
+    EXPECT_EQ(o.overflow, uint64_t(capped));
+    expectOverflowedPixelsShadowed(o, capped);
+    size_t lighter = 0;
+    for (size_t i = 0; i < o.visibility.size(); ++i) lighter += o.visibility[i] > clean.visibility[i];
+    EXPECT_EQ(lighter, 0u) << "pixels lit by mistake";
+}
+
 TEST_F(BvhRaytraceGLTest, CountersAndMemoryDescribeTheTree) {
     Shot s = pointShot();
     AlgorithmRun o = run(s);

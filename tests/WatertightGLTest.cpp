@@ -11,6 +11,7 @@
 #include "tests/TestSupport.h"
 
 #include <glm/glm.hpp>
+#include <random>
 #include <vector>
 
 namespace shadowlab {
@@ -65,6 +66,78 @@ TEST_F(WatertightGLTest, FaultContractedEdgeFunctionsStillHitOneTriangle) {
     const std::vector<glm::vec3> quad{kA, kB, kC, kD, kC, kB};
     const uint32_t hits = gpuHits(quad, kOrigin, kDirection, kTfar);
     EXPECT_TRUE(hits == 1u || hits == 2u) << "hit mask " << hits << ": the ray slipped between the triangles";
+}
+
+// ---- The BVH's slab test (shaders/common/slab.glsl) never drops a box whose triangle is hit ---------
+
+struct GrazingRays {
+    std::vector<glm::vec4> vertices; // 3 per pair
+    std::vector<glm::vec4> rays;     // (o, tfar), (d, 0) per pair
+};
+
+/// Rays aimed at a point on an edge or at a vertex of a triangle, where the triangle touches its
+/// bounding box: half the triangles axis-aligned (floors and walls: a flat box), half anywhere,
+/// origins 0.5 to 50 away in any direction, at offsets from the origin up to 1e3.
+GrazingRays grazingRays(int pairs, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), frac(0.0f, 1.0f), dist(0.5f, 50.0f);
+    std::uniform_int_distribution<int> axis(0, 2), where(0, 3);
+    GrazingRays out;
+    for (int i = 0; i < pairs; ++i) {
+        const float offset = i % 4 == 0 ? 1e3f : 1.0f;
+        glm::vec3 v[3];
+        for (glm::vec3& p : v) p = glm::vec3(unit(rng), unit(rng), unit(rng)) * offset;
+        if (i % 2 == 0) {
+            const int a = axis(rng);
+            for (glm::vec3& p : v) p[a] = v[0][a];
+        }
+        const int e = where(rng) % 3;
+        const glm::vec3 target = where(rng) == 0 ? v[e] : glm::mix(v[e], v[(e + 1) % 3], frac(rng));
+        const glm::vec3 o = target + glm::normalize(glm::vec3(unit(rng), unit(rng), unit(rng))) * dist(rng);
+        for (const glm::vec3& p : v) out.vertices.emplace_back(p, 1.0f);
+        out.rays.emplace_back(o, 2.0f);
+        out.rays.emplace_back(target - o, 0.0f);
+    }
+    return out;
+}
+
+/// Pairs whose triangle the watertight test hits but whose box the slab test misses.
+size_t hitsOutsideTheirBox(const GrazingRays& g, size_t* hitCount) {
+    const unsigned pairs = unsigned(g.rays.size() / 2);
+    GlBuffer tris = GlBuffer::fromVector(g.vertices);
+    GlBuffer rays = GlBuffer::fromVector(g.rays);
+    GlBuffer hits = GlBuffer::fromVector(std::vector<uint32_t>(pairs, 0u));
+    ShaderProgram probe = ShaderProgram::compute("tests/slab_probe.comp");
+    probe.set("uPairs", pairs);
+    tris.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+    rays.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+    hits.bindBase(GL_SHADER_STORAGE_BUFFER, 2);
+    probe.use();
+    glDispatchCompute((pairs + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    size_t outside = 0;
+    *hitCount = 0;
+    for (uint32_t h : hits.read<uint32_t>(pairs)) {
+        *hitCount += (h & 1u) != 0;
+        outside += h == 1u;
+    }
+    return outside;
+}
+
+constexpr int kGrazingPairs = 40000;
+
+TEST_F(WatertightGLTest, TheSlabTestKeepsEveryBoxWhoseTriangleARayGrazes) {
+    size_t hit = 0;
+    EXPECT_EQ(hitsOutsideTheirBox(grazingRays(kGrazingPairs, 1), &hit), 0u);
+    EXPECT_GT(hit, size_t(kGrazingPairs / 4)) << "the rays must hit their triangles, or nothing is tested";
+}
+
+// A reciprocal 2 ULP off the worst way round (GLSL allows 2.5): the widening must cover it.
+TEST_F(WatertightGLTest, FaultLooseReciprocalStillKeepsEveryGrazedBox) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_LOOSE_RECIPROCAL", "1"}});
+    size_t hit = 0;
+    EXPECT_EQ(hitsOutsideTheirBox(grazingRays(kGrazingPairs, 2), &hit), 0u);
+    EXPECT_GT(hit, size_t(kGrazingPairs / 4));
 }
 
 } // namespace

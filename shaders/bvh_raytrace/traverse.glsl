@@ -1,12 +1,18 @@
 // The BVH traversal of bvh_raytrace, shared with line_space's near field (start_region bvh): Aila &
 // Laine's while-while walk (inner nodes until a leaf is found, then the leaves), near child first, a
 // fixed stack whose overflow is reported, any-hit early exit, the watertight triangle test. Needs
-// common/watertight.glsl. The including shader may set, before including it:
+// common/watertight.glsl (and includes common/slab.glsl). The including shader may set, before including it:
 //   BVH_TRAVERSE_NODE_UNIT, BVH_TRAVERSE_TRI_UNIT  the texture units of the nodes and triangles
 //                                                  (default: bvh_raytrace's, layout.glsl)
 //   BVH_STACK_SIZE, BVH_SHORT_STACK                the stack (default 64 entries, in memory)
 //   BVH_TICK_NODE(), BVH_TICK_TRI()                a SIMD probe tick per node and per triangle
 // and sets the uniform uBvhStepCap (most loop passes of one walk: nodes + 2 * leaves + 1).
+#include "common/slab.glsl"
+
+#ifndef SHADOWLAB_FAULT_CUT_LEAF_LOOP
+#define SHADOWLAB_FAULT_CUT_LEAF_LOOP 0
+#endif
+
 #ifndef BVH_TRAVERSE_NODE_UNIT
 #define BVH_TRAVERSE_NODE_UNIT BVH_NODE_UNIT
 #endif
@@ -65,9 +71,7 @@ struct BvhRay {
 BvhRay bvhMakeRay(vec3 o, vec3 d, float tfar) {
     BvhRay r;
     r.o = o, r.d = d, r.tfar = tfar;
-    // A zero component would give 0 * inf = NaN in the slab test; 1e-30 keeps the slab infinite.
-    vec3 safe = mix(d, mix(vec3(-1e-30), vec3(1e-30), greaterThanEqual(d, vec3(0.0))), lessThan(abs(d), vec3(1e-30)));
-    r.invD = 1.0 / safe;
+    r.invD = slabInverse(d);
     r.w = watertightRay(o, d, tfar);
     return r;
 }
@@ -76,15 +80,8 @@ bool bvhHitTriangle(BvhRay r, uint tri) {
     return watertightHit(r.w, bvhVertex(tri, 0), bvhVertex(tri, 1), bvhVertex(tri, 2));
 }
 
-// Slab test on [0, tfar]; tnear is where the ray enters (for near-first ordering). The far end
-// is widened by a few ulps (Ize 2013) so rounding never drops a box the ray grazes.
-bool bvhHitBox(vec3 lo, vec3 hi, BvhRay r, out float tnear) {
-    vec3 t0 = (lo - r.o) * r.invD, t1 = (hi - r.o) * r.invD;
-    vec3 tmin = min(t0, t1), tmax = max(t0, t1);
-    tnear = max(max(tmin.x, tmin.y), max(tmin.z, 0.0));
-    float tfar = min(min(tmax.x, tmax.y), min(tmax.z, r.tfar)) * 1.0000004;
-    return tnear <= tfar;
-}
+// Slab test on [0, tfar] (common/slab.glsl: conservative under GLSL's division error).
+bool bvhHitBox(vec3 lo, vec3 hi, BvhRay r, out float tnear) { return slabHit(lo, hi, r.o, r.invD, r.tfar, tnear); }
 
 struct BvhTrace {
     bool occluded, overflow, capped;
@@ -187,11 +184,17 @@ BvhTrace bvhTrace(BvhRay r) {
         while (bvhIsLeaf(leaf) && steps < uBvhStepCap) {
             ++steps;
             uint first = (leaf & ~BVH_LEAF_REF) >> 4u, count = (leaf & 15u) + 1u;
-            for (uint i = 0u; i < count; ++i) {
+            uint i = 0u;
+            for (; i < count; ++i) {
+#if SHADOWLAB_FAULT_CUT_LEAF_LOOP
+                if (i == 1u) break; // what a driver's loop limit does: the loop just ends
+#endif
                 ++res.tested;
                 BVH_TICK_TRI();
                 if (bvhHitTriangle(r, first + i)) { res.occluded = true; return res; } // any hit ends the ray
             }
+            // A leaf left untested (a driver's loop limit ended the loop) may hold the occluder.
+            if (i < count) { res.capped = true; return res; }
             leaf = BVH_NONE;
             if (bvhIsLeaf(node)) { leaf = node; BVH_POP_INTO(node); }
         }
