@@ -83,5 +83,23 @@ TEST_F(IzbGLTest, CappedListWalksAreWrittenShadowed) {
     expectLostWorkShadowed(o, "walk_cap 16");
 }
 
+// A GPU may flush a stored denormal and canonicalise a stored NaN (a fault site, test-only, at every
+// float izb stores): the samples facing away from the light or outside the spot's cone, and those
+// in the first 2^23 cells of face 0, must keep their cell, or a pixel the light does not reach
+// is written lit.
+TEST_F(IzbGLTest, FaultFloatStorageKeepsEveryPixelExact) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_FLOAT_STORAGE", "1"}});
+    for (LightType light : {LightType::Point, LightType::Spot, LightType::Directional}) {
+        SCOPED_TRACE(toString(light));
+        const AlgorithmRun o = runAlgorithm(izbInfo(), withLight(lightAmidClutter(), light), {});
+        EXPECT_EQ(o.overflow, 0u);
+        EXPECT_EQ(o.accuracy.mismatchRatio, 0.0);
+        // The metrics compare the pixels the light reaches; the rest must stay unlit too.
+        size_t unreachedLit = 0;
+        for (size_t i = 0; i < o.visibility.size(); ++i) unreachedLit += o.reference[i] == 0.0f && o.visibility[i] > 0.0f;
+        EXPECT_EQ(unreachedLit, 0u) << "pixels the light does not reach written lit";
+    }
+}
+
 } // namespace
 } // namespace shadowlab

@@ -1,17 +1,18 @@
 #version 450
 // izb, pass 1: every lit view sample into its light-grid cell's list (a lock-free push: the cell's
 // head swapped for the sample). The sample keeps the reference's ray origin x = p + n * offset, and
-// the cell it went to. A sample the light does not reach (outside a spot's cone, facing away) is
+// the cell it went to (as an integer: a cell index as float bits could be a denormal or a NaN). A sample the light does not reach (outside a spot's cone, facing away) is
 // not inserted: its visibility is 0, as the reference's.
 #include "common/light.glsl"
 #include "izb/layout.glsl"
 #include "izb/grid.glsl"
+#include "common/stored_float.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D uPosition;
 layout(binding = 1) uniform sampler2D uNormal;
 layout(std430, binding = IZB_HEAD_BINDING) buffer Head { uint head[]; };
 layout(std430, binding = IZB_NEXT_BINDING) writeonly buffer Next { uint next[]; };
-layout(std430, binding = IZB_SAMPLE_BINDING) writeonly buffer Samples { vec4 samples[]; };
+layout(std430, binding = IZB_SAMPLE_BINDING) writeonly buffer Samples { uvec4 samples[]; }; // x's bits, the cell
 layout(std430, binding = IZB_BLOCKED_BINDING) writeonly buffer Blocked { uint blocked[]; };
 layout(std430, binding = IZB_COUNTER_BINDING) buffer Counters { uint counters[]; };
 layout(std430, binding = IZB_OCCUPIED_BINDING) writeonly buffer Occupied { uint occupied[]; };
@@ -45,7 +46,7 @@ void main() {
             }
         }
     }
-    samples[s] = vec4(x, uintBitsToFloat(cell));
+    samples[s] = uvec4(floatBitsToUint(storedFloat(x)), cell); // the cell an integer, never float bits
     if (cell >= IZB_ON_LIGHT) return;
     next[s] = atomicExchange(head[cell], s);
     int tilesPerSide = (uGrid + IZB_TILE - 1) / IZB_TILE;

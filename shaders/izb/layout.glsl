@@ -1,7 +1,7 @@
 // Bindings, counters and sizes of izb (the irregular z-buffer): #defines only, for C++ and GLSL.
 #define IZB_HEAD_BINDING 3     // uint[faces * grid^2]: a cell's first sample, IZB_NONE for none
 #define IZB_NEXT_BINDING 4     // uint[pixels]: the next sample of the same cell
-#define IZB_SAMPLE_BINDING 5   // vec4[pixels]: the sample's ray origin x (xyz), its cell (w, as bits)
+#define IZB_SAMPLE_BINDING 5   // uvec4[pixels]: the sample's ray origin x (xyz, float bits), its cell (w)
 #define IZB_BLOCKED_BINDING 6  // uint[pixels]: 1 once a triangle blocks the sample's ray
 #define IZB_JOB_BINDING 7      // uvec2[capacity]: (triangle, face << 24 | tile): one 8 × 8 tile of cells
 #define IZB_JOB_COUNT_BINDING 8 // {jobs, groups x, groups y, groups z}: the test pass's indirect grid

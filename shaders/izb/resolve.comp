@@ -13,7 +13,7 @@ layout(r32f, binding = 1) writeonly uniform image2D uListView; // debug: the sam
 #endif
 layout(std430, binding = IZB_HEAD_BINDING) readonly buffer Head { uint head[]; };
 layout(std430, binding = IZB_NEXT_BINDING) readonly buffer Next { uint next[]; };
-layout(std430, binding = IZB_SAMPLE_BINDING) readonly buffer Samples { vec4 samples[]; };
+layout(std430, binding = IZB_SAMPLE_BINDING) readonly buffer Samples { uvec4 samples[]; }; // x's bits, the cell
 layout(std430, binding = IZB_BLOCKED_BINDING) readonly buffer Blocked { uint blocked[]; };
 layout(std430, binding = IZB_FLAG_BINDING) readonly buffer TileFlags { uint tileFlags[]; };
 layout(std430, binding = IZB_CELL_FLAG_BINDING) readonly buffer CellFlags { uint cellFlags[]; };
@@ -25,7 +25,7 @@ void main() {
     if (any(greaterThanEqual(px, uResolution))) return;
     uint s = uint(px.y) * uint(uResolution.x) + uint(px.x);
     vec4 pos = texelFetch(uPosition, px, 0);
-    uint cell = floatBitsToUint(samples[s].w);
+    uint cell = samples[s].w;
     float visibility = 1.0; // background, or a point on the light
     if (pos.w >= 0.5) visibility = 0.0; // unless listed and unblocked: not reached by the light
     float listed = 0.0;

@@ -15,7 +15,7 @@
 layout(local_size_x = IZB_TILE, local_size_y = IZB_TILE) in;
 layout(std430, binding = IZB_HEAD_BINDING) readonly buffer Head { uint head[]; };
 layout(std430, binding = IZB_NEXT_BINDING) readonly buffer Next { uint next[]; };
-layout(std430, binding = IZB_SAMPLE_BINDING) readonly buffer Samples { vec4 samples[]; };
+layout(std430, binding = IZB_SAMPLE_BINDING) readonly buffer Samples { uvec4 samples[]; }; // x's bits, the cell
 layout(std430, binding = IZB_BLOCKED_BINDING) buffer Blocked { uint blocked[]; };
 layout(std430, binding = IZB_JOB_BINDING) readonly buffer Jobs { uvec2 jobs[]; };
 layout(std430, binding = IZB_JOB_COUNT_BINDING) readonly buffer JobCount { uint jobCount, groupsX, groupsY, groupsZ; };
@@ -49,7 +49,7 @@ void main() {
         ++steps;
         if (blocked[s] != 0u) continue;
         ++tests;
-        vec3 x = samples[s].xyz;
+        vec3 x = uintBitsToFloat(samples[s].xyz);
         if (watertightHit(shadowRayToLight(x, uRayOffset), a, b, c)) blocked[s] = 1u;
     }
     if (s != IZB_NONE) {
