@@ -68,7 +68,7 @@ void expectLostWorkShadowed(const AlgorithmRun& o, const char* what) {
 // A job list of 1,024 (triangle, tile) jobs on the engine, which asks for far more: the tiles left
 // out are flagged, and their samples written shadowed and counted.
 TEST_F(IzbGLTest, FullJobListLosesTilesThatAreWrittenShadowed) {
-    const AlgorithmRun o = runAlgorithm(izbInfo(), engineOnGround(), {{"job_capacity", 1024}});
+    const AlgorithmRun o = runAlgorithm(izbInfo(), lightAmidClutter(), {{"job_capacity", 8192}});
     EXPECT_GT(o.counters.at("lost_tiles"), 0.0);
     EXPECT_GT(o.counters.at("jobs"), 1024.0);
     expectLostWorkShadowed(o, "job_capacity 1024");
@@ -81,6 +81,17 @@ TEST_F(IzbGLTest, CappedListWalksAreWrittenShadowed) {
     const AlgorithmRun o = runAlgorithm(izbInfo(), cameraInsideShadow(), {{"walk_cap", 16}});
     EXPECT_GT(o.counters.at("capped_cells"), 0.0);
     expectLostWorkShadowed(o, "walk_cap 16");
+}
+
+// A job counter that wraps after capacity + 64 pushes instead of 2^32 (a fault site, test-only: the
+// wrap a flood of pushes, ~1,000 times the capacity, would cause) must not hand out the slots of
+// live jobs again: the pushes past capacity are taken back, every tile left out is flagged and
+// written shadowed. Counting on, 262 pixels were written lit.
+TEST_F(IzbGLTest, FaultPushFloodOverwritesNoJob) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_PUSH_FLOOD", "1"}});
+    const AlgorithmRun o = runAlgorithm(izbInfo(), lightAmidClutter(), {{"job_capacity", 8192}});
+    EXPECT_GT(o.counters.at("lost_tiles"), 0.0);
+    expectLostWorkShadowed(o, "job_capacity 8192, flooded");
 }
 
 // A GPU may flush a stored denormal and canonicalise a stored NaN (a fault site, test-only, at every

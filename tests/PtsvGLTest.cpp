@@ -211,6 +211,21 @@ TEST_F(PtsvGLTest, TinyJobListOverflowsButStaysExact) {
 
 // ---- Faults a GPU may show and a software GL does not (framework/gl/Shader.h) ----------------------
 
+// A job counter that wraps after capacity + 64 pushes instead of 2^32 (a fault site, test-only: the
+// wrap a flood of pushes, ~1,000 times the capacity, would cause) must not hand out the slots of
+// live jobs again: a walker whose push overwrote one would leave its subtree to a job nobody runs
+// (counting on, 1 % of the pixels were wrong).
+TEST_F(PtsvGLTest, FaultPushFloodOverwritesNoJob) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_PUSH_FLOOD", "1"}});
+    for (const auto& traversal : {kCooperative, kPerInvocation}) {
+        SCOPED_TRACE(std::get<std::string>(traversal.second));
+        Outcome o = run(thousandsOfTriangles(), {traversal, {"job_capacity", 64}});
+        EXPECT_GT(o.counters["job_overflow"], 100.0);
+        EXPECT_EQ(o.accuracy.mismatchRatio, 0.0);
+        EXPECT_EQ(o.accuracy.falseLit, 0.0);
+    }
+}
+
 // A culled triangle's status survives a GPU that flushes denormals (GLSL 4.50 section 4.7.1), and
 // its planes are never a previous frame's: with every plane read flushed and the plane buffer
 // filled beforehand with planes that would shadow everything, every culled triangle (front faces,

@@ -7,7 +7,7 @@ layout(std430, binding = IZB_JOB_COUNT_BINDING) buffer JobCount { uint jobCount,
 layout(std430, binding = IZB_COUNTER_BINDING) buffer Counters { uint counters[]; };
 uniform uint uJobCapacity;
 void main() {
-    counters[IZB_C_JOBS] = jobCount;
+    counters[IZB_C_JOBS] = jobCount + counters[IZB_C_LOST_TILES]; // asked for: listed + lost (a push past capacity is taken back)
     uint n = min(jobCount, uJobCapacity);
     jobCount = n;
     groupsX = min(n, uint(IZB_ROW));

@@ -9,6 +9,7 @@
 #include "izb/layout.glsl"
 #include "izb/grid.glsl"
 #include "izb/footprint.glsl"
+#include "common/list_push.glsl"
 layout(local_size_x = 64) in;
 uniform uint uInvocationsPerRow;
 layout(std430, binding = IZB_JOB_BINDING) writeonly buffer Jobs { uvec2 jobs[]; };
@@ -38,7 +39,8 @@ void main() {
         for (tx = t0.x; tx <= t1.x; ++tx) {
             uint tile = uint(ty * tilesPerSide + tx);
             if (occupied[uint(face) * uint(tilesPerSide * tilesPerSide) + tile] == 0u) continue; // no sample there
-            uint slot = atomicAdd(jobCount, 1u);
+            uint slot;
+            LIST_RESERVE(jobCount, 1u, uJobCapacity, slot);
             if (slot < uJobCapacity) jobs[slot] = uvec2(t, uint(face) << 24 | tile);
             else {
                 tileFlags[uint(face) * uint(tilesPerSide * tilesPerSide) + tile] = 1u;

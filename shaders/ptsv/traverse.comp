@@ -53,6 +53,7 @@
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "common/counters.glsl"
+#include "common/list_push.glsl"
 #define PTSV_TEXEL_READS 1
 #include "ptsv/ptsv.glsl"
 #include "common/shadow_ray.glsl"
@@ -355,7 +356,8 @@ uint visit(int depth, uint id, bool live) {
     // Children at the split depth become jobs here, with one atomic for all of them; those a full
     // list leaves out are returned, and the walk visits them itself.
     if (depth + 1 == uSplitDepth && v.x != 0u) {
-        uint slot = atomicAdd(ptsvCounters[PTSV_C_JOBS_PUSHED], uint(bitCount(v.x)));
+        uint slot;
+        LIST_RESERVE(ptsvCounters[PTSV_C_JOBS_PUSHED], uint(bitCount(v.x)), uJobCapacity, slot);
         uint kept = 0u;
         for (uint m = v.x; m != 0u; m &= m - 1u, ++slot) {
             uint c = uint(findLSB(m));
@@ -390,7 +392,7 @@ void traverse(int depth, uint id) {
         if (childDepth == uSplitDepth) {
             uint slot = 0u;
             if (LEADER) {
-                slot = atomicAdd(ptsvCounters[PTSV_C_JOBS_PUSHED], 1u);
+                LIST_RESERVE(ptsvCounters[PTSV_C_JOBS_PUSHED], 1u, uJobCapacity, slot);
                 if (slot < uJobCapacity) ptsvJobs[slot] = uvec2(gTriangle, childId);
                 else atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], 1u);
             }
