@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sys/stat.h>
 
 namespace shadowlab {
 namespace {
@@ -72,8 +73,11 @@ TEST(OutputPlaceTest, ASecondRunOnTheSamePlaceIsRefusedWhileTheFirstHoldsIt) {
 
 TEST(OutputPlaceTest, LeftoversOfKilledRunsAreCleanedAndAnInterruptedCommitRecovered) {
     std::string base = test::makeTempDir("place-stale"), out = base + "/out";
+    // A killed run's temporary directories carry the mark the run left in them.
     makeOutput(base + "/out.partial-999999", "half");
+    std::ofstream(base + "/out.partial-999999/.shadowlab-partial");
     makeOutput(base + "/out.old-999998", "previous");  // killed between the two renames: no out/
+    std::ofstream(base + "/out.old-999998/.shadowlab-old");
     std::vector<std::string> notes;
     {
         OutputPlace p = OutputPlace::open(out, true, &notes);
@@ -84,8 +88,39 @@ TEST(OutputPlaceTest, LeftoversOfKilledRunsAreCleanedAndAnInterruptedCommitRecov
     EXPECT_FALSE(fs::exists(base + "/out.old-999998"));
     // Recovered without --force: the previous results are not replaced.
     makeOutput(base + "/other.old-1", "kept");
+    std::ofstream(base + "/other.old-1/.shadowlab-old");
     EXPECT_NE(errorOf(base + "/other", false).find("already exists"), std::string::npos);
     EXPECT_EQ(slurp(base + "/other/summary.json"), "kept");
+    EXPECT_FALSE(fs::exists(base + "/other/.shadowlab-old")) << "the mark goes with the recovery";
+}
+
+// What lies beside DIR and only looks like a leftover by its name is the user's, never removed,
+// moved or locked: folders and files named DIR.partial-..., DIR.old-..., a finished run made with
+// --out DIR.partial-9, a file or FIFO at DIR.lock (a probe found the first three deleted or moved
+// into DIR, and the lock file truncated and unlinked).
+TEST(OutputPlaceTest, LookalikesOfLeftoversAreNeverTouched) {
+    std::string base = test::makeTempDir("place-lookalike"), out = base + "/notes";
+    fs::create_directories(base + "/notes.partial-draft");
+    fs::create_directories(base + "/notes.old-2023");
+    std::ofstream(base + "/notes.old-2023/chapter.tex") << "years of work";
+    std::ofstream(base + "/notes.partial-file.txt") << "x";
+    makeOutput(base + "/notes.partial-9", "a finished run");
+    {
+        OutputPlace p = OutputPlace::open(out, false);
+        p.commit();
+    }
+    EXPECT_TRUE(fs::is_directory(base + "/notes.partial-draft"));
+    EXPECT_EQ(slurp(base + "/notes.old-2023/chapter.tex"), "years of work");
+    EXPECT_TRUE(fs::exists(base + "/notes.partial-file.txt"));
+    EXPECT_EQ(slurp(base + "/notes.partial-9/summary.json"), "a finished run");
+    EXPECT_FALSE(fs::exists(out + "/.shadowlab-partial")) << "the committed output keeps no mark";
+
+    std::ofstream(base + "/mine.lock") << "my shopping list";
+    EXPECT_NE(errorOf(base + "/mine", false).find("not a shadowlab lock file"), std::string::npos);
+    EXPECT_EQ(slurp(base + "/mine.lock"), "my shopping list");
+    ASSERT_EQ(::mkfifo((base + "/pipe.lock").c_str(), 0644), 0);
+    EXPECT_NE(errorOf(base + "/pipe", false).find("not a shadowlab lock file"), std::string::npos);
+    EXPECT_TRUE(fs::is_fifo(base + "/pipe.lock"));
 }
 
 TEST(OutputPlaceTest, PlacesThatCannotHoldAnOutputAreBadInput) {

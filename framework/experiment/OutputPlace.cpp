@@ -82,6 +82,29 @@ std::string lockOwner(const std::string& lockPath) {
     return " (pid " + pid + ")";
 }
 
+/// The marks a run leaves in its temporary directories, so that only those are ever taken for a
+/// killed run's leftovers: DIR.partial-PID (the run being written) and DIR.old-PID (the previous
+/// results, moved aside for a moment on file systems without RENAME_EXCHANGE).
+constexpr const char* kPartialMark = ".shadowlab-partial";
+constexpr const char* kOldMark = ".shadowlab-old";
+
+bool writeMark(const fs::path& path) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd < 0) return false;
+    return ::close(fd) == 0;
+}
+
+/// `path` is PREFIX + digits, a real directory (no link) holding the regular file `mark`.
+bool isLeftover(const fs::path& path, const std::string& prefix, const char* mark) {
+    const std::string n = path.filename().string();
+    if (n.size() <= prefix.size() || n.compare(0, prefix.size(), prefix) != 0 ||
+        n.find_first_not_of("0123456789", prefix.size()) != std::string::npos)
+        return false;
+    std::error_code ec;
+    struct stat st {};
+    return fs::is_directory(fs::symlink_status(path, ec)) && ::lstat((path / mark).c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
 /// "X.partial-123" or "X.old-123": a run's temporary directory beside its output.
 bool isRunTemporary(const std::string& name) {
     for (const char* tag : {".partial-", ".old-", ".kept-"}) {
@@ -149,15 +172,34 @@ std::string nestedInside(const fs::path& dir, size_t limit = 200000) {
     return "";
 }
 
+/// A regular file of at most 20 bytes, all digits: a shadowlab lock (empty while being written).
+bool isLockFile(int fd) {
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > 20) return false;
+    char buf[21] = {0};
+    const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+    if (n < 0) return false;
+    for (ssize_t i = 0; i < n; ++i)
+        if (buf[i] < '0' || buf[i] > '9') return false;
+    return true;
+}
+
 /// Takes the lock file's exclusive flock. The file is unlinked by its holder at the end, so after
 /// locking, check that the path still names the file we locked (else a newer lock file exists).
 int acquireLock(const std::string& lockPath, const std::string& dir) {
     for (int attempt = 0; attempt < 100; ++attempt) {
-        int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+        int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
         if (fd < 0) {
             const int err = errno;
             throw InputError(shortPath(dir), "", "cannot create the lock file " + shortPath(lockPath) + ": " + std::strerror(err) +
                                           " (is the output's parent directory writable?)");
+        }
+        // A lock file holds nothing but its holder's pid (or nothing yet): anything else at that
+        // path (a FIFO, a user's file) is not ours to lock, truncate or unlink.
+        if (!isLockFile(fd)) {
+            ::close(fd);
+            throw InputError(shortPath(dir), "", shortPath(lockPath) + " exists and is not a shadowlab lock file; move it away or "
+                                          "choose another --out");
         }
         // Another run's lockIsLive() probe holds a shared lock for an instant: wait that out (50 ms)
         // before calling the place busy; a run in progress holds its lock for the whole run.
@@ -204,13 +246,15 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
     place.lockPath_ = dir + ".lock";
     place.lockFd_ = acquireLock(place.lockPath_, dir);
 
-    // Holding the lock, every DIR.partial-* and DIR.old-* is a leftover of a killed run.
+    // Holding the lock, a DIR.partial-PID or DIR.old-PID directory that carries the mark its run
+    // left in it is a leftover of a killed run. Anything else beside DIR (a user's notes.old-2023,
+    // a finished run made with --out DIR.partial-9, a file) is not ours and is left alone.
     const std::string name = finalPath.filename().string();
     std::vector<fs::path> partials, olds;
     for (const auto& e : fs::directory_iterator(parent, ec)) {
         std::string n = e.path().filename().string();
-        if (n.rfind(name + ".partial-", 0) == 0) partials.push_back(e.path());
-        if (n.rfind(name + ".old-", 0) == 0) olds.push_back(e.path());
+        if (isLeftover(e.path(), name + ".partial-", kPartialMark)) partials.push_back(e.path());
+        if (isLeftover(e.path(), name + ".old-", kOldMark)) olds.push_back(e.path());
     }
     auto note = [&](const std::string& s) {
         if (notes) notes->push_back(s);
@@ -220,6 +264,7 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
         // complete and were never replaced, so put them back.
         fs::rename(olds.back(), finalPath, ec);
         if (!ec) {
+            fs::remove(finalPath / kOldMark, ec);
             note("recovered " + shortPath(dir) + " from " + shortPath(olds.back().string()) + " (a run was killed while committing)");
             olds.pop_back();
         }
@@ -257,6 +302,8 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
     place.partial_ = dir + ".partial-" + pidSuffix();
     fs::create_directories(place.partial_ + "/images", ec);
     if (ec) throw InputError(shortPath(dir), "", "cannot create " + shortPath(place.partial_) + ": " + ec.message());
+    if (!writeMark(fs::path(place.partial_) / kPartialMark))
+        throw InputError(shortPath(dir), "", "cannot write in " + shortPath(place.partial_));
     return place;
 }
 
@@ -297,6 +344,9 @@ void OutputPlace::refuseCommit(const std::string& why) {
 
 void OutputPlace::commit() {
     std::error_code ec;
+    // Once renamed into place the partial directory is the output, no leftover: its mark goes first
+    // (killed before the rename, an unmarked partial directory is left for the user, not removed).
+    fs::remove(fs::path(partial_) / kPartialMark, ec);
     struct stat st {};
     const bool exists = ::lstat(final_.c_str(), &st) == 0;
     // Only what open() checked is replaced: a directory that appeared since (a run into a folder
@@ -314,6 +364,7 @@ void OutputPlace::commit() {
         } else if (errno == EINVAL || errno == ENOSYS) {
             // A file system without exchange: two renames; open() recovers DIR.old-PID if killed between.
             std::string old = final_ + ".old-" + pidSuffix();
+            (void)writeMark(fs::path(final_) / kOldMark); // without it a leftover is kept, not recovered
             fs::rename(final_, old, ec);
             if (ec) throw RuntimeError("cannot move " + shortPath(final_) + " aside: " + ec.message());
             fs::rename(partial_, final_, ec);
