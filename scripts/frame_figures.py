@@ -27,6 +27,7 @@ from matplotlib.patches import Patch  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import plot_style  # noqa: E402
+from safe_files import open_regular, save_figure  # noqa: E402
 
 plot_style.plain_text()  # ids, heat map names and units are drawn as written: no mathtext
 
@@ -41,7 +42,7 @@ def heat_legends(directory):
     """Every heat map's legend (the runner's JSON), with the path of its labelled PNG added."""
     out = []
     for path in sorted(glob.glob(os.path.join(directory, "images", "*_heat_*.json"))):
-        with open(path, encoding="utf-8") as f:
+        with open_regular(path) as f:
             legend = json.load(f)
         legend["labelled"] = path[:-len(".json")] + "_labelled.png"
         legend["png"] = os.path.join(os.path.dirname(path), legend["image"])
@@ -112,7 +113,7 @@ def labelled_heat_maps(legends):
         fig = plt.figure(figsize=grid.size)
         ax, cax = grid.axes(fig, 0, 0, bar=True)
         draw_heat(ax, cax, legend, f"{legend['id']} · {legend['name']} · frame {legend['frame']}")
-        fig.savefig(legend["labelled"], dpi=100)
+        save_figure(fig, legend["labelled"], dpi=100)
         plt.close(fig)
 
 
@@ -121,7 +122,7 @@ def mismatch(directory):
     out = {}
     path = os.path.join(directory, "frames.csv")
     if os.path.exists(path):
-        with open(path, newline="", encoding="utf-8") as f:
+        with open_regular(path, newline="") as f:
             for row in csv.DictReader(f):
                 if row["stage"] == "total" and row.get("mismatch_ratio"):
                     out[(row["id"], int(row["frame"]))] = float(row["mismatch_ratio"])
@@ -191,7 +192,7 @@ def contact_sheet(path, frame, entries, ids, scores):
                 ax.set_title(f"{aid} · difference\n{note}", fontsize=7)
             else:
                 draw_heat(ax, cax, what, f"{aid} · {what['name']}")
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
 
 
@@ -200,7 +201,7 @@ def ordered_ids(directory, frames):
     ids = []
     path = os.path.join(directory, "frames.csv")
     if os.path.exists(path):
-        with open(path, newline="", encoding="utf-8") as f:
+        with open_regular(path, newline="") as f:
             ids = list(dict.fromkeys(row["id"] for row in csv.DictReader(f)))
     rest = sorted({i for per in frames.values() for i in per} - set(ids))
     ids += rest

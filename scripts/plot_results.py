@@ -27,6 +27,7 @@ import frame_figures  # noqa: E402
 import plot_style  # noqa: E402
 import report_html  # noqa: E402
 from report_html import link_target, literal  # noqa: E402
+from safe_files import open_regular, save_figure, write_text  # noqa: E402
 
 PLOTS = [("plot_frame_time.png", "Frame time along the fly-through"), ("plot_stages.png", "Mean time per frame of each stage"),
          ("plot_accuracy.png", "Accuracy against the reference along the fly-through")]
@@ -36,7 +37,7 @@ FIGURES_HEADING = "## Figures"
 def load(path, wall):
     total = defaultdict(dict)     # id -> frame -> row of the "total" stage
     stages = defaultdict(lambda: defaultdict(float))  # id -> stage -> sum of ms over frames
-    with open(path, newline="", encoding="utf-8") as f:
+    with open_regular(path, newline="") as f:
         for row in csv.DictReader(f):
             if row["stage"] == "total":
                 total[row["id"]][int(row["frame"])] = row
@@ -59,7 +60,7 @@ def plot_frame_time(directory, ids, total, colour):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(f"{directory}/plot_frame_time.png", dpi=120)
+    save_figure(fig, f"{directory}/plot_frame_time.png", dpi=120)
     plt.close(fig)
 
 
@@ -94,7 +95,7 @@ def plot_stages(directory, ids, total, stages, wall):
     ax.set_title("Mean time per frame of each stage (timed pass: statistics compiled out)")
     ax.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(f"{directory}/plot_stages.png", dpi=120)
+    save_figure(fig, f"{directory}/plot_stages.png", dpi=120)
     plt.close(fig)
 
 
@@ -114,7 +115,7 @@ def plot_accuracy(directory, ids, total, colour):
     if plotted:
         ax.legend()
     fig.tight_layout()
-    fig.savefig(f"{directory}/plot_accuracy.png", dpi=120)
+    save_figure(fig, f"{directory}/plot_accuracy.png", dpi=120)
     plt.close(fig)
 
 
@@ -143,14 +144,13 @@ def append_figures(directory, sheets, heats):
     path = os.path.join(directory, "report.md")
     if not os.path.exists(path):
         return None
-    with open(path, encoding="utf-8") as f:
+    with open_regular(path) as f:
         text = f.read()
     cut = text.find("\n" + FIGURES_HEADING + "\n")
     if cut >= 0:
         text = text[:cut + 1]
     text = text.rstrip("\n") + "\n\n" + "\n".join(figures_section(directory, sheets, heats)).rstrip("\n") + "\n"
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
+    write_text(path, text)
     return path
 
 

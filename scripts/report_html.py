@@ -31,6 +31,9 @@ import stat
 import sys
 import urllib.parse
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from safe_files import read_text, write_text  # noqa: E402
+
 STYLE = """
 body { font: 14px/1.45 system-ui, sans-serif; margin: 2em auto; max-width: 1400px; padding: 0 1em; color: #222; }
 table { border-collapse: collapse; margin: 0.6em 0 1.2em; font-size: 12px; }
@@ -336,16 +339,11 @@ def to_html(markdown, base, title):
 
 
 def convert(markdown_path, html_path):
-    with open(markdown_path, encoding="utf-8") as f:
-        text = f.read()
+    text = read_text(markdown_path)
     first = next((l for l in text.split("\n") if l.startswith("# ")), "# report")
     title = bounded(unescape(first[2:].strip()), MAX_ALT_CHARS)
     page = to_html(text, os.path.dirname(os.path.abspath(markdown_path)), title)
-    # Written beside and renamed: a reader never sees half a page.
-    tmp = html_path + ".tmp"
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(page)
-    os.replace(tmp, html_path)
+    write_text(html_path, page)  # atomic: a reader never sees half a page
 
 
 if __name__ == "__main__":

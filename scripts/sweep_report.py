@@ -22,6 +22,7 @@ from collections import defaultdict
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from report_html import link_target, literal  # noqa: E402
+from safe_files import open_regular, save_figure, write_text  # noqa: E402
 
 SIZE_SCALES = ("value", "triangles", "pixels")
 
@@ -52,14 +53,14 @@ def nlogn_ratio(ns, ts):
 
 class Sweep:
     def __init__(self, directory):
-        with open(os.path.join(directory, "plan.json"), encoding="utf-8") as f:
+        with open_regular(os.path.join(directory, "plan.json")) as f:
             self.plan = json.load(f)
         self.axes = self.plan["axes"]
         self.merge = self.plan.get("merge") or {}
         # run id -> {"axes": {name: label}, "triangles", "pixels", "values": {alg id: {measure: float}}}
         self.runs = {}
         self.algorithms = {}  # alg id -> algorithm name, in first-seen order
-        with open(os.path.join(directory, "sweep.csv"), newline="", encoding="utf-8") as f:
+        with open_regular(os.path.join(directory, "sweep.csv"), newline="") as f:
             for row in csv.DictReader(f):
                 r = self.runs.setdefault(row["run"], {"index": int(row["index"]), "triangles": int(row["triangles"]),
                                                       "pixels": int(row["pixels"]), "values": defaultdict(dict),
@@ -215,8 +216,7 @@ def report(s, directory):
     for axis in s.axes:
         if axis["scale"] in SIZE_SCALES:
             lines += [""] + fit_table(s, axis)
-    with open(os.path.join(directory, "sweep.md"), "w", encoding="utf-8") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(os.path.join(directory, "sweep.md"), "\n".join(lines) + "\n")
 
 
 def axis_table_flat(s):
@@ -281,7 +281,7 @@ def plots(s, directory):
             ax.legend(fontsize=7)
         fig.suptitle(f"{s.plan['name']}: time per frame against {axis['name']}")
         fig.tight_layout()
-        fig.savefig(os.path.join(directory, plot_file(s, axis)), dpi=110)
+        save_figure(fig, os.path.join(directory, plot_file(s, axis)), dpi=110)
         plt.close(fig)
 
 
@@ -322,7 +322,7 @@ def stage_plot(s, directory):
                                for name, st in style.items()], title="stage", loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
     fig.suptitle(f"{s.plan['name']}: mean time per frame of each stage, run by run")
     path = os.path.join(directory, "sweep_stages.png")
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -333,7 +333,7 @@ def figures(s, directory):
     names.append(("sweep_stages.png", "The stages of each run, per algorithm id"))
     shown = [(n, title) for n, title in names if os.path.exists(os.path.join(directory, n))]
     path = os.path.join(directory, "sweep.md")
-    with open(path, encoding="utf-8") as f:
+    with open_regular(path) as f:
         text = f.read()
     cut = text.find("\n## Figures\n")
     if cut >= 0:
@@ -341,8 +341,7 @@ def figures(s, directory):
     if shown:
         text = text.rstrip("\n") + "\n\n## Figures\n\n" + "\n\n".join(
             f"![{literal(title)}]({link_target(n)})" for n, title in shown) + "\n"
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(text)
+        write_text(path, text)
 
 
 def html_report(directory):

@@ -24,6 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import plot_style  # noqa: E402
+from safe_files import open_regular, save_figure  # noqa: E402
 
 
 def stage_median(algorithm):
@@ -35,7 +36,7 @@ def stage_median(algorithm):
 def worst_rmse(directory):
     """Largest RMSE over the frames per algorithm id (frames.csv; one row per frame carries it)."""
     worst = {}
-    with open(os.path.join(directory, "frames.csv")) as f:
+    with open_regular(os.path.join(directory, "frames.csv")) as f:
         for row in csv.DictReader(f):
             if row.get("rmse"):
                 worst[row["id"]] = max(worst.get(row["id"], 0.0), float(row["rmse"]))
@@ -43,7 +44,7 @@ def worst_rmse(directory):
 
 
 def points(directory, baseline):
-    with open(os.path.join(directory, "summary.json")) as f:
+    with open_regular(os.path.join(directory, "summary.json")) as f:
         summary = json.load(f)
     worst = worst_rmse(directory)
     algorithms = summary["algorithms"]
@@ -92,7 +93,7 @@ def main(argv):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
-    fig.savefig(target, dpi=120)
+    save_figure(fig, target, dpi=120)
 
 
 if __name__ == "__main__":

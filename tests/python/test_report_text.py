@@ -441,6 +441,50 @@ class SweepReportTest(unittest.TestCase):
         self.assertEqual(len(re.findall(r"^!\[", md, flags=re.M)), 3)
 
 
+class PlantedTargetTest(unittest.TestCase):
+    """A link, FIFO or directory planted at a report's name in the folder (sweep.md, sweep.html, a
+    plot): the script refuses it in one line with status 2, promptly, and writes nothing through it
+    (a probe found `sweep merge` overwriting a file outside the folder through a link at sweep.md,
+    and hanging on a FIFO there)."""
+
+    def run_with(self, planted, make):
+        directory = tempfile.mkdtemp(prefix="sweep-planted-")
+        self.addCleanup(shutil.rmtree, directory, True)
+        fake_sweep(directory)
+        victim = os.path.join(directory + "-victim")
+        with open(victim, "w", encoding="utf-8") as f:
+            f.write("precious")
+        self.addCleanup(lambda: os.path.exists(victim) and os.unlink(victim))
+        make(os.path.join(directory, planted), victim)
+        start = time.monotonic()
+        r = subprocess.run([sys.executable, os.path.join(SCRIPTS, "sweep_report.py"), directory, "--no-plots"],
+                           capture_output=True, text=True, timeout=60)
+        self.assertLess(time.monotonic() - start, 30)
+        with open(victim, encoding="utf-8") as f:
+            self.assertEqual(f.read(), "precious")
+        return r
+
+    def test_link_at_sweep_md(self):
+        r = self.run_with("sweep.md", lambda path, victim: os.symlink(victim, path))
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+        self.assertIn("not a regular file", r.stderr)
+
+    def test_link_at_sweep_html(self):
+        r = self.run_with("sweep.html", lambda path, victim: os.symlink(victim, path))
+        self.assertEqual(r.returncode, 2, r.stderr)
+
+    def test_fifo_at_sweep_md(self):
+        r = self.run_with("sweep.md", lambda path, victim: os.mkfifo(path))
+        self.assertEqual(r.returncode, 2, r.stderr)
+
+    def test_writes_are_atomic_and_leave_no_temporary(self):
+        r = self.run_with("unrelated.txt", lambda path, victim: None)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        directory = os.path.dirname(os.path.abspath(r.args[2]) + "/x")
+        self.assertEqual([n for n in os.listdir(directory) if n.endswith(".tmp")], [])
+
+
 class RunReportTest(unittest.TestCase):
     """plot_results.py (and frame_figures.py) on a fake run whose ids, stages and heat map names are hostile."""
 
