@@ -53,6 +53,45 @@ TEST(UserTextTest, TheRuleRefusesInvisibleAndLineBreakingText) {
     EXPECT_NE(userTextProblem("a\xC2\x85" "b"), "") << "U+0085, a C1 line break";
     EXPECT_NE(userTextProblem("\xff"), "");
     EXPECT_NE(userTextProblem(std::string(201, 'n')), "");
+    // Every other invisible format character (a probe's finds): tags, soft hyphen, Mongolian vowel
+    // separator, interlinear annotation, Hangul filler.
+    for (const char* s : {"hi\xF3\xA0\x81\x81", "a\xC2\xAD" "b", "a\xE1\xA0\x8E" "b", "a\xEF\xBF\xB9" "b", "a\xE3\x85\xA4" "b"})
+        EXPECT_NE(userTextProblem(s), "") << s;
+    EXPECT_EQ(pathTextProblem("results/engine orbit " + std::string(300, 'n')), "") << "a path has no length bound";
+    EXPECT_NE(pathTextProblem("r\xE2\x80\xAE" "abc"), "");
+    EXPECT_NE(pathTextProblem("z\xE2\x80\x8B" "w"), "");
+}
+
+// An error line echoes what it refuses masked: no U+2028 or U+0085 that ends the line for a
+// Unicode-aware reader, no U+202E that reverses the terminal's text.
+TEST(UserTextTest, ErrorLinesMaskTheInvisibleCharactersTheyRefuse) {
+    for (const std::string& name : {std::string("a\\u2028b"), std::string("a\\u0085b"), std::string("abc\\u202edef")}) {
+        const Result r = shell(kBin + " validate " + kSmoke + " --set 'name=\"" + name + "\"'");
+        expectOneLineNaming(r, "/name");
+        for (const char* raw : {"\xE2\x80\xA8", "\xC2\x85", "\xE2\x80\xAE"}) EXPECT_EQ(r.out.find(raw), std::string::npos) << r.out;
+    }
+    const Result key = shell(kBin + " validate " + kSmoke + " --set 'x\xE2\x80\xAE=1'");
+    EXPECT_EQ(key.rc, 2) << key.out;
+    EXPECT_EQ(key.out.find("\xE2\x80\xAE"), std::string::npos) << key.out;
+}
+
+// A config whose path is not UTF-8 validated, rendered a whole run, then failed writing
+// summary.json; refused at validation now, naming the file.
+TEST(UserTextTest, AConfigPathThatIsNotUtf8IsRefusedAtValidation) {
+    const std::string file = test::makeTempDir("user-text-cfgpath") + "/c\xff.json";
+    fs::copy_file(kSmoke, file);
+    const Result r = shell(kBin + " validate '" + file + "'");
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("not valid UTF-8"), std::string::npos) << r.out;
+}
+
+// What validate accepts, run runs: an output.dir that no run can use ("/", a file, a device) is
+// refused by validate at /output/dir.
+TEST(UserTextTest, ValidateRefusesAnOutputPlaceNoRunCanUse) {
+    for (const char* dir : {"/", "/dev/null", "/etc/hostname"}) {
+        const Result r = shell(kBin + " validate " + kSmoke + " --set 'output.dir=\"" + dir + "\"'");
+        expectOneLineNaming(r, "/output/dir");
+    }
 }
 
 // Reproduction 4 (and 12's non-UTF-8 name): a name that is not one line of plain text is bad input.
@@ -74,7 +113,8 @@ TEST(UserTextTest, AnOutputFolderThatIsNotUtf8IsRefusedAtValidation) {
         "scene": {"objects": [{"procedural": "plane", "size": [6, 6]}]}})");
     const std::string file = test::writeJson(dir + "/c.json", c);
     const Result r = shell(kBin + " validate '" + file + "'");
-    expectOneLineNaming(r, "/output/dir");
+    // The config's own path is the first thing refused (its folder names the default output).
+    expectOneLineNaming(r, "not valid UTF-8");
 }
 
 // Reproductions 1-3: the name is shown as text, never read as a link or an image, in report.md and
@@ -148,6 +188,12 @@ TEST(UserTextTest, ASweepInsideARunsOutputIsRefusedUpFront) {
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("inside"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(dir + "/A/sw"));
+    // Into the run's output itself: refused before anything is written there.
+    const Result into = shell(kBin + " sweep run " + file + " --out " + dir + "/A");
+    EXPECT_EQ(into.rc, 2) << into.out;
+    EXPECT_NE(into.out.find("a run's output"), std::string::npos) << into.out;
+    EXPECT_FALSE(fs::exists(dir + "/A/runs"));
+    EXPECT_FALSE(fs::exists(dir + "/A/sweep.json"));
 }
 
 // Reproduction 12: a long path on an object that a grid copies is held once, not once per copy (a

@@ -4,6 +4,7 @@
 #include "framework/core/Interrupt.h"
 #include "framework/experiment/Config.h"
 #include "framework/experiment/MemoryPlan.h"
+#include "framework/experiment/OutputPlace.h"
 #include "framework/experiment/DeviceReport.h"
 #include "framework/experiment/Runner.h"
 #include "framework/gl/DeviceInfo.h"
@@ -137,7 +138,7 @@ int run(const std::vector<std::string>& args) {
             if (++i >= args.size()) usageError("--out needs a directory");
             if (args[i].empty()) usageError("--out must not be empty (leave it out for the config's output.dir)");
             // The folder's name reaches summary.json and the report, which hold UTF-8 text only.
-            if (const std::string why = textProblem(args[i], 0); !why.empty()) usageError("--out: the folder's name " + why);
+            if (const std::string why = pathTextProblem(args[i]); !why.empty()) usageError("--out: the folder's name " + why);
             opt.outputDir = args[i];
         } else if (a == "--force") {
             opt.force = true;
@@ -330,6 +331,12 @@ static int dispatch(std::vector<std::string> args) {
             }
             if (config.empty()) usageError("validate needs a config file");
             ExperimentConfig cfg = loadConfig(config, true, overrides);
+            // What validate accepts, run runs: the output place too (run --out may name another).
+            try {
+                OutputPlace::check(cfg.outputDir);
+            } catch (const InputError& e) {
+                throw InputError(config, "/output/dir", e.cause());
+            }
             std::cout << cfg.resolved.dump(2) << "\n";
             std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", shortText(config, 300).c_str(), cfg.scene->triangleCount(),
                          cfg.algorithms.size(), cfg.reference ? " + reference" : "");

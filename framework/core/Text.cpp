@@ -59,12 +59,42 @@ std::string textProblem(const std::string& text, size_t maxChars) {
     return "";
 }
 
+namespace {
+/// The code point of the well-formed UTF-8 sequence of `n` bytes at text[i].
+uint32_t codePoint(const std::string& text, size_t i, size_t n) {
+    const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+    if (n == 1) return byte(i);
+    uint32_t cp = byte(i) & (n == 2 ? 0x1F : n == 3 ? 0x0F : 0x07);
+    for (size_t k = 1; k < n; ++k) cp = (cp << 6) | (byte(i + k) & 0x3F);
+    return cp;
+}
+
+/// Characters that change how a line reads without being seen (userTextProblem's list): C1
+/// controls, every format character of Unicode's general category Cf (bidirectional controls,
+/// zero-width characters, soft hyphen, invisible operators, tags, ...), the line and paragraph
+/// separators, and the characters that render as nothing (Hangul fillers, the combining grapheme
+/// joiner, Mongolian variation selectors, Khmer inherent vowels).
+bool isInvisibleFormatting(uint32_t cp) {
+    const auto in = [cp](uint32_t lo, uint32_t hi) { return cp >= lo && cp <= hi; };
+    return in(0x80, 0x9F) || cp == 0xAD || cp == 0x34F || in(0x600, 0x605) || cp == 0x61C || cp == 0x6DD || cp == 0x70F ||
+           in(0x890, 0x891) || cp == 0x8E2 || in(0x115F, 0x1160) || in(0x17B4, 0x17B5) || in(0x180B, 0x180F) ||
+           in(0x200B, 0x200F) || in(0x2028, 0x202E) || in(0x2060, 0x206F) || cp == 0x3164 || cp == 0xFEFF || cp == 0xFFA0 ||
+           in(0xFFF9, 0xFFFB) || cp == 0x110BD || cp == 0x110CD || in(0x13430, 0x1343F) || in(0x1BCA0, 0x1BCA3) ||
+           in(0x1D173, 0x1D17A) || in(0xE0000, 0xE0FFF);
+}
+
+bool isAsciiAlnum(char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
+} // namespace
+
 std::string shortText(const std::string& text, size_t maxChars) {
     std::string out;
     for (size_t i = 0; i < text.size();) {
         if (out.size() >= maxChars) return out + "...";
         const size_t n = utf8Length(text, i);
-        if (n == 0 || (n == 1 && isControl(static_cast<unsigned char>(text[i])))) {
+        // Controls and invisible formatting (a U+2028 that ends the line for a Unicode-aware
+        // reader, a U+202E that reverses the terminal's text) are masked: an error line echoes
+        // what was refused, and stays one plain line.
+        if (n == 0 || (n == 1 && isControl(static_cast<unsigned char>(text[i]))) || isInvisibleFormatting(codePoint(text, i, n))) {
             out += '?';
             i += n ? n : 1;
         } else {
@@ -92,38 +122,31 @@ std::string validUtf8(const std::string& text) {
 }
 
 
+
 namespace {
-/// The code point of the well-formed UTF-8 sequence of `n` bytes at text[i].
-uint32_t codePoint(const std::string& text, size_t i, size_t n) {
-    const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
-    if (n == 1) return byte(i);
-    uint32_t cp = byte(i) & (n == 2 ? 0x1F : n == 3 ? 0x0F : 0x07);
-    for (size_t k = 1; k < n; ++k) cp = (cp << 6) | (byte(i + k) & 0x3F);
-    return cp;
-}
-
-/// Characters that change how a line reads without being seen (userTextProblem's list).
-bool isInvisibleFormatting(uint32_t cp) {
-    return (cp >= 0x80 && cp <= 0x9F) || cp == 0x061C || (cp >= 0x200B && cp <= 0x200F) || (cp >= 0x2028 && cp <= 0x202E) ||
-           (cp >= 0x2060 && cp <= 0x2069) || cp == 0xFEFF;
-}
-
-bool isAsciiAlnum(char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
-} // namespace
-
-std::string userTextProblem(const std::string& text) {
-    if (std::string why = textProblem(text, kMaxLabelChars); !why.empty()) return why;
+std::string invisibleProblem(const std::string& text) {
     for (size_t i = 0; i < text.size();) {
         const size_t n = utf8Length(text, i);
         if (const uint32_t cp = codePoint(text, i, n); isInvisibleFormatting(cp)) {
             char hex[16];
             std::snprintf(hex, sizeof hex, "U+%04X", unsigned(cp));
             return std::string("holds the invisible formatting character ") + hex +
-                   " (a bidirectional override, zero-width character, separator or C1 control)";
+                   " (a bidirectional control, zero-width or other invisible formatting character, a line separator or a C1 control)";
         }
         i += n;
     }
     return "";
+}
+} // namespace
+
+std::string userTextProblem(const std::string& text) {
+    if (std::string why = textProblem(text, kMaxLabelChars); !why.empty()) return why;
+    return invisibleProblem(text);
+}
+
+std::string pathTextProblem(const std::string& path) {
+    if (std::string why = textProblem(path, 0); !why.empty()) return why;
+    return invisibleProblem(path);
 }
 
 std::string markdownLiteral(const std::string& text) {

@@ -32,6 +32,12 @@ std::string textProblem(const std::string& text, size_t maxChars);
 /// "" when `text` may be used.
 std::string userTextProblem(const std::string& text);
 
+/// The rule for a path the user names (a config, an output folder): UTF-8 without control
+/// characters (summary.json and the reports hold it) and none of userTextProblem()'s invisible
+/// characters (a U+202E in a folder's name makes every line that names it read backwards); any
+/// length. "" when the path may be used.
+std::string pathTextProblem(const std::string& path);
+
 /// `text` as Markdown that renders as exactly `text`: every character CommonMark or a pipe table
 /// could read as markup is backslash-escaped: \ ` * [ ] ( ) ! | < > # ~ & { } + - . = $ :
 /// and '_' unless it stands between two letters or digits (CommonMark never emphasises there,

@@ -216,6 +216,9 @@ Light ExperimentConfig::lightAt(int frame) const {
 ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loadScene) {
     ExperimentConfig c;
     c.file = file;
+    // The file's path reaches summary.json and the report (UTF-8 text): refused here, as validate
+    // runs it, not after a whole run has rendered.
+    if (const std::string why = pathTextProblem(file); !why.empty()) throw InputError(shortText(file), "", "the file's path " + why);
     c.resolved = Json::object();
     JsonNode root(file, &json, "", &c.resolved);
     c.name = root.getString("name", "experiment");
@@ -279,7 +282,7 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
         root.fail("name", "\"" + shortText(c.name, 60) + "\" cannot name the default output folder results/NAME (it holds '/' or "
                           "'\\', or is '.' or '..'): give output.dir");
     c.outputDir = out.getPath("dir", "results/" + c.name);
-    if (const std::string why = textProblem(c.outputDir, 0); !why.empty()) out.fail("dir", "the folder's name " + why);
+    if (const std::string why = pathTextProblem(c.outputDir); !why.empty()) out.fail("dir", "the folder's name " + why);
     c.imagesAtFrames = out.getIntList("images_at_frames", {0});
     for (int f : c.imagesAtFrames)
         if (f < 0 || f >= c.frames)

@@ -228,15 +228,26 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
 
 } // namespace
 
-OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<std::string>* notes) {
+void OutputPlace::check(const std::string& given) {
     const std::string dir = normalize(given);
     if (dir.empty()) throw InputError("--out", "", "the output directory must not be empty");
     if (dir == "/" || containsWorkingDir(dir))
         throw InputError(shortPath(dir), "", "the output directory cannot be the working directory or one above it "
                                   "(an output is a directory of its own, e.g. --out results/run1)");
+    checkAncestors(dir);
+    std::error_code ec;
+    const auto status = fs::symlink_status(dir, ec);
+    if (fs::is_symlink(status))
+        throw InputError(shortPath(dir), "", "the output path is a symbolic link; give the directory it should name instead");
+    if (fs::exists(status) && !fs::is_directory(status))
+        throw InputError(shortPath(dir), "", "the output path exists and is not a directory");
+}
+
+OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<std::string>* notes) {
+    const std::string dir = normalize(given);
+    check(dir);  // before anything is created
     fs::path finalPath(dir);
     fs::path parent = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
-    checkAncestors(dir);  // before anything is created
     std::error_code ec;
     fs::create_directories(parent, ec);
     if (ec) throw InputError(shortPath(dir), "", "cannot create the parent directory " + shortPath(parent.string()) + ": " + ec.message());
@@ -389,6 +400,11 @@ void OutputPlace::commit() {
         committed_ = true;
     }
     release();
+}
+
+bool OutputPlace::isRunOutput(const std::string& dir) {
+    const std::string m = markerOf(fs::path(dir));
+    return m == "summary.json" || m == "config.resolved.json";
 }
 
 bool OutputPlace::isCompleteOutput(const std::string& dir) {

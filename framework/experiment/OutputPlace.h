@@ -30,6 +30,10 @@ public:
     /// InputError when `dir` lies inside a run in progress, a run's temporary folder, another run's
     /// output or a sweep (but for a sweep's own runs/ID): checked before anything is created there.
     static void refuseNestedPlace(const std::string& dir);
+    /// InputError when `dir` can never hold an output, whatever --force says: empty, "/", the
+    /// working directory or one above it, nested (refuseNestedPlace), a link or a non-directory.
+    /// open() checks it first; `validate` checks a config's output.dir with it.
+    static void check(const std::string& dir);
 
     OutputPlace(OutputPlace&& other) noexcept;
     OutputPlace& operator=(OutputPlace&&) = delete;
@@ -43,6 +47,8 @@ public:
 
     /// Whether `dir` holds a finished experiment (its summary.json, written last, is present).
     static bool isCompleteOutput(const std::string& dir);
+    /// Whether `dir` is a run's output, finished or not (summary.json or config.resolved.json).
+    static bool isRunOutput(const std::string& dir);
 
 private:
     OutputPlace() = default;

@@ -111,7 +111,7 @@ std::string get(const Args& a, const std::string& key, const std::string& def = 
 std::string outputDir(const Args& a, const Sweep& s) {
     const std::string dir = get(a, "--out", s.outputDir);
     if (dir.empty()) throw InputError("--out", "", "must not be empty (the sweep's folder: DIR/sweep.json, DIR/runs/)");
-    if (const std::string why = textProblem(dir, 0); !why.empty()) throw InputError("--out", "", "the folder's name " + why);
+    if (const std::string why = pathTextProblem(dir); !why.empty()) throw InputError("--out", "", "the folder's name " + why);
     return dir;
 }
 

@@ -324,7 +324,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     Sweep s;
     s.file = file;
     // The file's name reaches plan.json and messages; its folder anchors every relative path.
-    if (const std::string why = textProblem(file, 0); !why.empty()) throw InputError(shortText(file), "", "the file's path " + why);
+    if (const std::string why = pathTextProblem(file); !why.empty()) throw InputError(shortText(file), "", "the file's path " + why);
     const std::string sweepDir = absoluteFolder(parentDir(file));
     if (!isValidUtf8(sweepDir)) throw InputError(file, "", "the absolute path of its folder is not valid UTF-8");
     JsonNode root(file, &json, "", nullptr);
@@ -344,7 +344,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     std::string baseFile = file, baseDir = sweepDir, baseWhere = "/base";
     if (base.is_string()) {
         baseFile = resolvePath(sweepDir, base.get<std::string>());
-        if (const std::string why = textProblem(baseFile, 0); !why.empty()) root.fail("base", "the file name " + why);
+        if (const std::string why = pathTextProblem(baseFile); !why.empty()) root.fail("base", "the file name " + why);
         s.base = JsonNode::parseFile(baseFile);
         baseDir = absoluteFolder(parentDir(baseFile));
         baseWhere = "";
@@ -403,7 +403,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     if (out.has("dir") && out.raw()["dir"].is_string() && out.raw()["dir"].get<std::string>().empty())
         out.fail("dir", "must not be empty (the sweep's folder: DIR/sweep.json, DIR/runs/)");
     s.outputDir = out.getPath("dir", "results/" + s.name);
-    if (const std::string why = textProblem(s.outputDir, 0); !why.empty()) out.fail("dir", "the folder's name " + why);
+    if (const std::string why = pathTextProblem(s.outputDir); !why.empty()) out.fail("dir", "the folder's name " + why);
     out.finish();
     root.finish();
 
