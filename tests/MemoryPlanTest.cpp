@@ -146,5 +146,33 @@ TEST(MemoryPlanTest, NoFootprintWrapsPast64Bits) {
     }
 }
 
+// The plan follows the parameters that size what an algorithm holds (a probe found shadow_map at
+// resolution 4096 planned at 0 bytes while it held 768 MiB, and izb's and ptsv's job lists at their
+// largest capacity planned at a quarter and a ten-thousandth of what they hold): each estimate is at
+// least the buffers the parameter makes.
+TEST(MemoryPlanTest, EstimatesFollowTheParametersThatSizeTheStructures) {
+    struct Case {
+        const char* algorithm;
+        const char* key;
+        int value;
+        size_t atLeast;
+    };
+    const Case cases[] = {{"shadow_map", "resolution", 8192, size_t(6) * 8192 * 8192 * 8},
+                          {"izb", "job_capacity", 1 << 26, (size_t(1) << 26) * 8},
+                          {"ptsv", "job_capacity", 1 << 24, (size_t(1) << 24) * 8}};
+    for (const Case& c : cases) {
+        const AlgorithmInfo* a = findAlgorithm(c.algorithm);
+        ASSERT_NE(a, nullptr) << c.algorithm;
+        ASSERT_NE(a->footprint, nullptr) << c.algorithm << " has no estimate";
+        ParamValues params(a->schema());
+        params.set(c.key, c.value);
+        FootprintQuery q;
+        q.resolution = {64, 64};
+        q.params = &params;
+        q.triangles = 1000;
+        EXPECT_GE(a->footprint(q).bytes, c.atLeast) << c.algorithm << " " << c.key << " " << c.value;
+    }
+}
+
 } // namespace
 } // namespace shadowlab

@@ -17,6 +17,9 @@
 namespace shadowlab {
 namespace {
 
+/// The grid's side for the parameter `grid` (0 = auto) at image size r: see the schema.
+int gridSide(int grid, glm::ivec2 r) { return grid > 0 ? grid : std::clamp((std::max(r.x, r.y) / 2 + 7) / 8 * 8, 64, 1024); }
+
 struct IzbParams {
     int grid;        ///< cells per face side
     int jobCapacity; ///< jobs the list holds
@@ -73,7 +76,7 @@ public:
     }
 
     void resize(glm::ivec2 r) override {
-        grid_ = p_.grid > 0 ? p_.grid : std::clamp((std::max(r.x, r.y) / 2 + 7) / 8 * 8, 64, 1024);
+        grid_ = gridSide(p_.grid, r);
         const size_t cells = size_t(6) * size_t(grid_) * size_t(grid_);
         const size_t tilesPerSide = size_t((grid_ + IZB_TILE - 1) / IZB_TILE);
         head_ = GlBuffer(cells * 4, nullptr, 0);
@@ -251,8 +254,13 @@ private:
 /// Per pixel (lists, samples, visibility) and per cell of its grid; the triangles are read through
 /// the scene positions' view.
 Footprint izbFootprint(const FootprintQuery& q) {
+    // The buffers resize() and the constructor make, at the configured grid and job capacity.
+    const size_t grid = size_t(gridSide(std::get<int>(q.params->get("grid")), q.resolution));
+    const size_t cells = 6 * grid * grid, tiles = 6 * ((grid + IZB_TILE - 1) / IZB_TILE) * ((grid + IZB_TILE - 1) / IZB_TILE);
+    const size_t pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
+    const size_t jobs = size_t(std::get<int>(q.params->get("job_capacity"))) * 8;
     Footprint f;
-    f.bytes = 32 * size_t(q.resolution.x) * size_t(q.resolution.y) + 6 * 24 * 1024 * 1024;
+    f.bytes = saturatingSum({saturatingMul(pixels, 24 + 32), jobs, cells * 8, tiles * 8, 4096});
     f.refusal = texelRefusal(q, "the scene positions' view it reads", saturatingMul(3, q.triangles));
     return f;
 }

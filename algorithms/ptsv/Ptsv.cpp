@@ -542,7 +542,8 @@ private:
 Footprint ptsvFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t planes = saturatingMul(q.triangles, PTSV_PLANES_PER_TRIANGLE * 16);
-    f.bytes = saturatingSum({planes, 40 * size_t(q.resolution.x) * size_t(q.resolution.y)});
+    const size_t jobs = std::get<bool>(q.params->get("two_pass")) ? size_t(std::get<int>(q.params->get("job_capacity"))) * 8 : 0;
+    f.bytes = saturatingSum({planes, 40 * size_t(q.resolution.x) * size_t(q.resolution.y), jobs});
     f.refusal = storageRefusal(q, "its shadow-volume planes", planes, true);
     return f;
 }

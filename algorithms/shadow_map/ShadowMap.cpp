@@ -1,6 +1,7 @@
 #include "algorithms/shadow_map/ShadowMap.h"
 
 #include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/core/CheckedMath.h"
 #include "framework/render/LightUniforms.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -179,10 +180,21 @@ private:
 
 } // namespace
 
+/// Its maps at the configured resolution: 8 bytes a texel (distance and depth), on the six faces of
+/// a cube map and one 2D map (the plan does not know the light: the most any light asks for).
+Footprint shadowMapFootprint(const FootprintQuery& q) {
+    const size_t r = size_t(std::get<int>(q.params->get("resolution")));
+    Footprint f;
+    f.bytes = saturatingMul(saturatingMul(r, r), 8 * 7);
+    return f;
+}
+
 AlgorithmInfo shadowMapInfo() {
-    return makeAlgorithmInfo<ShadowMap>("shadow_map",
+    AlgorithmInfo info = makeAlgorithmInfo<ShadowMap>("shadow_map",
                                         "shadow maps: 2D for spot/directional, cube map for point lights, constant + slope bias, PCF",
                                         {LightType::Point, LightType::Spot, LightType::Directional}, false, &schema);
+    info.footprint = &shadowMapFootprint;
+    return info;
 }
 
 } // namespace shadowlab
