@@ -260,6 +260,29 @@ TEST_F(MetricTreeGLTest, FaultPendingDeltaSurvivesUndefinedNanConversion) {
     }
 }
 
+// Every loop of both queries ended from outside after a few dozen passes (a fault site, test-only:
+// llvmpipe's loop limit, one budget for all loops of an invocation): the cut pixels are counted
+// and written shadowed, never lit (before, a cut walk or triangle loop left its pixel lit).
+TEST_F(MetricTreeGLTest, FaultLoopsEndedFromOutsideAreCappedAndWrittenShadowed) {
+    const Shot shot = thousandsOfTriangles();
+    for (const char* query : {"pixel", "tile"}) {
+        SCOPED_TRACE(query);
+        const AlgorithmRun clean = runAlgorithm(metricTreeInfo(), shot, {{"query", std::string(query)}});
+        AlgorithmRun o;
+        {
+            ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_LOOP_BUDGET", "40"}});
+            o = runAlgorithm(metricTreeInfo(), shot, {{"query", std::string(query)}});
+        }
+        const double capped = o.counters.at("loop_capped_pixels");
+        EXPECT_GT(capped, 0.0);
+        EXPECT_EQ(o.overflow, uint64_t(capped));
+        expectOverflowedPixelsShadowed(o, capped);
+        size_t lighter = 0;
+        for (size_t i = 0; i < o.visibility.size(); ++i) lighter += o.visibility[i] > clean.visibility[i];
+        EXPECT_EQ(lighter, 0u) << "pixels lit by mistake";
+    }
+}
+
 TEST_F(MetricTreeGLTest, TinyStackReportsOverflowAndNeverLightsAPixel) {
     Outcome o = run(thousandsOfTriangles(), {{"stack_size", 1}, {"overlap_interval", false}});
     const double pixels = o.counters["stack_overflow_pixels"];

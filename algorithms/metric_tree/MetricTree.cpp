@@ -277,6 +277,7 @@ public:
             return {{"clusters", n},
                     {"build_errors", double(c[MT_C_BUILD_ERRORS])},
                     {"stack_overflow_pixels", double(c[MT_C_STACK_OVERFLOW])},
+                    {"loop_capped_pixels", double(c[MT_C_LOOP_CAPPED])},
                     {"tile_pixels", tileQueryPixels()},
                     {"tile_fallbacks", double(c[MT_C_TILE_FALLBACKS])},
                     {"cache_hit", cacheHit_ ? 1.0 : 0.0},
@@ -311,6 +312,7 @@ public:
                 {"tile_nodes_per_pixel", perPixel(MT_C_TILE_NODES_LO)},
                 {"tile_fallbacks", double(c[MT_C_TILE_FALLBACKS])},
                 {"stack_overflow_pixels", double(c[MT_C_STACK_OVERFLOW])},
+                {"loop_capped_pixels", double(c[MT_C_LOOP_CAPPED])},
                 {"cache_hit", cacheHit_ ? 1.0 : 0.0},
                 {"clustering_ms", clusteringMs_}};
     }
@@ -331,10 +333,11 @@ public:
         return memoryBytes() + geometryBytes_ + restClusters_.size() + clusterPart_.size() + order_.size();
     }
 
-    /// Pixels whose query stack overflowed (written shadowed) plus build errors (must be 0).
+    /// Pixels whose query stack overflowed or whose loops were cut (both written shadowed) plus
+    /// build errors (must be 0).
     uint64_t overflowCount() const override {
         const auto& c = counters_.read();
-        return uint64_t(c[MT_C_STACK_OVERFLOW]) + c[MT_C_BUILD_ERRORS];
+        return uint64_t(c[MT_C_STACK_OVERFLOW]) + c[MT_C_LOOP_CAPPED] + c[MT_C_BUILD_ERRORS];
     }
 
     /// The tile shape tilePixels() gives on this device (used by the tile query).

@@ -74,4 +74,5 @@
 #define MT_C_TILE_NODES_LO 22      // nodes the tile query's caps visited (query: tile), low / high
 #define MT_C_TILE_NODES_HI 23
 #define MT_C_TILE_FALLBACKS 24     // tiles whose candidate list or stack was full: per-pixel query
-// Words 25..31 are reserved (the block size stays fixed).
+#define MT_C_LOOP_CAPPED 25        // pixels whose query loop was ended from outside (written shadowed)
+// Words 26..31 are reserved (the block size stays fixed).

@@ -11,6 +11,7 @@
 #include "common/shadow_ray.glsl"
 #include "metric_tree/tree.glsl"
 #include "common/pixel_order.glsl"
+#include "common/loop_fault.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
 // The tree, clusters and cluster-ordered triangles as buffer textures (views of the SSBOs the build
@@ -42,6 +43,7 @@ layout(r32f, binding = 2) writeonly uniform image2D uTriangleTests;
 layout(r32f, binding = 3) writeonly uniform image2D uFruitless;    // paper Figure 9
 layout(r32f, binding = 4) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
 #endif
+uniform uint uClusterCount; // nodes of the tree: no walk visits more (each node at most once)
 uniform float uRayOffset;     // world units: the reference's shadow-ray origin offset along the normal
 uniform float uSlabTolerance; // world units added on both sides of a cluster's slabs
 
@@ -107,10 +109,11 @@ struct Result {
     float visibility;
     uint visited, triangles, fruitless, coneHits, slabRejects, depthSkips;
     bool overflow;
+    bool capped; // a loop ended before its work did (a driver's loop limit, or the walk's cap)
 };
 
 Result query(vec3 q) {
-    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
+    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false, false);
     // The shadow ray: to the light (t in (0, 1)), or towards it forever for a directional light.
     vec3 dir = lightIsDirectional() ? -uLightDirection : uLightPosition - q;
     float tMax = lightIsDirectional() ? kMtInf : 1.0;
@@ -129,14 +132,20 @@ Result query(vec3 q) {
     // nothing left), then test that cluster's triangles. In a SIMD group (8 to 64 pixels in
     // lockstep) a pixel that found its cluster waits for the others to find theirs, and the group
     // tests all its pixels' clusters in one triangle loop instead of one loop per pixel's cluster.
-    bool done = false;
+    // `finished` is set only where the work really ends (the walk done, a hit, an overflow): a loop
+    // that a driver ends from outside leaves it false, and the pixel is written shadowed (rule 13).
+    bool done = false, finished = false;
     uint triangle = 0u, trianglesEnd = 0u; // the cluster to test: [triangle, trianglesEnd)
     while (!done) {
+        FAULT_LOOP_STEP()
         while (true) {
+            FAULT_LOOP_STEP()
             if (next == MT_NO_CHILD) {
-                if (sp == 0) { done = true; break; }
+                if (sp == 0) { done = true; finished = true; break; }
                 next = stack[--sp];
             }
+            // A tree's walk visits each node at most once: more is a corrupt tree, stopped here.
+            if (r.visited >= uClusterCount) { done = true; break; }
             uint node = next - 1u;
             ++r.visited;
             MtNode n = mtNode(node);
@@ -166,21 +175,24 @@ Result query(vec3 q) {
             next = follow;
             if (triangle < trianglesEnd) break;
         }
-        if (r.overflow) break;
+        if (r.overflow) { finished = true; break; }
         bool hit = false;
         for (; triangle < trianglesEnd && !hit; ++triangle) {
+            FAULT_LOOP_STEP()
             ++r.triangles;
             vec3 v0, v1, v2;
             mtTriangle(triangle, v0, v1, v2);
             hit = watertightHit(ray, v0, v1, v2);
         }
-        if (hit) { r.visibility = 0.0; break; }
+        if (hit) { r.visibility = 0.0; finished = true; break; }
+        if (triangle < trianglesEnd) break; // the triangle loop was ended from outside
         if (trianglesEnd != 0u) ++r.fruitless;
         triangle = trianglesEnd = 0u;
     }
 #undef MT_PUSH
-    // An overflowed pixel is never reported lit: it is written shadowed and counted.
-    if (r.overflow) r.visibility = 0.0;
+    // An overflowed or cut pixel is never reported lit: it is written shadowed and counted.
+    r.capped = !finished;
+    if (r.overflow || r.capped) r.visibility = 0.0;
     return r;
 }
 
@@ -206,12 +218,15 @@ bool testCluster(uint node, vec3 q, vec3 p, vec3 dir, float tMax, WatertightRay 
     MtCluster c = mtCluster(node);
     if (!mtCrossesSlabs(c, q, dir, tMax)) { ++r.slabRejects; return false; }
     bool hit = false;
-    for (uint tri = c.first; tri < c.first + c.count && !hit; ++tri) {
+    uint tri = c.first;
+    for (; tri < c.first + c.count && !hit; ++tri) {
+        FAULT_LOOP_STEP()
         ++r.triangles;
         vec3 v0, v1, v2;
         mtTriangle(tri, v0, v1, v2);
         hit = watertightHit(ray, v0, v1, v2);
     }
+    if (!hit && tri < c.first + c.count) r.capped = true; // ended from outside
     if (!hit) ++r.fruitless;
     return hit;
 }
@@ -242,23 +257,34 @@ void collectCandidates(uint tile) {
     vec3 c = vec3(0.0);
     float maxDepth = 0.0;
     uint valid = 0u, first = tile * uint(MT_TILE_PIXELS), end = first + uint(MT_TILE_PIXELS);
-    for (uint i = first; i < end; ++i)
+    uint i = first;
+    for (; i < end; ++i) {
+        FAULT_LOOP_STEP()
         if (sValid[i]) { c += sPoint[i]; maxDepth = max(maxDepth, sDepth[i]); ++valid; }
+    }
+    // A loop ended from outside leaves the cap too small: the tile's pixels query alone instead.
+    if (i < end) { sTileFallback[tile] = true; atomicAdd(mtCounters[MT_C_TILE_FALLBACKS], 1u); return; }
     if (valid == 0u) return;
     c = lightIsDirectional() ? c / float(valid) : normalize(c);
     float rho = 0.0;
-    for (uint i = first; i < end; ++i)
+    for (i = first; i < end; ++i) {
+        FAULT_LOOP_STEP()
         if (sValid[i]) rho = max(rho, lightIsDirectional() ? length(sPoint[i] - c) : mtAngle(c, sPoint[i]));
+    }
+    if (i < end) { sTileFallback[tile] = true; atomicAdd(mtCounters[MT_C_TILE_FALLBACKS], 1u); return; }
     rho += uLsEps; // far above the rounding of rho, of c's distances and of each pixel's
     uint stack[MT_STACK_SIZE];
     int sp = 0;
     uint next = mtCounters[MT_C_ROOT], count = 0u, visited = 0u;
 #define MT_TILE_PUSH(x) { if (sp == MT_STACK_SIZE) { sTileFallback[tile] = true; break; } stack[sp++] = (x); }
+    bool finished = false; // set only where the walk really ends (see query())
     while (true) {
+        FAULT_LOOP_STEP()
         if (next == MT_NO_CHILD) {
-            if (sp == 0) break;
+            if (sp == 0) { finished = true; break; }
             next = stack[--sp];
         }
+        if (visited >= uClusterCount) break; // more than the tree's nodes: corrupt, stopped
         uint node = next - 1u;
         ++visited;
         MtNode n = mtNode(node);
@@ -287,6 +313,7 @@ void collectCandidates(uint tile) {
         next = nearChild;
     }
 #undef MT_TILE_PUSH
+    if (!finished) sTileFallback[tile] = true; // ended from outside, or full: the per-pixel query
     sCandidateCount[tile] = count;
 #if SHADOWLAB_INSTRUMENTATION
     addWide(MT_C_TILE_NODES_LO, visited);
@@ -303,7 +330,7 @@ Result tileQuery(bool needs, vec3 q) {
     barrier();
     if (i < uint(MT_TILES)) collectCandidates(i);
     barrier();
-    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
+    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false, false);
     if (!needs) return r;
     uint tile = i / uint(MT_TILE_PIXELS);
     if (sTileFallback[tile]) return query(q);
@@ -313,8 +340,14 @@ Result tileQuery(bool needs, vec3 q) {
     vec3 p = sPoint[i];
     uint count = sCandidateCount[tile];
     bool hit = false;
-    for (uint k = 0u; k < count && !hit; ++k) hit = testCluster(sCandidates[tile][k], q, p, dir, tMax, ray, r);
-    if (hit) r.visibility = 0.0;
+    uint k = 0u;
+    for (; k < count && !hit; ++k) {
+        FAULT_LOOP_STEP()
+        hit = testCluster(sCandidates[tile][k], q, p, dir, tMax, ray, r);
+    }
+    if (!hit && k < count) r.capped = true; // ended from outside
+    if (hit) r.capped = false;              // a hit is a hit, whatever was left
+    if (hit || r.capped) r.visibility = 0.0;
     return r;
 }
 #endif
@@ -341,7 +374,7 @@ void main() {
             if (dot(nrm, toLight(x)) > 0.0) { needs = true; q = x + nrm * uRayOffset; }
         }
     }
-    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false);
+    Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false, false);
 #if MT_QUERY_TILE
     r = tileQuery(needs, q);
 #else
@@ -349,6 +382,8 @@ void main() {
 #endif
     if (needs) {
         visibility = r.visibility;
+        // Pixels a cut loop wrote shadowed: counted in both modes (never a silent wrong image).
+        if (r.capped) atomicAdd(mtCounters[MT_C_LOOP_CAPPED], 1u);
 #if SHADOWLAB_INSTRUMENTATION
         atomicAdd(sTraversed, 1u);
         atomicAdd(sVisited, r.visited);
@@ -372,7 +407,7 @@ void main() {
         imageStore(uNodesVisited, px, vec4(float(r.visited)));
         imageStore(uTriangleTests, px, vec4(float(r.triangles)));
         imageStore(uFruitless, px, vec4(float(r.fruitless)));
-        imageStore(uOverflow, px, vec4(r.overflow ? 1.0 : 0.0));
+        imageStore(uOverflow, px, vec4(r.overflow || r.capped ? 1.0 : 0.0));
 #endif
     }
 #if SHADOWLAB_INSTRUMENTATION
