@@ -138,4 +138,14 @@ std::vector<AccuracyCase> hardSceneTable(double maxMismatch, std::vector<Accurac
     return out;
 }
 
+void expectCutLoopsCappedAndShadowed(const AlgorithmRun& o, const AlgorithmRun& clean) {
+    const double capped = o.counters.at("loop_capped_pixels");
+    EXPECT_GT(capped, 0.0);
+    EXPECT_EQ(o.overflow, uint64_t(capped));
+    expectOverflowedPixelsShadowed(o, capped);
+    size_t lighter = 0;
+    for (size_t i = 0; i < o.visibility.size(); ++i) lighter += o.visibility[i] > clean.visibility[i];
+    EXPECT_EQ(lighter, 0u) << "pixels lit by mistake";
+}
+
 } // namespace shadowlab::test

@@ -102,4 +102,9 @@ void expectAccurateRow(const AlgorithmRun& o, double maxMismatch);
 /// `pixels` their counter reports.
 void expectOverflowedPixelsShadowed(const AlgorithmRun& o, double pixels);
 
+/// A run under a fault that cuts loops short (`o`) against the same run without it (`clean`): some
+/// pixels were capped, exactly those are counted as overflow and written shadowed, and no pixel
+/// came out lighter than without the fault.
+void expectCutLoopsCappedAndShadowed(const AlgorithmRun& o, const AlgorithmRun& clean);
+
 } // namespace shadowlab::test
