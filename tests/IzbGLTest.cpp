@@ -86,7 +86,7 @@ TEST_F(IzbGLTest, CappedListWalksAreWrittenShadowed) {
 // A job counter that wraps after capacity + 64 pushes instead of 2^32 (a fault site, test-only: the
 // wrap a flood of pushes, ~1,000 times the capacity, would cause) must not hand out the slots of
 // live jobs again: the pushes past capacity are taken back, every tile left out is flagged and
-// written shadowed. Counting on, 262 pixels were written lit.
+// written shadowed.
 TEST_F(IzbGLTest, FaultPushFloodOverwritesNoJob) {
     ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_PUSH_FLOOD", "1"}});
     const AlgorithmRun o = runAlgorithm(izbInfo(), lightAmidClutter(), {{"job_capacity", 8192}});

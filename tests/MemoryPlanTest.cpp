@@ -146,10 +146,8 @@ TEST(MemoryPlanTest, NoFootprintWrapsPast64Bits) {
     }
 }
 
-// The plan follows the parameters that size what an algorithm holds (a probe found shadow_map at
-// resolution 4096 planned at 0 bytes while it held 768 MiB, and izb's and ptsv's job lists at their
-// largest capacity planned at a quarter and a ten-thousandth of what they hold): each estimate is at
-// least the buffers the parameter makes.
+// The plan follows the parameters that size what an algorithm holds (shadow_map's resolution,
+// izb's and ptsv's job capacity): each estimate is at least the buffers the parameter makes.
 TEST(MemoryPlanTest, EstimatesFollowTheParametersThatSizeTheStructures) {
     struct Case {
         const char* algorithm;

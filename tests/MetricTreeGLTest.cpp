@@ -262,7 +262,7 @@ TEST_F(MetricTreeGLTest, FaultPendingDeltaSurvivesUndefinedNanConversion) {
 
 // Every loop of both queries ended from outside after a few dozen passes (a fault site, test-only:
 // llvmpipe's loop limit, one budget for all loops of an invocation): the cut pixels are counted
-// and written shadowed, never lit (before, a cut walk or triangle loop left its pixel lit).
+// and written shadowed, never lit.
 TEST_F(MetricTreeGLTest, FaultLoopsEndedFromOutsideAreCappedAndWrittenShadowed) {
     const Shot shot = thousandsOfTriangles();
     for (const char* query : {"pixel", "tile"}) {

@@ -96,8 +96,7 @@ TEST(OutputPlaceTest, LeftoversOfKilledRunsAreCleanedAndAnInterruptedCommitRecov
 
 // What lies beside DIR and only looks like a leftover by its name is the user's, never removed,
 // moved or locked: folders and files named DIR.partial-..., DIR.old-..., a finished run made with
-// --out DIR.partial-9, a file or FIFO at DIR.lock (a probe found the first three deleted or moved
-// into DIR, and the lock file truncated and unlinked).
+// --out DIR.partial-9, a file or FIFO at DIR.lock.
 TEST(OutputPlaceTest, LookalikesOfLeftoversAreNeverTouched) {
     std::string base = test::makeTempDir("place-lookalike"), out = base + "/notes";
     fs::create_directories(base + "/notes.partial-draft");

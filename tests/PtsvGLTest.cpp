@@ -213,8 +213,7 @@ TEST_F(PtsvGLTest, TinyJobListOverflowsButStaysExact) {
 
 // A job counter that wraps after capacity + 64 pushes instead of 2^32 (a fault site, test-only: the
 // wrap a flood of pushes, ~1,000 times the capacity, would cause) must not hand out the slots of
-// live jobs again: a walker whose push overwrote one would leave its subtree to a job nobody runs
-// (counting on, 1 % of the pixels were wrong).
+// live jobs again: a walker whose push overwrote one would leave its subtree to a job nobody runs.
 TEST_F(PtsvGLTest, FaultPushFloodOverwritesNoJob) {
     ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_PUSH_FLOOD", "1"}});
     for (const auto& traversal : {kCooperative, kPerInvocation}) {

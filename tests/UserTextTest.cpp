@@ -75,8 +75,8 @@ TEST(UserTextTest, ErrorLinesMaskTheInvisibleCharactersTheyRefuse) {
     EXPECT_EQ(key.out.find("\xE2\x80\xAE"), std::string::npos) << key.out;
 }
 
-// A config whose path is not UTF-8 validated, rendered a whole run, then failed writing
-// summary.json; refused at validation now, naming the file.
+// A config whose path is not UTF-8 cannot be named in summary.json: refused at validation, naming
+// the file, never after a whole run.
 TEST(UserTextTest, AConfigPathThatIsNotUtf8IsRefusedAtValidation) {
     const std::string file = test::makeTempDir("user-text-cfgpath") + "/c\xff.json";
     fs::copy_file(kSmoke, file);

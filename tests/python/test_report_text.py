@@ -443,9 +443,7 @@ class SweepReportTest(unittest.TestCase):
 
 class PlantedTargetTest(unittest.TestCase):
     """A link, FIFO or directory planted at a report's name in the folder (sweep.md, sweep.html, a
-    plot): the script refuses it in one line with status 2, promptly, and writes nothing through it
-    (a probe found `sweep merge` overwriting a file outside the folder through a link at sweep.md,
-    and hanging on a FIFO there)."""
+    plot): the script refuses it in one line with status 2, promptly, and writes nothing through it."""
 
     def run_with(self, planted, make):
         directory = tempfile.mkdtemp(prefix="sweep-planted-")
