@@ -286,6 +286,82 @@ TEST_F(PtsvGLTest, FaultLaneMissingFromVotesIsRecoveredExactly) {
     EXPECT_EQ(o.visibility, clean.visibility);
 }
 
+// Lanes that part ways once (a fault site, test-only: the odd lanes miss the first vote of their
+// workgroup and classify that node alone, conservatively, every child intersected) stand at
+// different nodes from then on. Before the lanes went alone for good, they voted again as soon as
+// they met at the same ballot, and each lane read the verdicts of the other half's node as its own:
+// children lost (lit pixels) and children accepted that the volume never covered (shadowed ones).
+// A lane that recovered once now walks alone for the rest of its batch, and the voting lanes
+// follow it at their next ballot.
+TEST_F(PtsvGLTest, FaultLanesThatPartWaysNeverVoteAgain) {
+    if (querySubgroupSize() == 0) GTEST_SKIP() << "no ARB_shader_ballot: ptsv refuses `vote: ballot` (tested above)";
+    for (bool twoPass : {true, false}) {
+        SCOPED_TRACE(twoPass ? "two passes" : "one pass");
+        const std::map<std::string, ParamValue> ballot = {kCooperative, {"vote", std::string("ballot")}, {"two_pass", twoPass}};
+        const Outcome clean = run(thousandsOfTriangles(), ballot);
+        ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_SPLIT_LANES", "1"}});
+        Outcome o = run(thousandsOfTriangles(), ballot);
+        EXPECT_GT(o.counters["vote_recoveries"], 0.0);
+        EXPECT_EQ(o.accuracy.mismatchRatio, 0.0);
+        EXPECT_EQ(o.overflow, 0u);
+        EXPECT_EQ(o.visibility, clean.visibility);
+    }
+}
+
+// A ballot workgroup that is not one whole subgroup (a fault site, test-only: as a driver that picks
+// another width than the one compiled for) runs its jobs one per invocation, with no vote: that
+// frame is as exact as any (it used to run none of its jobs: every shadow of them lit), and it is
+// counted, so the host compiles shared-memory votes for the next frame.
+TEST_F(PtsvGLTest, FaultSubgroupMismatchFrameStaysExact) {
+    if (querySubgroupSize() == 0) GTEST_SKIP() << "no ARB_shader_ballot: ptsv refuses `vote: ballot` (tested above)";
+    for (bool twoPass : {true, false}) {
+        SCOPED_TRACE(twoPass ? "two passes" : "one pass");
+        const std::map<std::string, ParamValue> ballot = {kCooperative, {"vote", std::string("ballot")}, {"two_pass", twoPass}};
+        const Outcome clean = run(thousandsOfTriangles(), ballot);
+        ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_SUBGROUP_MISMATCH", "1"}});
+        Outcome o = run(thousandsOfTriangles(), ballot);
+        EXPECT_GT(o.counters["subgroup_mismatch_groups"], 0.0);
+        EXPECT_EQ(o.accuracy.mismatchRatio, 0.0);
+        EXPECT_EQ(o.visibility, clean.visibility);
+    }
+}
+
+// Every walk and sample loop ended from outside after a few dozen passes (a fault site, test-only:
+// llvmpipe's loop limit, one budget for all loops of an invocation). The cut jobs are counted as
+// overflow and the subtrees they had still to visit written shadowed: no pixel comes out lighter
+// than without the fault (before, their samples were simply left lit).
+TEST_F(PtsvGLTest, FaultCutWalksShadowWhatTheyLeft) {
+    const Shot shot = thousandsOfTriangles();
+    // Not the shared-memory votes: a cut would leave the other invocations of the group waiting at
+    // a barrier (the cap itself would too; that path runs where ballots are missing, not llvmpipe).
+    std::vector<std::map<std::string, ParamValue>> variants = {{kPerInvocation}};
+    if (querySubgroupSize() != 0) {
+        variants.push_back({kCooperative, {"vote", std::string("ballot")}});
+        variants.push_back({kPacket});
+    }
+    for (auto p : variants) {
+        for (bool twoPass : {true, false}) {
+            p["two_pass"] = twoPass;
+            SCOPED_TRACE(std::get<std::string>(p.at("traversal")) + (twoPass ? ", two passes" : ", one pass"));
+            const Outcome clean = run(shot, p, false);
+            Outcome o;
+            {
+                ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_LOOP_BUDGET", "40"}});
+                o = run(shot, p, false);
+            }
+            EXPECT_GT(o.counters["truncated_jobs"], 0.0);
+            EXPECT_GE(o.overflow, uint64_t(o.counters["truncated_jobs"]));
+            size_t lighter = 0, darker = 0;
+            for (size_t i = 0; i < o.visibility.size(); ++i) {
+                lighter += o.visibility[i] > clean.visibility[i];
+                darker += o.visibility[i] < clean.visibility[i];
+            }
+            EXPECT_EQ(lighter, 0u) << "pixels lit by mistake";
+            EXPECT_GT(darker, 0u) << "the cut subtrees are written shadowed";
+        }
+    }
+}
+
 // The heat map (Figure 3) counts exactly the test-and-set operations.
 TEST_F(PtsvGLTest, HeatMapSumsToTheTestAndSetCount) {
     Outcome o = run(fenceDiscontinuity(), {{"heat_map", true}}, false);

@@ -18,15 +18,20 @@
 //   size a subgroup may have, ARB_shader_ballot section 7.4: radeonsi reports 64 and may run
 //   compute in wave32): a workgroup that is not one whole subgroup (a driver free to pick
 //   SIMD8/16/32, a wave32/wave64 choice) runs none of its jobs and counts itself in
-//   PTSV_C_SUBGROUP_MISMATCH, which overflowCount() reports (never a silent wrong image); the
-//   host then recompiles with shared-memory votes for the following frames.
+//   PTSV_C_SUBGROUP_MISMATCH and its invocations run the batch's jobs alone, one job each, with no
+//   vote (the frame stays exact, only slower); the host then recompiles with shared-memory votes
+//   for the following frames.
 //   GL does not promise that lanes reconverge after divergent code (classify(), `if (LEADER)`), so
 //   every vote checks who took part: each ballot of b comes with the ballot of !b, and a lane
 //   missing from both is a lane missing from the vote. A lane that sees a vote miss someone
-//   classifies the node's children itself (the per-invocation loop), counts PTSV_C_VOTE_RECOVERED,
-//   and clears its own accepted children; a broadcast carries its sender's lane, and one that did
-//   not come from lane 0 is taken as "not pushed" (the subtree is finished here). Lanes may then
-//   walk different but each complete paths: never a missing shadow.
+//   goes alone for the rest of its workgroup's batch (gAlone, sticky): it classifies every node's
+//   children itself (the per-invocation loop), tests every sample of a leaf, pushes its own jobs,
+//   and never votes again; it counts PTSV_C_VOTE_RECOVERED. A broadcast carries its sender's lane,
+//   and one that did not come from lane 0 is taken as "not pushed" (the subtree is finished here)
+//   and sends the lane alone too. Sticky, because a lane that walked on alone may stand at another
+//   node than the others: a later ballot that every lane answers would still mix the verdicts of
+//   two nodes, and nothing in it could tell. The voting lanes then miss the lone ones in their
+//   next ballot and go alone as well. Each lane walks a complete path: never a missing shadow.
 // PTSV_BALLOT 0: PTSV_LANES invocations (32 unless forced), votes through shared memory and a
 //   barrier.
 // PTSV_LANES up to 32: each invocation tests 32 / PTSV_LANES children of a node. PTSV_LANES 64
@@ -54,6 +59,7 @@
 #include "common/scene.glsl"
 #include "common/counters.glsl"
 #include "common/list_push.glsl"
+#include "common/loop_fault.glsl"
 #define PTSV_TEXEL_READS 1
 #include "ptsv/ptsv.glsl"
 #include "common/shadow_ray.glsl"
@@ -109,6 +115,15 @@ const uint64_t kFaultDropped = 2ul;
 const uint64_t kFaultDropped = 0ul;
 #endif
 bool gVoteMissedLane = false; // a vote of the current node did not hear from every lane
+bool gAlone = false;          // this lane votes no more: it walks, tests and pushes alone (see the top)
+#define ALONE gAlone
+// Test fault: the odd lanes miss the first vote of the workgroup (the even lanes hear everyone)
+// and classify that node alone conservatively, every existing child intersected (a verdict as
+// exact as any, only slower): from then on the two halves walk different nodes, as lanes that had
+// not reconverged, or whose lone verdicts differed from the voted ones, would.
+#if SHADOWLAB_FAULT_SPLIT_LANES
+bool gFaultSplitDone = false;
+#endif
 
 // ballotARB(b), and whether every lane took part: a lane absent from the ballot of b (its bit
 // lost if b was true) is absent from the ballot of !b as well only if it missed them, since each
@@ -163,6 +178,7 @@ uint broadcast(uint v, uint fallback) {
 #endif
     if (r.x == 0u) return r.y;
     atomicAdd(ptsvCounters[PTSV_C_VOTE_RECOVERED], 1u);
+    gAlone = true;
     return fallback;
 #else
     if (lane == 0u) sBroadcast = v;
@@ -174,6 +190,9 @@ uint broadcast(uint v, uint fallback) {
 }
 
 #endif // !PTSV_PER_INVOCATION
+#ifndef ALONE
+#define ALONE false // shared-memory votes hear every invocation (a barrier), one job per invocation none
+#endif
 
 // ---- One job -------------------------------------------------------------------------------------
 const vec4 kZero7[7] = vec4[7](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
@@ -241,6 +260,13 @@ bvec3 classifyHalf(uint childId, int depth, uint side) {
 }
 #endif
 
+// A walk cut short (rule 13) leaves its pixels shadowed: the children of node (depth, id) it had
+// still to visit are marked accepted in that node's mask, so resolve.comp shadows their samples.
+// (It is counted in PTSV_C_TRUNCATED, an overflow.)
+void shadowUnvisited(int depth, uint id, uint children) {
+    if (children != 0u) atomicAnd(ptsvMasks[uMaskOffset[depth] + id], ~children);
+}
+
 // Where sample q lies against the current triangle's shadow volume, by its four planes: 1 inside,
 // 0 outside, 2 too close to call (one plane value within uCloseCall of 0, where the rounding of
 // the plane and of the reference's ray test could disagree).
@@ -258,11 +284,15 @@ void testSamples(uint key) {
     uvec3 lo, hi;
     ptsvNodeRange(key, uLevels, lo, hi);
     uint first = (lo.y * uint(uTilesX) + lo.x) * ptsvTileSamples();
-    uint s = lane;
+    // A lane alone tests every sample; voting lanes share them out.
+    uint step = ALONE ? 1u : SAMPLE_STEP;
+    uint s = ALONE ? 0u : lane;
     while (s < ptsvTileSamples()) {
+        FAULT_LOOP_STEP()
         uint closeSlot = 0xFFFFFFFFu;
         vec3 closeQ = vec3(0.0);
-        for (; s < ptsvTileSamples(); s += SAMPLE_STEP) {
+        for (; s < ptsvTileSamples(); s += step) {
+            FAULT_LOOP_STEP()
             uvec4 slot = ptsvSlotAt(first + s); // q and key in one fetch
             uint k = slot.w;
 #if PTSV_LEAF_CLUSTER_ONLY
@@ -277,7 +307,7 @@ void testSamples(uint key) {
             vec3 q = uintBitsToFloat(slot.xyz);
             uint side = volumeSide(q);
             if (side == 1u) ptsvShadow[first + s] = 1u;
-            if (side == 2u) { closeSlot = first + s; closeQ = q; s += SAMPLE_STEP; break; }
+            if (side == 2u) { closeSlot = first + s; closeQ = q; s += step; break; }
         }
         if (closeSlot == 0xFFFFFFFFu) break;
         ++gCloseCalls;
@@ -285,7 +315,10 @@ void testSamples(uint key) {
                           sceneVertex(gTriangle, 2u)))
             ptsvShadow[closeSlot] = 1u;
     }
-    if (s < ptsvTileSamples()) gTruncated = true;
+    if (s < ptsvTileSamples()) { // cut short: the whole cluster shadowed
+        gTruncated = true;
+        shadowUnvisited(uLevels - 1, key >> 5u, 1u << (key & 31u));
+    }
     if (LEADER) ++gLeafVisits;
 }
 
@@ -317,7 +350,11 @@ uint visit(int depth, uint id, bool live) {
 #endif
 #if PTSV_PER_INVOCATION
     v = classifyAlone(depth, id, mask, live);
-#elif PTSV_LANES == 64
+#else
+    if (ALONE) {
+        v = classifyAlone(depth, id, mask, true);
+    } else {
+#if PTSV_LANES == 64
     uint c = lane & 31u, side = lane >> 5u;
     bool exists = ((mask >> c) & 1u) != 0u;
     bvec3 r = exists ? classifyHalf(id * 32u + c, depth + 1, side) : bvec3(true, false, false);
@@ -339,11 +376,21 @@ uint visit(int depth, uint id, bool live) {
         v |= vote2(!r.x && !r.y, r.y) << (round * uint(PTSV_LANES));
     }
 #endif
-#if PTSV_BALLOT && !PTSV_PER_INVOCATION
-    if (gVoteMissedLane) { // the votes cannot be trusted: this lane decides alone
-        v = classifyAlone(depth, id, mask, true);
+#if PTSV_BALLOT
+    bool faultSplit = false;
+#if SHADOWLAB_FAULT_SPLIT_LANES
+    faultSplit = !gFaultSplitDone && (lane & 1u) == 1u;
+    gFaultSplitDone = true;
+#endif
+    if (gVoteMissedLane || faultSplit) { // the votes cannot be trusted: this lane decides alone, from now on
+        v = faultSplit ? uvec2(mask, 0u) : classifyAlone(depth, id, mask, true);
         atomicAdd(ptsvCounters[PTSV_C_VOTE_RECOVERED], 1u);
+        gAlone = true;
     }
+#endif
+    }
+#endif
+#if PTSV_BALLOT && !PTSV_PER_INVOCATION
     // With ballots every lane that accepts a child clears it: after a recovery the lanes' verdicts
     // may differ (each is exact), and a lane that accepted a node does not test its samples.
     clearsAlone = true;
@@ -379,6 +426,7 @@ void traverse(int depth, uint id) {
     uint node = id; // visited at depth top; node ids are key prefixes, so its parent is node >> 5
     stackMask[top] = visit(depth, id, true);
     while (true) {
+        FAULT_LOOP_STEP()
         while (top >= depth && stackMask[top] == 0u) { // deepest level with children left
             --top;
             node >>= 5u;
@@ -391,14 +439,13 @@ void traverse(int depth, uint id) {
 #if PTSV_PASS == 1 && PTSV_TWO_PASS && !PTSV_PER_INVOCATION
         if (childDepth == uSplitDepth) {
             uint slot = 0u;
-            if (LEADER) {
+            bool alone = ALONE; // a lane alone pushes its own jobs (the leader may push them too)
+            if (LEADER || alone) {
                 LIST_RESERVE(ptsvCounters[PTSV_C_JOBS_PUSHED], 1u, uJobCapacity, slot);
                 if (slot < uJobCapacity) ptsvJobs[slot] = uvec2(gTriangle, childId);
                 else atomicAdd(ptsvCounters[PTSV_C_JOB_OVERFLOW], 1u);
             }
-#if !PTSV_PER_INVOCATION
-            slot = broadcast(slot, uJobCapacity);
-#endif
+            if (!alone) slot = broadcast(slot, uJobCapacity);
             if (slot < uJobCapacity) continue; // pass two finishes it
             // The list is full: finish this subtree here, exactly as the one-pass traversal would.
         }
@@ -411,7 +458,10 @@ void traverse(int depth, uint id) {
         node = childId;
         stackMask[top] = visit(childDepth, childId, true);
     }
-    if (top >= depth) gTruncated = true;
+    if (top >= depth) { // cut short: every subtree still on the stack shadowed
+        gTruncated = true;
+        for (int d = top; d >= depth; --d, node >>= 5u) shadowUnvisited(d, node, stackMask[d]);
+    }
 }
 
 #if PTSV_PACKET && PTSV_PASS == 1
@@ -437,6 +487,7 @@ void traversePacket(bool live) {
     own[0] = visit(0, 0u, live);
     any[0] = orLanes(own[0]);
     while (true) {
+        FAULT_LOOP_STEP()
         while (top >= 0 && any[top] == 0u) {
             --top;
             node >>= 5u;
@@ -457,7 +508,10 @@ void traversePacket(bool live) {
         own[top] = visit(childDepth, childId, mine);
         any[top] = orLanes(own[top]);
     }
-    if (top >= 0) gTruncated = true;
+    if (top >= 0) { // cut short: this lane's subtrees still on the stack shadowed
+        gTruncated = true;
+        for (int d = top; d >= 0; --d, node >>= 5u) shadowUnvisited(d, node, own[d]);
+    }
 }
 #endif
 
@@ -530,10 +584,21 @@ void main() {
 #if PTSV_BALLOT
     // Ballots only see one subgroup: the workgroup must be exactly one, its lanes 0 .. PTSV_LANES - 1
     // (see the top). Checked here, before any divergent code, with the ballot itself.
-    if (ballotARB(true) != kAllLanes) {
+#if SHADOWLAB_FAULT_SUBGROUP_MISMATCH
+    const bool mismatch = true; // test fault: as a driver that split the workgroup
+#else
+    bool mismatch = ballotARB(true) != kAllLanes;
+#endif
+    if (mismatch) {
+        // Not one whole subgroup: every invocation runs jobs of the batch alone (no vote).
         if (gl_LocalInvocationIndex == 0u) atomicAdd(ptsvCounters[PTSV_C_SUBGROUP_MISMATCH], 1u);
-        return;
-    }
+        gAlone = true;
+        for (uint k = gl_LocalInvocationIndex; k < uint(PTSV_JOBS_PER_GROUP); k += uint(PTSV_LANES)) {
+            uint job = group * uint(PTSV_JOBS_PER_GROUP) + k;
+            if (job >= count) break;
+            runJob(job);
+        }
+    } else
 #else
     if (lane == 0u) sVote[0] = sVote[1] = sVote[2] = uint[6](0u, 0u, 0u, 0u, 0u, 0u);
     barrier();
