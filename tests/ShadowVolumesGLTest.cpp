@@ -4,6 +4,8 @@
 // method's own failure cases shown (ZPASS with the eye in shadow, light-facing volumes of open
 // meshes); the 8-bit stencil wrapping at 256 caught by the exact count.
 #include "algorithms/shadow_volumes/ShadowVolumes.h"
+#include "framework/gl/GlObjects.h"
+#include "framework/gl/Shader.h"
 #include "framework/scene/Procedural.h"
 #include "tests/AlgorithmHarness.h"
 #include "tests/TestSupport.h"
@@ -149,6 +151,35 @@ TEST_F(ShadowVolumesGLTest, StencilWrapAt256IsCaughtByTheExactCount) {
     EXPECT_GT(wrapped, 100.0);
     EXPECT_EQ(o.overflow, uint64_t(wrapped));
     EXPECT_LE(o.accuracy.mismatchRatio, 1e-4);
+}
+
+// A face border that runs parallel to the pixel's view ray has no nearest place along it:
+// svClosestAlong says so with a flag, and volume.frag makes the pixel a close call. It used to
+// return a NaN t that `t == t` tested, which a compiler may fold to true (NaNs need not be kept,
+// GLSL 4.50 section 4.7.1): the border then counted as one at a garbage t, and the close call was
+// missed. The probe asks for exactly parallel, anti-parallel and nearly parallel borders, and one
+// at a known crossing.
+TEST_F(ShadowVolumesGLTest, ParallelBorderIsFlaggedNotANaN) {
+    const glm::vec3 eye{1.0f, 2.0f, 3.0f}, v = glm::normalize(glm::vec3{0.3f, -0.2f, -1.0f});
+    const std::vector<glm::vec4> cases = {
+        // eye, a, d, v: parallel, anti-parallel, parallel within 1e-7, crossing at t = 5
+        glm::vec4(eye, 0), glm::vec4(eye + glm::vec3(0.1f, 0, 0), 0), glm::vec4(v * 3.0f, 0), glm::vec4(v, 0),
+        glm::vec4(eye, 0), glm::vec4(eye + glm::vec3(0, 0.5f, 0), 0), glm::vec4(-v, 0), glm::vec4(v, 0),
+        glm::vec4(eye, 0), glm::vec4(eye + glm::vec3(0, 0, 2), 0), glm::vec4(v + glm::vec3(1e-7f, 0, 0), 0), glm::vec4(v, 0),
+        glm::vec4(eye, 0), glm::vec4(eye + v * 5.0f - glm::vec3(0, 0, 0), 0), glm::vec4(glm::normalize(glm::cross(v, glm::vec3(0, 1, 0))), 0), glm::vec4(v, 0),
+    };
+    GlBuffer in = GlBuffer::fromVector(cases);
+    GlBuffer out = GlBuffer::fromVector(std::vector<glm::vec2>(4, glm::vec2(-1.0f)));
+    ShaderProgram probe = ShaderProgram::compute("tests/closest_along_probe.comp");
+    in.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+    out.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+    probe.use();
+    glDispatchCompute(4, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    const std::vector<glm::vec2> r = out.read<glm::vec2>(4);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(r[i].x, 0.0f) << "case " << i << ": a parallel border has no nearest place";
+    EXPECT_EQ(r[3].x, 1.0f);
+    EXPECT_NEAR(r[3].y, 5.0f, 1e-4f);
 }
 
 } // namespace

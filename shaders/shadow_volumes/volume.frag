@@ -24,6 +24,7 @@
 #include "common/light.glsl"
 #include "shadow_volumes/layout.glsl"
 #include "shadow_volumes/test_point.glsl"
+#include "shadow_volumes/closest_along.glsl"
 layout(binding = 0) uniform sampler2D uPosition;
 layout(binding = 1) uniform sampler2D uNormal;
 layout(binding = SV_TRIANGLE_ID_UNIT) uniform usampler2D uTriangleId;
@@ -70,12 +71,6 @@ float inside(vec3 x, Border b, vec3 n, vec3 inward, vec3 v) {
     return (dot(m, inward) >= 0.0 ? dot(m, x - b.a) : -dot(m, x - b.a)) * across;
 }
 
-// Where along the view ray (eye + v t) border b passes closest to it; NaN when they run parallel.
-float closestAlong(Border b, vec3 v) {
-    vec3 w = uEye - b.a;
-    float bd = dot(v, b.d), dd = dot(b.d, b.d), denom = dd - bd * bd;
-    return denom > 1e-12 * dd ? (bd * dot(b.d, w) - dd * dot(v, w)) / denom : uintBitsToFloat(0x7FC00000u);
-}
 
 // The face as rasterised here may not be where the view ray meets its plane: the rasteriser snaps
 // vertices to a subpixel grid (1/256 of a pixel on llvmpipe) and clips faces one by one, so within
@@ -112,8 +107,7 @@ int borderSide(vec3 v, float se, out float tPlane, out float tBorder) {
         if (d <= best) { best = d; nearest = k; }
     }
     if (nearest < 0) return SV_SIDE_PLANE;
-    tBorder = closestAlong(b[nearest], v);
-    return tBorder == tBorder ? SV_SIDE_BORDER : SV_SIDE_CLOSE;
+    return svClosestAlong(uEye, b[nearest].a, b[nearest].d, v, tBorder) ? SV_SIDE_BORDER : SV_SIDE_CLOSE;
 }
 
 void main() {
