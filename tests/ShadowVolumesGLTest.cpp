@@ -182,5 +182,27 @@ TEST_F(ShadowVolumesGLTest, ParallelBorderIsFlaggedNotANaN) {
     EXPECT_NEAR(r[3].y, 5.0f, 1e-4f);
 }
 
+// The border margin follows the rasteriser's subpixel grid (GL_SUBPIXEL_BITS) instead of assuming
+// the 8 bits of llvmpipe and today's GPUs: on a device with the 4 bits GL guarantees (the fault
+// SHADOWLAB_FAULT_SUBPIXEL_BITS, test-only, reports 4) a pixel may go to the neighbour across a
+// border 16 times farther away, so more pixels near borders are close calls, and the image stays
+// the reference's. (With the margin fixed at 1/64 px the two runs listed the same pixels.)
+TEST_F(ShadowVolumesGLTest, FaultCoarseSubpixelGridWidensTheBorderMargin) {
+    const Shot shot = engineOnGround();
+    const AlgorithmRun fine = runAlgorithm(shadowVolumesInfo(), shot, {});
+    AlgorithmRun coarse;
+    {
+        ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_SUBPIXEL_BITS", "1"}});
+        coarse = runAlgorithm(shadowVolumesInfo(), shot, {});
+    }
+    EXPECT_GE(fine.counters.at("subpixel_bits"), 4.0);
+    EXPECT_EQ(coarse.counters.at("subpixel_bits"), 4.0);
+    std::printf("[shadow_volumes] close calls at %.0f subpixel bits: %.0f, at 4: %.0f\n", fine.counters.at("subpixel_bits"),
+                fine.counters.at("close_call_pixels"), coarse.counters.at("close_call_pixels"));
+    EXPECT_GT(coarse.counters.at("close_call_pixels"), fine.counters.at("close_call_pixels"));
+    EXPECT_LE(coarse.accuracy.mismatchRatio, 1e-4);
+    EXPECT_EQ(coarse.overflow, 0u);
+}
+
 } // namespace
 } // namespace shadowlab

@@ -15,6 +15,8 @@
 #include "framework/render/LightUniforms.h"
 #include "shaders/shadow_volumes/layout.glsl"
 
+#include <cmath>
+
 namespace shadowlab {
 namespace {
 
@@ -99,6 +101,7 @@ struct VolumeState {
 class ShadowVolumes final : public ShadowAlgorithm {
 public:
     ShadowVolumes(const ParamValues& p, const AlgorithmOptions& o) : p_(shadowVolumesParams().read(p)), options_(o) {
+        subpixelBits_ = subpixelBits();
         compile();
         GLuint vao = 0;
         glCreateVertexArrays(1, &vao);
@@ -237,6 +240,7 @@ public:
             const float n = f.camera.nearPlane, fa = f.camera.farPlane;
             volumePass_.set("uDepthScale", (fa - n) / (fa * n));
             volumePass_.set("uPixelAngle", 2.0f * std::tan(glm::radians(f.camera.fovYDeg) * 0.5f) / float(r.y));
+            volumePass_.set("uBorderMargin", borderMargin());
             volumePass_.set("uRayOffset", offset);
             volumePass_.set("uCloseCall", closeCallLength());
             volumePass_.set("uCountSign", zfail ? -1.0f : 1.0f);
@@ -310,7 +314,8 @@ public:
                                     {"inconsistent_pixels", double(c[SV_C_INCONSISTENT])},
                                     {"open_edges", double(openEdges_)},
                                     {"non_manifold_edges", double(nonManifold_)},
-                                    {"max_triangles_per_edge", double(maxSides_)}};
+                                    {"max_triangles_per_edge", double(maxSides_)},
+                                    {"subpixel_bits", double(subpixelBits_)}};
         if (options_.instrumentation) {
             const double pixels = double(resolution_.x) * double(resolution_.y);
             const double fragments = double(counters_.wide(SV_C_FRAGMENTS_LO));
@@ -337,6 +342,21 @@ public:
     }
 
 private:
+    /// The rasteriser's subpixel precision (GL_SUBPIXEL_BITS; GL guarantees 4, today's GPUs and
+    /// llvmpipe have 8). The test fault SHADOWLAB_FAULT_SUBPIXEL_BITS stands for a device with 4.
+    static int subpixelBits() {
+        GLint bits = 0;
+        glGetIntegerv(GL_SUBPIXEL_BITS, &bits);
+        if (shaderFaultActive("SHADOWLAB_FAULT_SUBPIXEL_BITS")) bits = 4;
+        if (bits < 4)
+            throw RuntimeError("shadow_volumes: the GL reports " + std::to_string(bits) +
+                               " subpixel bits, fewer than the 4 GL guarantees: its rasteriser's rounding is unknown");
+        return bits;
+    }
+    /// How near a face's border, in pixels, the rasteriser may hand the pixel to the neighbour
+    /// across it (volume.frag): four steps of its subpixel grid (1/64 of a pixel at 8 bits, 1/4 at 4).
+    float borderMargin() const { return std::ldexp(4.0f, -subpixelBits_); }
+
     // The plane tests' own rounding, in world units: 2e-6 of the scene's size (the depth buffer's,
     // far coarser, is added per pixel by volume.frag).
     float closeCallLength() const {
@@ -369,6 +389,7 @@ private:
     const SceneGpu* scene_ = nullptr;
     size_t edges_ = 0, capacity_ = 1, maxSides_ = 0, openEdges_ = 0, nonManifold_ = 0;
     glm::ivec2 resolution_{0};
+    int subpixelBits_ = 8;
     bool zfailLast_ = true;
     ShaderProgram eyePass_, facingPass_, silhouettePass_, depthPass_, volumePass_, resolvePass_, closeArgsPass_, closeRayPass_;
     GlBuffer sides_, first_, facing_, records_, draw_, closeList_, closeBlocked_, closeArgs_;

@@ -46,6 +46,7 @@ uniform int uCountBehind;  // ZFAIL 1: the faces beyond q count; ZPASS 0: those 
 uniform vec3 uForward;     // the camera's unit view axis
 uniform float uDepthScale; // (far - near) / (far * near): world depth per unit of window depth, over z^2
 uniform float uPixelAngle; // a pixel's angular size: 2 tan(fov / 2) / height
+uniform float uBorderMargin; // pixels: four steps of the rasteriser's subpixel grid (the host reads it)
 layout(location = 0) out float oCount;
 
 #if SHADOWLAB_INSTRUMENTATION
@@ -73,11 +74,12 @@ float inside(vec3 x, Border b, vec3 n, vec3 inward, vec3 v) {
 
 
 // The face as rasterised here may not be where the view ray meets its plane: the rasteriser snaps
-// vertices to a subpixel grid (1/256 of a pixel on llvmpipe) and clips faces one by one, so within
-// that of a face's border the pixel can go to the neighbour across it, whose plane the ray meets
-// elsewhere: near the border, about as far from it along the ray as X (where it meets this face's
-// plane) is. So where X lies within 1/64 of a pixel (as seen from the eye) of a border, the pixel is
-// a close call if the test point lies in that stretch of the ray around the border. Returns SV_SIDE_*
+// vertices to a subpixel grid (GL_SUBPIXEL_BITS: 1/256 of a pixel on llvmpipe and today's GPUs, 1/16
+// where GL's minimum) and clips faces one by one, so within that of a face's border the pixel can
+// go to the neighbour across it, whose plane the ray meets elsewhere: near the border, about as far
+// from it along the ray as X (where it meets this face's plane) is. So where X lies within
+// uBorderMargin pixels (as seen from the eye: four steps of that grid) of a border, the pixel is a
+// close call if the test point lies in that stretch of the ray around the border. Returns SV_SIDE_*
 // and, for SV_SIDE_BORDER, where along the ray X is (tPlane) and the border passes closest (tBorder).
 int borderSide(vec3 v, float se, out float tPlane, out float tBorder) {
     tBorder = tPlane = 0.0;
@@ -86,7 +88,7 @@ int borderSide(vec3 v, float se, out float tPlane, out float tBorder) {
     float t = -se / cosine;
     tPlane = t;
     vec3 x = uEye + v * t, n = vPlane.xyz;
-    float margin = max(t, 0.0) * uPixelAngle * (1.0 / 64.0) + uCloseCall;
+    float margin = max(t, 0.0) * uPixelAngle * uBorderMargin + uCloseCall;
     Border b[3];
     vec3 inward[3];
     if (vKind == SV_FACE_NEAR_CAP) {
