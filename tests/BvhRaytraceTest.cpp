@@ -1,7 +1,7 @@
 // bvh_raytrace's CPU side without GL: the binned-SAH builder's tree is a valid BVH (every triangle in
 // exactly one leaf, every box enclosing its subtree, leaves within the size limit) on ordinary and
 // degenerate inputs, deterministic, and the SSBO-limit check reports what does not fit.
-#include "algorithms/bvh_raytrace/BvhBuilder.h"
+#include "framework/accel/BvhBuilder.h"
 #include "framework/core/Error.h"
 #include "framework/scene/Procedural.h"
 

@@ -2,13 +2,12 @@
 
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
-#include "algorithms/bvh_raytrace/BvhBuilder.h"
-#include "algorithms/bvh_raytrace/BvhGpu.h"
-#include "algorithms/bvh_raytrace/BvhGpuLayout.h"
+#include "framework/accel/SceneBvh.h"
 #include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
 #include "framework/render/LightUniforms.h"
+#include "shaders/bvh_raytrace/layout.glsl"
 
 #include <algorithm>
 #include <array>
@@ -76,41 +75,23 @@ public:
 
     void setScene(const SceneGpu& scene) override {
         scene_ = &scene;
-        gpu_ = bvh::BvhGpu(); // free the old tree before building the new one
         auto t0 = Clock::now();
         bvh::BuildOptions opt;
         opt.maxLeafSize = p_.leafSize;
         opt.bins = p_.sahBins;
         opt.traversalCost = p_.traversalCost;
-        bvh::Bvh tree = bvh::buildBvh(scene.cpu(), opt);
+        const bvh::Bvh& tree = bvh_.build(scene, opt, maxShaderStorageBlockBytes(), "bvh_raytrace");
         buildMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-        const GLbitfield flags = scene.dynamic() ? GL_DYNAMIC_STORAGE_BIT : 0;  // refitted trees are re-uploaded
-        gpu_ = bvh::uploadBvh(tree, maxShaderStorageBlockBytes(), flags, "bvh_raytrace");
         counters_.allocate();
         nodeCount_ = tree.nodes.size();
         depth_ = tree.depth;
         leaves_ = tree.leaves;
         sahCost_ = tree.sahCost;
-        if (scene.dynamic()) {
-            tree_ = std::move(tree);
-            posed_ = scene.cpu().positions;
-        }
     }
 
-    // Moving parts: their posed triangles are read back (the floats the G-buffer used), the tree
-    // refitted on the CPU and uploaded whole; a GPU refit would beat this on big moving sets.
-    void sceneMoved(const FrameInputs& f) override {
-        f.timer.begin("read_scene");
-        scene_->readMovingPositions(posed_);
-        f.timer.end();
-        f.timer.begin("refit", false);
-        bvh::refitBvh(tree_, posed_);
-        f.timer.end();
-        f.timer.begin("upload");
-        gpu_.nodes.upload(tree_.nodes.data(), tree_.nodes.size() * sizeof(bvh::NodeGpu));
-        gpu_.triangles.upload(tree_.triangles.data(), tree_.triangles.size() * sizeof(glm::vec4));
-        f.timer.end();
-    }
+    // Moving parts: the tree refitted to the posed triangles (SceneBvh); a GPU refit would beat this
+    // on big moving sets.
+    void sceneMoved(const FrameInputs& f) override { bvh_.refit(*scene_, f.timer); }
 
     void resize(glm::ivec2 resolution) override {
         if (!options_.instrumentation) return; // timing mode: no debug images
@@ -134,8 +115,8 @@ public:
         setLightUniforms(trace_, f.light);
         trace_.set("uRayOffset", rayOffsetLength(p_.rayOffset, *scene_));
         trace_.set("uSampleCount", sampleCount);
-        trace_.set("uBvhStepCap", unsigned(gpu_.stepCap));
-        gpu_.bind(BVH_NODE_UNIT, BVH_TRI_UNIT);
+        trace_.set("uBvhStepCap", unsigned(bvh_.gpu().stepCap));
+        bvh_.gpu().bind(BVH_NODE_UNIT, BVH_TRI_UNIT);
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
         bindPixelPassInputs(f);
@@ -164,8 +145,8 @@ public:
                                     {"bvh_depth", double(depth_)},
                                     {"bvh_sah_cost", sahCost_},
                                     {"bvh_build_ms", buildMs_},
-                                    {"node_bytes", double(gpu_.nodes.size())},
-                                    {"triangle_bytes", double(gpu_.triangles.size())}};
+                                    {"node_bytes", double(bvh_.gpu().nodes.size())},
+                                    {"triangle_bytes", double(bvh_.gpu().triangles.size())}};
         if (!options_.instrumentation) return out;
         out.insert(out.begin(), {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
                                  {"nodes_visited_max", double(c[BVH_C_VISITED_MAX])},
@@ -186,7 +167,7 @@ public:
     /// Nodes + the leaf-ordered triangles the rays read (a ray tracer needs them and line_space does
     /// not: the paper's Table 1 compares sizes on that basis, "the BVH needs the triangle
     /// information in addition"). Per-pixel debug images and the sample list are not counted.
-    size_t memoryBytes() const override { return gpu_.bytes(); }
+    size_t memoryBytes() const override { return bvh_.gpu().bytes(); }
 
     /// Pixels with a ray whose stack overflowed or whose walk reached its step cap, or whose sample
     /// loop the driver cut short (all written shadowed): 0 means the image is exact.
@@ -207,10 +188,8 @@ private:
     AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
     ShaderProgram trace_;
-    bvh::BvhGpu gpu_; ///< the tree as the trace reads it
+    bvh::SceneBvh bvh_; ///< the tree as the trace reads it, refitted as the scene moves
     GlBuffer samples_;
-    bvh::Bvh tree_;                  ///< kept for refits (moving scenes only)
-    std::vector<glm::vec3> posed_;   ///< the posed scene positions the last refit used
     GpuCounters<BVH_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
     SampleBatches batches_; ///< the light's samples over dispatches, and their state between them

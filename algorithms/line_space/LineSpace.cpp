@@ -2,7 +2,7 @@
 
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
-#include "algorithms/bvh_raytrace/BvhGpu.h"
+#include "framework/accel/BvhGpu.h"
 #include "algorithms/line_space/LineSpaceCache.h"
 #include "algorithms/line_space/NTree.h"
 #include "algorithms/line_space/SampleClassifier.h"

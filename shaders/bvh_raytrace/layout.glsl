@@ -1,5 +1,5 @@
 // bvh_raytrace GPU layout constants, shared by GLSL (#include "bvh_raytrace/layout.glsl") and C++
-// (algorithms/bvh_raytrace/BvhGpuLayout.h includes this very file). #defines and comments only,
+// (framework/accel/BvhGpuLayout.h includes this very file). #defines and comments only,
 // so it is valid in both languages and the numbers exist once.
 
 // SSBO binding points (after the scene buffers 0..2 of shaders/common/scene.glsl, which the BVH
@@ -10,16 +10,6 @@
 // the leaf-ordered triangles (RGBA32F, 3 texels per triangle); units 0 and 1 are the G-buffer.
 #define BVH_NODE_UNIT 2
 #define BVH_TRI_UNIT 3
-
-// A node stores the bounds of both children (Aila & Laine 2009), so one 64-byte fetch decides
-// which children a ray enters. countK > 0: child K is a leaf of countK triangles starting at
-// triangle childK of the leaf-ordered triangle buffer; countK == 0: child K is inner node childK. An absent child
-// (a tree of fewer than two leaves) has an inverted box that no ray enters.
-#define BVH_NODE_BYTES 64
-// Leaf triangles: 3 vec4 vertices (w unused) in leaf order.
-#define BVH_TRI_BYTES 48
-// Leaves hold at most this many triangles (the shader packs count - 1 in 4 bits of a stack entry).
-#define BVH_MAX_LEAF 16
 
 // Per-frame counters, one 32-bit word each; 64-bit sums are split into LO/HI words (the shader
 // carries into HI when LO wraps).
@@ -52,6 +42,3 @@
 #define BVH_ACC_OVERFLOW 0x10000000u   // a ray's stack overflowed
 #define BVH_ACC_CAPPED 0x20000000u     // a ray's traversal reached its step cap
 #define BVH_ACC_TRUNCATED 0x40000000u  // the driver cut a dispatch's sample loop short
-
-// Child reference of an absent child (only the root of a tree of fewer than two leaves has one).
-#define BVH_ABSENT 0xFFFFFFFFu

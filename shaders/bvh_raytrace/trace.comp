@@ -19,7 +19,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 #define BVH_TICK_NODE() SIMD_TICK(BVH_SIMD_NODE)
 #define BVH_TICK_TRI() SIMD_TICK(BVH_SIMD_TRI)
-#include "bvh_raytrace/traverse.glsl"
+#define BVH_TRAVERSE_NODE_UNIT BVH_NODE_UNIT
+#define BVH_TRAVERSE_TRI_UNIT BVH_TRI_UNIT
+#include "common/bvh_traverse.glsl"
 layout(std430, binding = BVH_SAMPLE_BINDING) readonly buffer LightSamples { vec4 lightSamples[]; };
 layout(std430, binding = BVH_COUNTER_BINDING) buffer BvhCounters { uint bvhCounters[]; };
 

@@ -57,15 +57,14 @@
 #include "common/scene.glsl"
 #endif
 #if LS_START_MODE == LS_START_BVH
-// The near field: the segment before the start region's end, traced exactly through bvh_raytrace's
-// BVH with its traversal (any hit ends it); the line space walks from the region's end as
-// LS_START_DISTANCE does, so nothing is ignored.
-#include "bvh_raytrace/layout.glsl"
+// The near field: the segment before the start region's end, traced exactly through the scene's
+// BVH (framework/accel, common/bvh_traverse.glsl; any hit ends it); the line space walks from the
+// region's end as LS_START_DISTANCE does, so nothing is ignored.
 #define BVH_TRAVERSE_NODE_UNIT LS_BVH_NODE_UNIT
 #define BVH_TRAVERSE_TRI_UNIT LS_BVH_TRI_UNIT
 #define BVH_TICK_NODE() SIMD_TICK(LS_SIMD_NEAR_NODE)
 #define BVH_TICK_TRI() SIMD_TICK(LS_SIMD_NEAR_TRI)
-#include "bvh_raytrace/traverse.glsl"
+#include "common/bvh_traverse.glsl"
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
 

@@ -1,8 +1,8 @@
 #pragma once
-// A BVH on the GPU as shaders/bvh_raytrace/traverse.glsl reads it: nodes and leaf-ordered triangles
+// A BVH on the GPU as shaders/common/bvh_traverse.glsl reads it: nodes and leaf-ordered triangles
 // with their buffer-texture views, and the walk's step cap. bvh_raytrace traces through it, and so
-// does line_space's near field (start_region bvh).
-#include "algorithms/bvh_raytrace/BvhBuilder.h"
+// do line_space's near field (start_region bvh) and shadow_volumes' close calls.
+#include "framework/accel/BvhBuilder.h"
 #include "framework/gl/GlObjects.h"
 
 #include <cstddef>

@@ -1,6 +1,6 @@
-#include "algorithms/bvh_raytrace/BvhGpu.h"
+#include "framework/accel/BvhGpu.h"
 
-#include "algorithms/bvh_raytrace/BvhGpuLayout.h"
+#include "framework/accel/BvhGpuLayout.h"
 #include "framework/core/Error.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "algorithms/bvh_raytrace/BvhBuilder.h"
+#include "framework/accel/BvhBuilder.h"
 
 #include <algorithm>
 #include <array>

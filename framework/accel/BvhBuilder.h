@@ -2,7 +2,7 @@
 // CPU construction of the BVH that bvh_raytrace traverses on the GPU: binned SAH (Wald 2007) over
 // triangle centroids, flattened into the two-children-per-node layout of BvhGpuLayout.h.
 // GL-free, so the CPU tests can check it directly.
-#include "algorithms/bvh_raytrace/BvhGpuLayout.h"
+#include "framework/accel/BvhGpuLayout.h"
 #include "framework/scene/Scene.h"
 
 #include <cstdint>

@@ -1,8 +1,8 @@
 #pragma once
-// Host mirror of the bvh_raytrace GPU structures. The constants live once, in
-// shaders/bvh_raytrace/layout.glsl (#defines only, valid C++ and GLSL); the node struct is
-// mirrored from BvhNode in shaders/bvh_raytrace/traverse.glsl.
-#include "shaders/bvh_raytrace/layout.glsl"
+// Host mirror of the scene BVH's GPU structures. The constants live once, in
+// shaders/common/bvh_layout.glsl (#defines only, valid C++ and GLSL); the node struct is
+// mirrored from BvhNode in shaders/common/bvh_traverse.glsl.
+#include "shaders/common/bvh_layout.glsl"
 
 #include <cstddef>
 #include <cstdint>

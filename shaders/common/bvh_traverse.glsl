@@ -1,23 +1,22 @@
-// The BVH traversal of bvh_raytrace, shared with line_space's near field (start_region bvh): Aila &
-// Laine's while-while walk (inner nodes until a leaf is found, then the leaves), near child first, a
-// fixed stack whose overflow is reported, any-hit early exit, the watertight triangle test. Needs
-// common/watertight.glsl (and includes common/slab.glsl). The including shader may set, before including it:
+// The traversal of the scene BVH (framework/accel), run by bvh_raytrace, line_space's near field
+// (start_region bvh) and shadow_volumes' close calls: Aila & Laine's while-while walk (inner nodes
+// until a leaf is found, then the leaves), near child first, a fixed stack whose overflow is
+// reported, any-hit early exit, the watertight triangle test. Needs common/watertight.glsl (and
+// includes common/slab.glsl and common/bvh_layout.glsl). The including shader sets, before including it:
 //   BVH_TRAVERSE_NODE_UNIT, BVH_TRAVERSE_TRI_UNIT  the texture units of the nodes and triangles
-//                                                  (default: bvh_raytrace's, layout.glsl)
+// and may set:
 //   BVH_STACK_SIZE, BVH_SHORT_STACK                the stack (default 64 entries, in memory)
 //   BVH_TICK_NODE(), BVH_TICK_TRI()                a SIMD probe tick per node and per triangle
 // and sets the uniform uBvhStepCap (most loop passes of one walk: nodes + 2 * leaves + 1).
 #include "common/slab.glsl"
+#include "common/bvh_layout.glsl"
 
 #ifndef SHADOWLAB_FAULT_CUT_LEAF_LOOP
 #define SHADOWLAB_FAULT_CUT_LEAF_LOOP 0
 #endif
 
-#ifndef BVH_TRAVERSE_NODE_UNIT
-#define BVH_TRAVERSE_NODE_UNIT BVH_NODE_UNIT
-#endif
-#ifndef BVH_TRAVERSE_TRI_UNIT
-#define BVH_TRAVERSE_TRI_UNIT BVH_TRI_UNIT
+#if !defined(BVH_TRAVERSE_NODE_UNIT) || !defined(BVH_TRAVERSE_TRI_UNIT)
+#error "define BVH_TRAVERSE_NODE_UNIT and BVH_TRAVERSE_TRI_UNIT before including common/bvh_traverse.glsl"
 #endif
 #ifndef BVH_STACK_SIZE
 #define BVH_STACK_SIZE 64
@@ -32,7 +31,7 @@
 #define BVH_TICK_TRI()
 #endif
 
-struct BvhNode { // 64 bytes, mirrored by bvh::NodeGpu (algorithms/bvh_raytrace/BvhGpuLayout.h)
+struct BvhNode { // 64 bytes, mirrored by bvh::NodeGpu (framework/accel/BvhGpuLayout.h)
     vec3 lo0; uint child0;
     vec3 hi0; uint child1;
     vec3 lo1; uint count0;
