@@ -3,12 +3,14 @@
 // the union and how often), `volumes` (with the hardware depth test, depth.frag first: the
 // G-buffer's depth at the test points; then (volume.vert/.frag: quads and caps counted on the stencil and in an
 // exact R32F count, close calls marked) and `resolve` (resolve.comp: count to visibility, close
-// calls listed) and `close_calls` (close_rays.comp: the listed pixels by the reference's ray).
+// calls listed) and `close_calls` (close_rays.comp: the listed pixels by the reference's ray, traced
+// through the scene's BVH, framework/accel).
 #include "algorithms/shadow_volumes/ShadowVolumes.h"
 
 #include "algorithms/shadow_volumes/EdgeAdjacency.h"
 #include "framework/algorithm/AlgorithmSupport.h"
 #include "framework/algorithm/SharedParams.h"
+#include "framework/accel/SceneBvh.h"
 #include "framework/core/CheckedMath.h"
 #include "framework/core/Error.h"
 #include "framework/gl/GpuCounters.h"
@@ -125,8 +127,14 @@ public:
         facingTexels_ = makeBufferTexture(facing_, GL_R32I, 4, "shadow_volumes' facing signs");
         recordTexels_ = makeBufferTexture(records_, GL_R32UI, 4, "shadow_volumes' silhouette records");
         sideTexels_ = makeBufferTexture(sides_, GL_R32UI, 4, "shadow_volumes' edge sides");
+        // The close calls' rays trace through the scene's BVH (leaves of 4, the default build).
+        bvh_.build(scene, bvh::BuildOptions{}, maxShaderStorageBlockBytes(), "shadow_volumes");
         counters_.allocate();
     }
+
+    // Moving parts: the silhouettes and volumes follow the posed scene buffers by themselves; the
+    // close calls' BVH is refitted to them.
+    void sceneMoved(const FrameInputs& f) override { bvh_.refit(*scene_, f.timer); }
 
     void resize(glm::ivec2 r) override {
         depthStencil_ = makeTexture2D(GL_DEPTH32F_STENCIL8, r.x, r.y);
@@ -136,7 +144,6 @@ public:
         other_ = makeTexture2D(GL_R32I, r.x, r.y);
         const size_t pixels = size_t(r.x) * size_t(r.y);
         closeList_ = GlBuffer((pixels + 1) * sizeof(uint32_t));
-        closeBlocked_ = GlBuffer(std::max<size_t>(pixels, 1) * sizeof(uint32_t), nullptr, 0);
         closeArgs_ = GlBuffer(3 * sizeof(uint32_t), nullptr, 0);
         if (options_.instrumentation) {
             closeView_ = makeTexture2D(GL_R32F, r.x, r.y);
@@ -185,9 +192,9 @@ public:
             setLightUniforms(eyePass_, f.light);
             eyePass_.set("uEye", f.camera.position);
             eyePass_.use();
-            for (unsigned first = 0; first < triangles; first += SV_CLOSE_RANGE) {
+            for (unsigned first = 0; first < triangles; first += SV_EYE_RANGE) {
                 eyePass_.set("uFirst", first);
-                eyePass_.set("uEnd", unsigned(std::min<size_t>(triangles, size_t(first) + SV_CLOSE_RANGE)));
+                eyePass_.set("uEnd", unsigned(std::min<size_t>(triangles, size_t(first) + SV_EYE_RANGE)));
                 glDispatchCompute(1, 1, 1);
             }
         }
@@ -267,35 +274,28 @@ public:
         const uint32_t noEntries = 0;
         glNamedBufferSubData(closeList_.id(), 0, sizeof(noEntries), &noEntries);
         closeList_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_CLOSE_LIST_BINDING);
-        closeBlocked_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_CLOSE_BLOCKED_BINDING);
         closeArgs_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_CLOSE_ARGS_BINDING);
         setLightUniforms(resolvePass_, f.light);
         if (options_.instrumentation) runPixelPass(f, resolvePass_, {&closeView_, &countView_});
         else runPixelPass(f, resolvePass_, {});
         f.timer.end();
 
-        // The close calls: one workgroup per listed pixel, the triangles in ranges of SV_CLOSE_RANGE,
-        // one dispatch each (close_rays.comp says why); the last writes their visibility.
+        // The close calls: one ray each through the BVH, an indirect dispatch sized by the list.
         f.timer.begin("close_calls");
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         closeArgsPass_.use();
         glDispatchCompute(1, 1, 1);
         glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
         bindPixelPassInputs(f);
+        bvh_.gpu().bind(SV_BVH_NODE_UNIT, SV_BVH_TRI_UNIT);
         setLightUniforms(closeRayPass_, f.light);
         closeRayPass_.set("uRayOffset", offset);
+        closeRayPass_.set("uBvhStepCap", unsigned(bvh_.gpu().stepCap));
         closeRayPass_.use();
         glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, closeArgs_.id());
-        for (unsigned first = 0;; first += SV_CLOSE_RANGE) {
-            const unsigned end = unsigned(std::min<size_t>(triangles, size_t(first) + SV_CLOSE_RANGE));
-            closeRayPass_.set("uFirst", first);
-            closeRayPass_.set("uEnd", end);
-            closeRayPass_.set("uLast", end >= triangles ? 1 : 0);
-            glDispatchComputeIndirect(0);
-            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-            if (end >= triangles) break;
-        }
+        glDispatchComputeIndirect(0);
         glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         finishPixelPass();
         f.timer.end();
         counters_.markStale();
@@ -310,6 +310,7 @@ public:
                                     {"close_call_pixels", double(c[SV_C_CLOSE_PIXELS])},
                                     {"stencil_wrapped_pixels", double(c[SV_C_WRAPPED])},
                                     {"loop_capped_pixels", double(c[SV_C_CUT_LOOPS])},
+                                    {"stack_overflow_pixels", double(c[SV_C_STACK_OVERFLOW])},
                                     {"eye_in_volumes", double(c[SV_C_EYE])},
                                     {"inconsistent_pixels", double(c[SV_C_INCONSISTENT])},
                                     {"open_edges", double(openEdges_)},
@@ -334,11 +335,11 @@ public:
     size_t memoryBytes() const override {
         const size_t pixels = size_t(resolution_.x) * size_t(resolution_.y);
         return sides_.size() + first_.size() + facing_.size() + records_.size() + draw_.size() + counters_.size() +
-               pixels * (8 + 4 + 4 + 4 + 8); // depth-stencil, count, other side, close-call image and list
+               bvh_.gpu().bytes() + pixels * (8 + 4 + 4 + 4 + 4); // depth-stencil, count, other side, close-call image and list
     }
     uint64_t overflowCount() const override {
         const auto& c = counters_.read();
-        return uint64_t(c[SV_C_RECORD_OVERFLOW]) + c[SV_C_WRAPPED] + c[SV_C_CUT_LOOPS];
+        return uint64_t(c[SV_C_RECORD_OVERFLOW]) + c[SV_C_WRAPPED] + c[SV_C_CUT_LOOPS] + c[SV_C_STACK_OVERFLOW];
     }
 
 private:
@@ -381,7 +382,7 @@ private:
         resolvePass_ = ShaderProgram::compute("shadow_volumes/resolve.comp", {instr, check});
         eyePass_ = ShaderProgram::compute("shadow_volumes/eye_count.comp", {{"SCENE_POSITION_TEXELS", "1"}});
         closeArgsPass_ = ShaderProgram::compute("shadow_volumes/close_args.comp", {});
-        closeRayPass_ = ShaderProgram::compute("shadow_volumes/close_rays.comp", {instr, {"SCENE_POSITION_TEXELS", "1"}});
+        closeRayPass_ = ShaderProgram::compute("shadow_volumes/close_rays.comp", {instr});
     }
 
     ShadowVolumesParams p_;
@@ -392,7 +393,8 @@ private:
     int subpixelBits_ = 8;
     bool zfailLast_ = true;
     ShaderProgram eyePass_, facingPass_, silhouettePass_, depthPass_, volumePass_, resolvePass_, closeArgsPass_, closeRayPass_;
-    GlBuffer sides_, first_, facing_, records_, draw_, closeList_, closeBlocked_, closeArgs_;
+    GlBuffer sides_, first_, facing_, records_, draw_, closeList_, closeArgs_;
+    bvh::SceneBvh bvh_; ///< the close calls' rays trace through it
     GlTexture facingTexels_, recordTexels_, sideTexels_, depthStencil_, count_, close_, other_, closeView_, countView_;
     GlFramebuffer fbo_;
     GlVertexArray emptyVao_;
@@ -402,15 +404,22 @@ private:
 } // namespace
 
 /// Edge sides and silhouette records (12 bytes a triangle each, storage blocks), the first side of
-/// each edge and the facing sign (4 each), 28 bytes a pixel; the edge adjacency's build peaks at
-/// ~130 bytes a triangle on the host. The triangles are read through the scene positions' view.
+/// each edge and the facing sign (4 each), the close calls' BVH (48 bytes a triangle in leaf order,
+/// nodes of 64 bytes for every two, bvh_raytrace's default leaves of 4; 152 bytes a triangle more
+/// held for its refits when the scene moves), 24 bytes a pixel; the BVH's build peaks at ~152 bytes
+/// a triangle on the host, the edge adjacency's at ~130. The triangles are read through the scene
+/// positions' view.
 Footprint shadowVolumesFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t n = q.triangles;
-    f.bytes = saturatingSum({saturatingMul(44, n), 28 * size_t(q.resolution.x) * size_t(q.resolution.y)});
-    f.peakBytes = saturatingMul(130, n);
+    const size_t nodes = n / 2 + 1;
+    f.bytes = saturatingSum({saturatingMul(44, n), saturatingMul(48, n), saturatingMul(64, nodes), q.moving ? saturatingMul(152, n) : 0,
+                             24 * size_t(q.resolution.x) * size_t(q.resolution.y)});
+    f.peakBytes = saturatingMul(152, n);
     f.refusal = storageRefusal(q, "its edge sides", saturatingMul(12, n));
     if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", saturatingMul(3, n));
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its BVH's leaf-ordered triangles", saturatingMul(48, n), true);
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "its BVH's nodes", saturatingMul(64, nodes), true);
     return f;
 }
 AlgorithmInfo shadowVolumesInfo() {
@@ -419,6 +428,7 @@ AlgorithmInfo shadowVolumesInfo() {
                                             {LightType::Point, LightType::Spot, LightType::Directional}, true,
                                             &shadowVolumesSchema);
     info.footprint = &shadowVolumesFootprint;
+    info.motion = MotionHandling::Refit; // the close calls' BVH; the volumes follow the posed buffers
     return info;
 }
 

@@ -6,12 +6,24 @@
 // reference's own. Include after common/light.glsl.
 #include "common/watertight.glsl"
 
-WatertightRay shadowRayToLight(vec3 o, float offset) {
-    if (lightIsDirectional()) return watertightRay(o, -uLightDirection, uintBitsToFloat(0x7F800000u));
-    vec3 d = uLightPosition - o;
-    float dist = length(d);
+// The ray's direction d and length tfar (for a traversal that builds its own ray from them).
+void shadowRaySegment(vec3 o, float offset, out vec3 d, out float tfar) {
+    if (lightIsDirectional()) {
+        d = -uLightDirection;
+        tfar = uintBitsToFloat(0x7F800000u);
+        return;
+    }
+    vec3 v = uLightPosition - o;
+    float dist = length(v);
     // The origin on the light: nothing lies between them (tfar 0 hits nothing).
-    if (!(dist > 0.0)) return watertightRay(o, vec3(0.0, 0.0, 1.0), 0.0);
-    return watertightRay(o, d / dist, max(0.0, dist - offset));
+    d = dist > 0.0 ? v / dist : vec3(0.0, 0.0, 1.0);
+    tfar = dist > 0.0 ? max(0.0, dist - offset) : 0.0;
+}
+
+WatertightRay shadowRayToLight(vec3 o, float offset) {
+    vec3 d;
+    float tfar;
+    shadowRaySegment(o, offset, d, tfar);
+    return watertightRay(o, d, tfar);
 }
 

@@ -1,66 +1,46 @@
 #version 450
 // shadow_volumes: the close calls decided by the reference's own ray (common/shadow_ray.glsl, the
-// watertight test) against every triangle. One workgroup per listed pixel; its SV_CLOSE_LANES
-// invocations take every SV_CLOSE_LANES-th triangle of this dispatch's range [uFirst, uEnd), so
-// that no invocation loops more than SV_CLOSE_RANGE / SV_CLOSE_LANES times: llvmpipe silently ends
-// the loops of a shader invocation after 65,535 iterations in all (its gallivm loop limiter), and a
-// GPU driver kills a long dispatch. Ranges run as successive dispatches (the host's loop); a pixel
-// found blocked skips the later ones, and the last writes the visibility. A lane whose loop ended
-// short of its range without a hit was cut off: it is counted (loop_capped_pixels) and the pixel
-// written shadowed, never lit by mistake.
+// watertight test) traced through the scene's BVH (framework/accel, common/bvh_traverse.glsl): one
+// invocation per listed pixel, SV_CLOSE_GROUP to a workgroup, workgroups in rows of SV_CLOSE_ROW.
+// The walk is bounded by the tree (uBvhStepCap); one that overflows its stack or reaches its cap
+// (or that a driver's loop limit ends) is counted and its pixel written shadowed, never lit by
+// mistake. (It used to test every triangle of the scene per listed pixel: O(close calls x
+// triangles) per frame, a watchdog's risk on a big frame.)
 #include "common/instrumentation.glsl"
 #include "common/light.glsl"
-#include "common/scene.glsl"
 #include "common/shadow_ray.glsl"
 #include "common/counters.glsl"
 #include "shadow_volumes/layout.glsl"
-layout(local_size_x = SV_CLOSE_LANES) in;
+#define BVH_TRAVERSE_NODE_UNIT SV_BVH_NODE_UNIT
+#define BVH_TRAVERSE_TRI_UNIT SV_BVH_TRI_UNIT
+#include "common/bvh_traverse.glsl"
+layout(local_size_x = SV_CLOSE_GROUP) in;
 layout(binding = 0) uniform sampler2D uPosition;
 layout(binding = 1) uniform sampler2D uNormal;
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 layout(std430, binding = SV_CLOSE_LIST_BINDING) readonly buffer CloseList { uint closeCount; uint closeList[]; };
-layout(std430, binding = SV_CLOSE_BLOCKED_BINDING) buffer CloseBlocked { uint closeBlocked[]; };
 layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
 uniform float uRayOffset;
-uniform uint uFirst, uEnd; // this dispatch's triangles
-uniform int uLast;         // 1 on the last range: write the visibility
 
-shared uint groupBlocked;
-
+#if SHADOWLAB_INSTRUMENTATION
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(counters, lo, value)
+#endif
 
 void main() {
-    uint entry = gl_WorkGroupID.y * uint(SV_CLOSE_ROW) + gl_WorkGroupID.x;
-    if (entry >= closeCount) return; // the whole workgroup: uniform
-    if (gl_LocalInvocationIndex == 0u) groupBlocked = closeBlocked[entry];
-    barrier();
-    uint blocked = groupBlocked;
-    if (blocked == 0u) {
-        uint word = closeList[entry];
-        ivec2 px = ivec2(int(word & 0xFFFFu), int(word >> 16));
-        vec3 p = texelFetch(uPosition, px, 0).xyz, n = texelFetch(uNormal, px, 0).xyz;
-        WatertightRay r = shadowRayToLight(p + n * uRayOffset, uRayOffset);
-        uint t = uFirst + gl_LocalInvocationIndex, tests = 0u;
-        bool hit = false;
-        for (; t < uEnd; t += uint(SV_CLOSE_LANES)) {
-            ++tests;
-            if (watertightHit(r, sceneVertex(t, 0u), sceneVertex(t, 1u), sceneVertex(t, 2u))) { hit = true; break; }
-        }
-        if (!hit && t < uEnd) { // the loop was ended from outside: count it, cast the pixel shadowed
-            atomicAdd(counters[SV_C_CUT_LOOPS], 1u);
-            hit = true;
-        }
-        if (hit) atomicOr(groupBlocked, 1u);
+    uint group = gl_WorkGroupID.y * uint(SV_CLOSE_ROW) + gl_WorkGroupID.x;
+    uint entry = group * uint(SV_CLOSE_GROUP) + gl_LocalInvocationIndex;
+    if (entry >= closeCount) return;
+    uint word = closeList[entry];
+    ivec2 px = ivec2(int(word & 0xFFFFu), int(word >> 16));
+    vec3 p = texelFetch(uPosition, px, 0).xyz, n = texelFetch(uNormal, px, 0).xyz;
+    vec3 o = p + n * uRayOffset, d;
+    float tfar;
+    shadowRaySegment(o, uRayOffset, d, tfar);
+    BvhTrace t = bvhTrace(bvhMakeRay(o, d, tfar));
+    if (t.overflow) atomicAdd(counters[SV_C_STACK_OVERFLOW], 1u);
+    if (t.capped) atomicAdd(counters[SV_C_CUT_LOOPS], 1u);
 #if SHADOWLAB_INSTRUMENTATION
-        addWide(SV_C_CLOSE_TESTS_LO, tests);
+    addWide(SV_C_CLOSE_TESTS_LO, t.tested);
 #endif
-    }
-    barrier();
-    if (gl_LocalInvocationIndex != 0u) return;
-    blocked = groupBlocked;
-    closeBlocked[entry] = blocked;
-    if (uLast != 0) {
-        uint word = closeList[entry];
-        imageStore(uVisibility, ivec2(int(word & 0xFFFFu), int(word >> 16)), vec4(blocked != 0u ? 0.0 : 1.0));
-    }
+    imageStore(uVisibility, px, vec4(t.occluded || t.overflow || t.capped ? 0.0 : 1.0));
 }

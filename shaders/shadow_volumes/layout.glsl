@@ -6,7 +6,6 @@
 #define SV_DRAW_BINDING 7     // the quads' DrawArraysIndirectCommand: {6, quads, 0, 0}
 #define SV_COUNTER_BINDING 8
 #define SV_CLOSE_LIST_BINDING 9    // {count, uint[pixels]}: close-call pixels, x | y << 16
-#define SV_CLOSE_BLOCKED_BINDING 10 // uint[pixels]: 1 once a triangle blocks the entry's ray
 #define SV_CLOSE_ARGS_BINDING 11    // the close-ray dispatch's {x, y, z} groups
 // Texture units of the volume pass (its vertex shader reads buffers as buffer textures: every GL
 // has those in vertex shaders, while vertex-stage storage blocks may be 0).
@@ -30,22 +29,27 @@
 #define SV_C_LIT 5            // lit pixels resolved
 #define SV_C_FRAGMENTS_LO 6   // volume fragments rasterised (instrumented), 64-bit
 #define SV_C_CLOSE_TESTS_LO 8 // triangle tests of the close calls, 64-bit
-#define SV_C_CUT_LOOPS 10     // close-ray loops ended from outside (the pixel is written shadowed)
+#define SV_C_CUT_LOOPS 10     // close-ray walks that reached their step cap or were ended from outside (written shadowed)
 #define SV_C_EYE 11           // volumes holding the eye (eye_count.comp): every pixel's two counts differ by it
 #define SV_C_INCONSISTENT 12  // lit pixels whose counts broke that rule (decided by the ray as close calls)
-#define SV_COUNTER_WORDS 13
+#define SV_C_STACK_OVERFLOW 13 // close-ray walks whose stack overflowed (the pixel is written shadowed)
+#define SV_COUNTER_WORDS 14
 #define SV_DEPTH_UNIT 5       // the G-buffer's depth (the depth pass)
 // The depth pass moves the G-buffer's depth at least this many float steps nearer (depth.frag);
 // the close calls allow for this many steps of depth-buffer rounding (volume.frag). The second is
 // the larger: a face the depth test orders wrongly lies within it, and is a close call.
 #define SV_NUDGE_ULPS 8
 #define SV_DEPTH_ULPS 16
-// The close calls' rays (close_rays.comp): one workgroup of SV_CLOSE_LANES per pixel, groups in
-// rows of SV_CLOSE_ROW, SV_CLOSE_RANGE triangles per dispatch (so 8,192 loop iterations at most
-// per invocation, far from llvmpipe's 65,535 and from a watchdog).
-#define SV_CLOSE_LANES 64
+// The close calls' rays (close_rays.comp): SV_CLOSE_GROUP listed pixels a workgroup, workgroups in
+// rows of SV_CLOSE_ROW, each ray traced through the scene's BVH.
+#define SV_CLOSE_GROUP 64
 #define SV_CLOSE_ROW 32768
-#define SV_CLOSE_RANGE 524288
+#define SV_BVH_NODE_UNIT 6    // the BVH's nodes and leaf-ordered triangles (buffer textures)
+#define SV_BVH_TRI_UNIT 7
+// The eye's count (eye_count.comp): SV_EYE_LANES invocations, SV_EYE_RANGE triangles a dispatch (so
+// 8,192 loop iterations at most per invocation, far from llvmpipe's 65,535 and from a watchdog).
+#define SV_EYE_LANES 64
+#define SV_EYE_RANGE 524288
 // The kinds of volume face (volume.vert to volume.frag).
 #define SV_FACE_SIDE 0
 #define SV_FACE_NEAR_CAP 1

@@ -4,8 +4,8 @@
 // count decides where the 8-bit stencil wrapped (a multiple of 256 reads 0: counted, never lit by
 // mistake). With SV_CHECK (analytic ZFAIL), a pixel whose counts beyond and before the test point
 // do not differ by the eye's own count (eye_count.comp) lost or doubled a face: it is decided as a
-// close call. A close call (volume.frag) is listed, for the reference's own ray test against every
-// triangle (close_rays.comp), which then writes its visibility (written here as the stencil says,
+// close call. A close call (volume.frag) is listed, for the reference's own ray traced through the
+// scene's BVH (close_rays.comp), which then writes its visibility (written here as the stencil says,
 // until then). The list holds one entry per pixel: it cannot overflow.
 #include "common/instrumentation.glsl"
 #include "common/light.glsl"
@@ -27,7 +27,6 @@ layout(r32f, binding = 2) writeonly uniform image2D uCountView; // debug: the ex
 #endif
 layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
 layout(std430, binding = SV_CLOSE_LIST_BINDING) buffer CloseList { uint closeCount; uint closeList[]; };
-layout(std430, binding = SV_CLOSE_BLOCKED_BINDING) writeonly buffer CloseBlocked { uint closeBlocked[]; };
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -59,7 +58,6 @@ void main() {
                 // Listed for close_rays.comp, which writes this pixel's visibility.
                 uint entry = atomicAdd(closeCount, 1u);
                 closeList[entry] = uint(px.x) | uint(px.y) << 16;
-                closeBlocked[entry] = 0u;
                 atomicAdd(counters[SV_C_CLOSE_PIXELS], 1u);
                 closeView = 1.0;
             }
