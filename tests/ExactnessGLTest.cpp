@@ -6,6 +6,8 @@
 // and lights built to put query points next to shadow planes and triangle planes, where a plane
 // test and the reference's ray test could round differently: thin posts, long slivers, a light on
 // the extension of a wall's plane, a light skimming the ground.
+#include "algorithms/bvh_raytrace/BvhRaytrace.h"
+#include "algorithms/izb/Izb.h"
 #include "algorithms/metric_tree/MetricTree.h"
 #include "algorithms/psv/Psv.h"
 #include "algorithms/ptsv/Ptsv.h"
@@ -164,6 +166,50 @@ TEST_P(ExactGrazingGLTest, EveryPixelIsTheReferences) {
 
 INSTANTIATE_TEST_SUITE_P(Table, ExactGrazingGLTest, ::testing::ValuesIn(kGrazing),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// ---- Where the GPU's triangle test and Embree's part ways ----------------------------------------
+
+// Thin posts standing almost under a point light, so that the shadow rays of the ground around
+// their feet run along the posts' sides for 8 units, a hair from parallel to them (sin φ from 5e-4
+// to 5e-3), the whole shot turned by an odd rotation so that no coordinate is round, seen close up.
+Shot postsTowardTheLight() {
+    const glm::mat4 turn = rotate(37.0f, glm::normalize(glm::vec3(0.3f, 1.0f, 0.55f))) * rotate(11.0f, {1, 0, 0});
+    const auto at = [&](glm::vec3 p) { return glm::vec3(turn * glm::vec4(p, 1.0f)); };
+    Scene local = makePlane({2, 2}, 1, Material{});
+    for (int i = 0; i < 24; ++i) {
+        const float a = glm::radians(15.0f * float(i) + 3.7f), r = 0.005f + 0.002f * float(i);
+        local.append(makeCylinder(0.0015f, 8.0f, 16, Material{}), translate({r * std::cos(a), 0, r * std::sin(a)}));
+    }
+    Shot s;
+    s.scene.append(local, turn);
+    s.camera = lookAt(at({0.015f, 0.02f, -0.03f}), at({0.012f, 0.0f, 0.0008f}), 6.0f);
+    s.light = pointLight(at({0.0f, 10.0f, 0.0f}));
+    return s;
+}
+
+// On rays that run a hair from parallel to a triangle for a long way, the watertight test in
+// floats decides by rounding, and ours (common/watertight.glsl) and Embree's robust one round
+// differently: both are watertight, neither is wrong, and on this shot a few pixels differ. What
+// holds is that every GPU algorithm makes the one decision of the shared test: the exact family,
+// izb and bvh_raytrace give the same image, bit for bit, and each differs from the reference on the
+// same pixels. (The 1-2 falsely lit pixels of frame 1 of configs/metric_tree/many_models.json,
+// 74 M triangles among thin fence posts, stay with every culling test off: the same cause.)
+class ExactFamilyGLTest : public GLTest {};
+
+TEST_F(ExactFamilyGLTest, GpuAlgorithmsShareOneTriangleDecisionWhereEmbreeDiffers) {
+    const Shot shot = postsTowardTheLight();
+    const AlgorithmRun bvh = runAlgorithm(bvhRaytraceInfo(), shot, {});
+    const size_t differs = size_t(bvh.accuracy.mismatchRatio * double(bvh.accuracy.litPixels) + 0.5);
+    std::printf("[exact] posts toward the light: bvh_raytrace differs from the reference on %zu of %zu lit pixels\n",
+                differs, bvh.accuracy.litPixels);
+    for (const Exact& e : kExact) {
+        const AlgorithmRun o = runAlgorithm(e.info(), shot, e.params);
+        EXPECT_EQ(o.visibility, bvh.visibility) << e.name;
+        EXPECT_EQ(o.overflow, 0u) << e.name;
+    }
+    const AlgorithmRun izb = runAlgorithm(izbInfo(), shot, {});
+    EXPECT_EQ(izb.visibility, bvh.visibility) << "izb";
+}
 
 } // namespace
 } // namespace shadowlab
