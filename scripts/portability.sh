@@ -80,6 +80,7 @@ SUITES="Registry/ConformanceGLTest.*:ConformanceTimingModeGLTest.*:Registry/Chan
 SUITES+=":Registry/SchemaConformanceTest.*"
 SUITES+=":Table/PsvAccuracyGLTest.*:Table/PtsvAccuracyGLTest.*:Table/MetricTreeAccuracyGLTest.*"
 SUITES+=":Table/BvhRaytraceAccuracyGLTest.*:Table/ShadowVolumesAccuracyGLTest.*:Table/IzbAccuracyGLTest.*:*TinyStack*:*TinyJobList*:*Fault*"
+SUITES+=":ShadowVolumesGLTest.ParallelBorderIsFlaggedNotANaN:ExactFamilyGLTest.*"
 TABLE="Table/PortabilityGLTest.*:PortabilityTableTest.*"
 NO_BALLOT_EXCLUDED="Table/PtsvAccuracyGLTest.MatchesReference/*packet*"
 if [ -n "$a_junit" ] && [ ! -s "$a_junit" ]; then

@@ -83,7 +83,7 @@ PlaneError planeErrors(const Edges& e) {
     return out;
 }
 
-TEST_F(ShadowPlaneGLTest, PlanesOfEdgesPointingAtTheLightPassThroughTheirEnds) {
+TEST_F(ShadowPlaneGLTest, FaultRoundedCrossProductAndTheAccuratePlanes) {
     const PlaneError accurate = planeErrors(postEdges());
     PlaneError rounded;
     {
