@@ -124,6 +124,20 @@ std::vector<BadCase> badCases() {
         {"GltfTranslationKeyBeyondCoordinates", "m.gltf",
          test::animatedTriangleGltf({{"translation", "LINEAR", {0, 1}, {0, 0, 0, 3e38f, 0, 0}}}),
          {"m.gltf", "/nodes/0", "beyond ±1e15", "frame 1"}, R"(, "animation": 0)"},
+        // What the glTF reader refuses in its own words, named by JSON path (checked before it).
+        {"GltfByteStrideOfThree", "m.gltf", test::triangleGltf({{"bufferViews", R"([{"buffer": 0, "byteLength": 36, "byteStride": 3}])"}}),
+         {"m.gltf", "/bufferViews/0/byteStride"}},
+        {"GltfByteStrideOf256", "m.gltf", test::triangleGltf({{"bufferViews", R"([{"buffer": 0, "byteLength": 36, "byteStride": 256}])"}}),
+         {"m.gltf", "/bufferViews/0/byteStride"}},
+        {"GltfDataUriShorterThanItsByteLength", "m.gltf",
+         test::triangleGltf({{"buffers", R"([{"byteLength": 48, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA"}])"}}),
+         {"m.gltf", "/buffers/0/byteLength"}},
+        {"GltfBufferFileMissing", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "nope.bin"}])"}}),
+         {"m.gltf", "/buffers/0/uri", "does not exist"}},
+        {"GltfSkinWithoutInverseBindMatrices", "m.gltf", test::triangleGltf({{"skins", R"([{"joints": [0]}])"}}),
+         {"m.gltf", "/skins/0/inverseBindMatrices"}},
+        {"GlbBufferLongerThanItsBinaryChunk", "m.glb", test::glbOf(test::triangleGltf({{"buffers", R"([{"byteLength": 36}])"}})),
+         {"m.glb", "/buffers/0/byteLength"}},
         {"UnbackedAccessorOfGigabytes", "m.gltf", test::triangleGltf({{"accessors", R"([{"componentType": 5126, "type": "MAT4", "count": 120000000}])"}}), {"/accessors/0/count", "too large"}},
     };
 }

@@ -18,10 +18,11 @@ std::string slurp(const std::string& path) {
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-/// A finished output holding `tag` in its summary.json.
+/// A finished output holding `tag` in its summary.json, with the mark every run's output carries.
 void makeOutput(const std::string& dir, const std::string& tag) {
     fs::create_directories(dir);
     std::ofstream(dir + "/summary.json") << tag;
+    std::ofstream(dir + "/.shadowlab-output");
 }
 
 std::string errorOf(const std::string& dir, bool force) {
@@ -214,6 +215,9 @@ TEST(OutputPlaceTest, ASweepsRunSlotsAreTheOnlyOutputsInsideIt) {
     std::string base = test::makeTempDir("place-sweep"), sweep = base + "/sweep";
     fs::create_directories(sweep + "/runs");
     std::ofstream(sweep + "/sweep.json") << "{}";
+    // Only a slot the sweep planned: it writes runs/ID.config.json before it starts the run there.
+    EXPECT_NE(errorOf(sweep + "/runs/abc123", false).find("inside the sweep directory"), std::string::npos);
+    std::ofstream(sweep + "/runs/abc123.config.json") << "{}";
     {
         OutputPlace run = OutputPlace::open(sweep + "/runs/abc123", true);  // as `sweep run` starts its runs
         std::ofstream(run.partialDir() + "/summary.json") << "run";

@@ -6,6 +6,7 @@
 #include "TestSupport.h"
 
 #include <filesystem>
+#include <fstream>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
@@ -243,6 +244,121 @@ TEST(UserTextTest, AnEmptyOutIsRefused) {
     const Result r = shell(kBin + " run " + kSmoke + " --out ''");
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("--out"), std::string::npos) << r.out;
+}
+
+// ---- A second probe's findings (each a reproduction kept as a test) --------------------------------
+
+std::string readText(const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A tiny config (one algorithm, a small frame) for the output-place cases: they fail before any frame.
+std::string tinyConfig(const std::string& dir) {
+    Json c = test::smallSweep()["base"];
+    c["name"] = "tiny";
+    c["frames"] = 1;
+    c["algorithms"] = Json::array({Json{{"algorithm", "shadow_map"}}});
+    c["reference"] = false;
+    return test::writeJson(dir + "/tiny.json", c);
+}
+
+// D1: a sweep's name forms its default folder results/NAME, so it must be one path component, as
+// a run's name must ("../../x" wrote the sweep outside results/).
+TEST(UserTextTest, ASweepNameThatIsAPathIsRefused) {
+    const std::string dir = test::makeTempDir("user-text-sweep-name");
+    for (const char* name : {"../../esc_sweep", "..", ".", "a/b"}) {
+        Json sw = test::smallSweep();
+        sw["name"] = name;
+        const std::string file = test::writeJson(dir + "/s.sweep.json", sw);
+        expectOneLineNaming(shell(kBin + " sweep plan " + file), "/name");
+    }
+    EXPECT_FALSE(fs::exists(dir + "/../esc_sweep"));
+}
+
+// D2: a sweep's folder is checked as a run's is, and must be empty or a sweep's: the working
+// directory, a symbolic link and a folder of the user's were adopted, and `sweep merge` then wrote
+// over the user's own sweep.md, sweep.csv and plan.json there.
+TEST(UserTextTest, ASweepFolderIsEmptyOrASweepsOwn) {
+    const std::string dir = test::makeTempDir("user-text-sweep-place");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep());
+    fs::create_directories(dir + "/mine");
+    for (const char* name : {"sweep.md", "sweep.csv", "plan.json", "file.txt"}) std::ofstream(dir + "/mine/" + name) << "keep\n";
+    fs::create_directories(dir + "/target");
+    fs::create_symlink(dir + "/target", dir + "/link");
+    fs::create_directories(dir + "/cwd/inner");
+    for (const std::string& out : {dir + "/mine", dir + "/link"}) {
+        const Result r = shell(kBin + " sweep run " + file + " --out " + out);
+        EXPECT_EQ(r.rc, 2) << out << ": " << r.out;
+        EXPECT_LE(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    }
+    for (const char* out : {".", ".."}) {
+        const Result r = shell("cd " + dir + "/cwd/inner && " + kBin + " sweep run " + file + " --out " + out);
+        EXPECT_EQ(r.rc, 2) << out << ": " << r.out;
+    }
+    for (const char* name : {"sweep.md", "sweep.csv", "plan.json", "file.txt"}) EXPECT_EQ(readText(dir + "/mine/" + name), "keep\n");
+    EXPECT_FALSE(fs::exists(dir + "/mine/sweep.json"));
+    EXPECT_FALSE(fs::exists(dir + "/target/sweep.json"));
+    EXPECT_FALSE(fs::exists(dir + "/cwd/sweep.json"));
+    EXPECT_FALSE(fs::exists(dir + "/cwd/inner/sweep.json"));
+}
+
+// D3, D4: nothing goes inside a sweep but its own runs: a sweep into another's runs/xx (it left a
+// sweep skeleton there), a run into a runs/NAME the sweep never planned (it was accepted).
+TEST(UserTextTest, NothingButASweepsOwnRunsGoesInsideIt) {
+    const std::string dir = test::makeTempDir("user-text-sweep-nest");
+    fs::create_directories(dir + "/sw/runs");
+    std::ofstream(dir + "/sw/sweep.json") << "{}\n";
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep());
+    expectOneLineNaming(shell(kBin + " sweep run " + file + " --out " + dir + "/sw/runs/xx"), "sweep");
+    EXPECT_FALSE(fs::exists(dir + "/sw/runs/xx"));
+    const std::string config = tinyConfig(dir);
+    expectOneLineNaming(shell(kBin + " validate " + config + " --set output.dir=" + dir + "/sw/runs/abc"), "sweep");
+    // The sweep's own slot, where it wrote the run's config: accepted.
+    std::ofstream(dir + "/sw/runs/abc.config.json") << "{}\n";
+    const Result ok = shell(kBin + " validate " + config + " --set output.dir=" + dir + "/sw/runs/abc");
+    EXPECT_EQ(ok.rc, 0) << ok.out;
+}
+
+// D7: DIR.lock holds "shadowlab-lock PID"; a user's file there, even an empty one or one holding
+// only digits, is refused and left as it was (it was taken for a stale lock and deleted).
+TEST(UserTextTest, AUsersFileAtTheLockIsNeverTakenForALock) {
+    const std::string dir = test::makeTempDir("user-text-lock");
+    const std::string config = tinyConfig(dir);
+    for (const char* content : {"", "1", "0", "99999999999999999999"}) {
+        std::ofstream(dir + "/out.lock") << content;
+        const Result r = shell(kBin + " run " + config + " --out " + dir + "/out --no-progress");
+        EXPECT_EQ(r.rc, 2) << "\"" << content << "\": " << r.out;
+        EXPECT_EQ(readText(dir + "/out.lock"), content);
+        EXPECT_FALSE(fs::exists(dir + "/out"));
+    }
+}
+
+// D8: --force replaces only a directory marked as a run's output (.shadowlab-output, or the
+// summary.json a run writes), not one that merely holds files of those names: a folder with a
+// directory named summary.json, or an empty config.resolved.json, was replaced with its contents.
+TEST(UserTextTest, ForceNeedsARealOutputNotItsFileNames) {
+    const std::string dir = test::makeTempDir("user-text-force");
+    const std::string config = tinyConfig(dir);
+    fs::create_directories(dir + "/a/summary.json");
+    std::ofstream(dir + "/a/precious.txt") << "keep\n";
+    fs::create_directories(dir + "/b");
+    std::ofstream(dir + "/b/config.resolved.json") << "{}\n";
+    std::ofstream(dir + "/b/precious.txt") << "keep\n";
+    for (const char* name : {"a", "b"}) {
+        const Result r = shell(kBin + " run " + config + " --out " + dir + "/" + name + " --force --no-progress");
+        expectOneLineNaming(r, name);
+        EXPECT_EQ(readText(dir + "/" + name + "/precious.txt"), "keep\n");
+    }
+}
+
+// D6: an area light's sides are bounded as every position is (sample points at ±5e37 validated,
+// ran, and gave a silently wrong line_space image).
+TEST(UserTextTest, AnAreaLightsSizeIsBounded) {
+    const std::string dir = test::makeTempDir("user-text-area");
+    const std::string config = tinyConfig(dir);
+    expectOneLineNaming(shell(kBin + " validate " + config + " --set light.type=area --set 'light.size=[1e38,1e38]'"),
+                        "/light/size");
 }
 
 } // namespace

@@ -530,6 +530,30 @@ private:
 /// scene positions fit one storage block (the reported size), as setScene does; with
 /// start_triangles culled a plane per triangle (16 bytes), with leaf_split > 1 8 bytes per occupied
 /// leaf (at most about one per triangle).
+/// An upper bound of the N-tree's pools for `triangles` triangles, without the scene: level l of the
+/// tree has k³ cells (k = N^l), of which a triangle, lying in a plane, touches at most 4k² (a plane
+/// crosses at most three cells of each column along its normal's largest axis, four with the cells
+/// it only touches), and a cell is a node only where a triangle touches it. Every node holds its
+/// line space (wordsPerNode words), its occupancy bits, its entry in the node pool and a children
+/// group of N³ entries in the tree pool. The build refuses more than LS_BIT_CHUNKS storage blocks of
+/// line space and one block of nodes or tree (NTreeBuilder), so neither can exceed that.
+size_t lineSpacePoolBound(int n, int d, size_t triangles, size_t blockBytes) {
+    size_t nodes = 0, k = 1;
+    for (int level = 0; level < d; ++level, k = saturatingMul(k, size_t(n))) {
+        const size_t cells = saturatingMul(saturatingMul(k, k), k);
+        nodes = saturatingSum({nodes, std::min(cells, saturatingMul(saturatingMul(4, saturatingMul(k, k)), std::max<size_t>(triangles, 1)))});
+    }
+    const size_t cube = size_t(n) * size_t(n) * size_t(n);
+    size_t bits = saturatingMul(nodes, 4 * ls::wordsPerNode(n));
+    size_t nodePool = saturatingMul(nodes, sizeof(ls::NodeGpu)), treePool = saturatingMul(nodes, 4 * cube);
+    if (blockBytes > 0) {
+        bits = std::min(bits, saturatingMul(LS_BIT_CHUNKS, blockBytes));
+        nodePool = std::min(nodePool, blockBytes);
+        treePool = std::min(treePool, blockBytes);
+    }
+    return saturatingSum({bits, nodePool, treePool, saturatingMul(nodes, 4 * ls::occupancyWords(n))});
+}
+
 Footprint lineSpaceFootprint(const FootprintQuery& q) {
     Footprint f;
     const std::string& region = std::get<std::string>(q.params->get("start_region"));
@@ -537,8 +561,12 @@ Footprint lineSpaceFootprint(const FootprintQuery& q) {
     const bool culled = exact && std::get<std::string>(q.params->get("start_triangles")) == "culled";
     const bool split = std::get<int>(q.params->get("leaf_split")) > 1;
     const size_t n = q.triangles;
-    f.bytes = saturatingMul(8 + (culled ? 16 : 0) + (split ? 8 : 0), n);
-    f.peakBytes = saturatingSum({f.bytes, saturatingMul(8, n)});
+    const size_t pools = lineSpacePoolBound(std::get<int>(q.params->get("n")), std::get<int>(q.params->get("d")), n,
+                                            q.reportedStorageBlockBytes);
+    // The pools are built on the host and uploaded: both copies are held while setScene() runs.
+    f.bytes = saturatingSum({saturatingMul(8 + (culled ? 16 : 0) + (split ? 8 : 0), n), pools});
+    f.peakBytes = pools;
+    f.peakBytes = saturatingSum({f.peakBytes, saturatingMul(8, n)});
     if (exact) f.refusal = storageRefusal(q, "the scene positions its exact start region reads", saturatingMul(36, n), true);
     if (region == "bvh") {
         // bvh_raytrace's tree with its default leaves of 4: triangles 48 bytes, nodes ~32 bytes a triangle.

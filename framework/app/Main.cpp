@@ -170,7 +170,8 @@ int run(const std::vector<std::string>& args) {
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
     const ScenePrediction predicted = predictConfigScene(config, overrides);
-    const MemoryPlan plan = checkMemoryPlan(cfg, predicted.triangles, predicted.moving, currentDeviceLimits(predicted.triangles));
+    const MemoryPlan plan =
+        checkMemoryPlan(cfg, predicted.triangles, predicted.moving, currentDeviceLimits(predicted.triangles), predicted.materials);
     std::fprintf(stderr, "shadowlab: memory: %s\n", plan.summary().c_str());
     opt.memoryPlan = plan.toJson();
     cfg = loadConfig(config, true, overrides);
@@ -226,7 +227,7 @@ int plan(const std::vector<std::string>& args) {
                 limits.reportedStorageBlockBytes >> 20, limits.textureBufferTexels);
     for (const std::string& line : describeFootprints(cfg, predicted.triangles, predicted.moving, limits))
         std::printf("%s\n", line.c_str());
-    const MemoryPlan p = checkMemoryPlan(cfg, predicted.triangles, predicted.moving, limits);
+    const MemoryPlan p = checkMemoryPlan(cfg, predicted.triangles, predicted.moving, limits, predicted.materials);
     std::printf("plan: %s\n", p.summary().c_str());
     return 0;
 }

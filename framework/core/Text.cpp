@@ -5,6 +5,10 @@
 
 namespace shadowlab {
 
+bool isFileName(const std::string& name) {
+    return name != "." && name != ".." && name.find_first_of("/\\") == std::string::npos;
+}
+
 namespace {
 
 /// Length of the UTF-8 sequence starting at text[i], 0 when it is malformed there.

@@ -38,6 +38,10 @@ std::string userTextProblem(const std::string& text);
 /// length. "" when the path may be used.
 std::string pathTextProblem(const std::string& path);
 
+/// Whether `name` can be one component of a path (no '/' or '\\', not "." or ".."): a name that
+/// forms the default output folder results/NAME must be.
+bool isFileName(const std::string& name);
+
 /// `text` as Markdown that renders as exactly `text`: every character CommonMark or a pipe table
 /// could read as markup is backslash-escaped: \ ` * [ ] ( ) ! | < > # ~ & { } + - . = $ :
 /// and '_' unless it stands between two letters or digits (CommonMark never emphasises there,

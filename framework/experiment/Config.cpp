@@ -13,11 +13,6 @@ namespace shadowlab {
 
 namespace {
 
-/// Whether `name` can be one component of a path: the default output folder is results/NAME.
-bool isFileName(const std::string& name) {
-    return name != "." && name != ".." && name.find_first_of("/\\") == std::string::npos;
-}
-
 const std::vector<std::string> kLightTypes = {"point", "spot", "directional", "area"};
 
 LightType lightTypeFromString(const std::string& s) {
@@ -46,6 +41,9 @@ void parseLight(JsonNode node, ExperimentConfig& c) {
     if (l.type == LightType::Area) {
         l.size = node.getVec2("size", {1, 1});
         if (l.size.x <= 0 || l.size.y <= 0) node.fail("size", "both sides must be positive");
+        // Its sample points lie half a side from the centre: within the coordinates' bound too.
+        if (double(l.size.x) > kMaxCoordinate || double(l.size.y) > kMaxCoordinate)
+            node.fail("size", "a side exceeds 1e15 scene units (the light's sample points must lie within ±1e15, as every position)");
         l.samples = node.getInt("samples", 16, configlimits::kAreaSamplesMin, configlimits::kAreaSamplesMax);
         l.pattern = node.getEnum("pattern", "stratified", {"stratified", "grid", "random"});
         l.seed = uint32_t(node.getInt("seed", 1, 0, INT32_MAX));

@@ -122,12 +122,13 @@ std::vector<std::string> describeFootprints(const ExperimentConfig& cfg, size_t 
     return lines;
 }
 
-MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits) {
-    return checkMemoryPlan(cfg, triangles, moving, limits, systemMemory());
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
+                           size_t materials) {
+    return checkMemoryPlan(cfg, triangles, moving, limits, systemMemory(), materials);
 }
 
 MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
-                           const SystemMemory& machine) {
+                           const SystemMemory& machine, size_t materials) {
     MemoryPlan plan;
     plan.triangles = triangles;
     plan.moving = moving;
@@ -143,8 +144,11 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool m
                              std::to_string(limits.storageBlockBytes >> 20) + " MiB on this device, " +
                              std::to_string(poseLimit) + " triangles; this one has up to " + std::to_string(triangles));
 
-    plan.held.emplace_back("scene", saturatingMul(triangles, kSceneBytesPerTriangle));
-    plan.held.emplace_back("scene_gpu", saturatingMul(triangles, kSceneGpuBytesPerTriangle));
+    // Per triangle, plus one vertex of slack (Scene::append reserves it) and the materials: 16 bytes
+    // each on the host (Material) and on the GPU (its RGBA32F record).
+    const size_t materialBytes = saturatingMul(materials, 16);
+    plan.held.emplace_back("scene", saturatingSum({saturatingMul(triangles, kSceneBytesPerTriangle), sizeof(glm::vec3), materialBytes}));
+    plan.held.emplace_back("scene_gpu", saturatingSum({saturatingMul(triangles, kSceneGpuBytesPerTriangle), materialBytes}));
     // The largest object (a grid's copies) is made whole and then appended to the scene.
     plan.loadPeak = saturatingMul(2, plan.held[0].second);
     refuseOverflow(cfg, "/scene", "the scene", plan.loadPeak, triangles);

@@ -39,10 +39,12 @@ struct MemoryPlan {
 /// The plan for `cfg` with a scene of (at most) `triangles`; throws InputError naming cfg.file and
 /// the JSON path (the algorithm entry that refuses, or /scene) when an algorithm refuses the scene on
 /// this device or the plan's peak exceeds the memory available.
-MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits);
+/// `materials`: the scene's materials (ScenePrediction::materials), held on the host and the GPU.
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
+                           size_t materials = 0);
 /// As above against `machine` instead of this machine's /proc/meminfo (tests).
 MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
-                           const SystemMemory& machine);
+                           const SystemMemory& machine, size_t materials = 0);
 
 /// One line per algorithm entry: its estimate, or why it refuses the scene here (never throws):
 /// what `shadowlab plan` prints, to find the size where each algorithm stops.

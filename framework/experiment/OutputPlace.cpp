@@ -2,6 +2,7 @@
 
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
+#include "framework/core/JsonNode.h"
 
 #include <cerrno>
 #include <cstdio>
@@ -48,11 +49,32 @@ std::string markerOf(const fs::path& dir) {
     return "";
 }
 
+/// The mark every run's output carries (written into DIR.partial-PID, kept when it becomes DIR):
+/// what --force relies on to call a directory a shadowlab output, rather than on the names of the
+/// files in it, which anything can hold.
+constexpr const char* kOutputMark = ".shadowlab-output";
+
+bool isRegularFile(const fs::path& path) {
+    struct stat st {};
+    return ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/// An output written before the mark existed: its summary.json a regular file holding a JSON object.
+bool isLegacyOutput(const fs::path& dir) {
+    if (!isRegularFile(dir / "summary.json")) return false;
+    try {
+        const Json j = JsonNode::parseFile((dir / "summary.json").string());
+        return j.is_object();
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
 /// A run's output (or an empty directory, which holds nothing to lose).
 bool isShadowlabOutput(const fs::path& dir) {
     std::error_code ec;
-    const std::string m = markerOf(dir);
-    return m == "summary.json" || m == "config.resolved.json" || (m.empty() && fs::is_empty(dir, ec));
+    if (fs::is_empty(dir, ec) && !ec) return true;
+    return isRegularFile(dir / kOutputMark) || isLegacyOutput(dir);
 }
 
 /// Whether another run holds `lockPath` now: its holder keeps an exclusive flock for the whole run,
@@ -71,15 +93,15 @@ bool lockIsLive(const std::string& lockPath) {
     return live;
 }
 
+std::string lockText(int fd, bool* regular);
+std::string lockPid(const std::string& text);
+
 std::string lockOwner(const std::string& lockPath) {
     const int fd = ::open(lockPath.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOFOLLOW);
     if (fd < 0) return "";
-    char owner[24] = {0};
-    const ssize_t n = ::pread(fd, owner, sizeof owner - 1, 0);
+    const std::string pid = lockPid(lockText(fd, nullptr));
     ::close(fd);
-    std::string pid(owner, n > 0 ? size_t(n) : 0);
-    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) return "";
-    return " (pid " + pid + ")";
+    return pid.empty() ? "" : " (pid " + pid + ")";
 }
 
 /// The marks a run leaves in its temporary directories, so that only those are ever taken for a
@@ -119,7 +141,8 @@ bool isRunTemporary(const std::string& name) {
 /// An output inside another run's output, inside a run in progress, or inside a sweep (other than a
 /// sweep's own run slot, SWEEP/runs/ID) would be lost or corrupt when that one is replaced, or
 /// would replace part of it: refused before anything is created.
-void checkAncestors(const std::string& dir) {
+/// `allowRunSlot`: a run (not a sweep) may go to SWEEP/runs/ID, where the sweep wrote ID.config.json.
+void checkAncestors(const std::string& dir, bool allowRunSlot) {
     std::error_code ec;
     const fs::path lexical = fs::absolute(dir, ec).lexically_normal();
     std::vector<fs::path> chains = {lexical};
@@ -139,10 +162,13 @@ void checkAncestors(const std::string& dir) {
             const std::string marker = fs::is_directory(fs::symlink_status(a, ec)) ? markerOf(a) : "";
             if (marker.empty()) continue;
             if (marker == "sweep.json") {
-                // A sweep runs each of its runs into SWEEP/runs/ID; anything else inside it is not its.
-                if (depth == 2 && target.parent_path().filename() == "runs") continue;
+                // A sweep runs each of its runs into SWEEP/runs/ID, after writing ID.config.json
+                // there; anything else inside it is not its.
+                if (allowRunSlot && depth == 2 && target.parent_path().filename() == "runs" &&
+                    isRegularFile(target.string() + ".config.json"))
+                    continue;
                 throw InputError(shortPath(dir), "", "the output lies inside the sweep directory " + shortPath(a.string()) +
-                                              " (it holds sweep.json); its runs go to runs/ID. Choose --out outside it");
+                                              " (it holds sweep.json); only the sweep's own runs go to its runs/ID. Choose --out outside it");
             }
             throw InputError(shortPath(dir), "", "the output lies inside " + shortPath(a.string()) + ", a shadowlab run's output (it holds " + marker +
                                           "); replacing that one would delete this. Choose --out outside it");
@@ -172,23 +198,52 @@ std::string nestedInside(const fs::path& dir, size_t limit = 200000) {
     return "";
 }
 
-/// A regular file of at most 20 bytes, all digits: a shadowlab lock (empty while being written).
-bool isLockFile(int fd) {
+/// What a lock file holds: this prefix and its holder's pid.
+constexpr const char* kLockPrefix = "shadowlab-lock ";
+
+/// The lock file's text ("" when unreadable, or not a regular file of at most 40 bytes).
+std::string lockText(int fd, bool* regular = nullptr) {
     struct stat st {};
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > 20) return false;
-    char buf[21] = {0};
+    const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size <= 40;
+    if (regular) *regular = ok;
+    if (!ok) return "";
+    char buf[41] = {0};
     const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
-    if (n < 0) return false;
-    for (ssize_t i = 0; i < n; ++i)
-        if (buf[i] < '0' || buf[i] > '9') return false;
-    return true;
+    return n > 0 ? std::string(buf, size_t(n)) : "";
+}
+
+/// The pid in a lock file's text "shadowlab-lock PID", or "" when the text is not that.
+std::string lockPid(const std::string& text) {
+    const size_t p = std::strlen(kLockPrefix);
+    if (text.size() <= p || text.compare(0, p, kLockPrefix) != 0) return "";
+    const std::string pid = text.substr(p);
+    return pid.find_first_not_of("0123456789") == std::string::npos ? pid : "";
+}
+
+/// Whether fd is a shadowlab lock: "shadowlab-lock PID", or empty while its creator is writing it
+/// (that creator holds its flock from the start, so an empty file nobody holds is looked at again
+/// 50 ms later; still empty and free, it is somebody else's file).
+bool isLockFile(int fd) {
+    bool regular = false;
+    for (int look = 0; look < 10; ++look) {
+        const std::string text = lockText(fd, &regular);
+        if (!regular) return false;
+        if (!text.empty()) return !lockPid(text).empty();
+        if (::flock(fd, LOCK_SH | LOCK_NB) != 0) return errno == EWOULDBLOCK; // held: being written
+        ::flock(fd, LOCK_UN);
+        ::usleep(5000);
+    }
+    return false;
 }
 
 /// Takes the lock file's exclusive flock. The file is unlinked by its holder at the end, so after
 /// locking, check that the path still names the file we locked (else a newer lock file exists).
 int acquireLock(const std::string& lockPath, const std::string& dir) {
     for (int attempt = 0; attempt < 100; ++attempt) {
-        int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+        // Created here: ours (empty, and locked at once below); found: it must be a shadowlab lock.
+        int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+        const bool created = fd >= 0;
+        if (!created && errno == EEXIST) fd = ::open(lockPath.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
         if (fd < 0) {
             const int err = errno;
             throw InputError(shortPath(dir), "", "cannot create the lock file " + shortPath(lockPath) + ": " + std::strerror(err) +
@@ -196,7 +251,7 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
         }
         // A lock file holds nothing but its holder's pid (or nothing yet): anything else at that
         // path (a FIFO, a user's file) is not ours to lock, truncate or unlink.
-        if (!isLockFile(fd)) {
+        if (!created && !isLockFile(fd)) {
             ::close(fd);
             throw InputError(shortPath(dir), "", shortPath(lockPath) + " exists and is not a shadowlab lock file; move it away or "
                                           "choose another --out");
@@ -207,18 +262,17 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
         for (int wait = 0; wait < 10 && !(locked = ::flock(fd, LOCK_EX | LOCK_NB) == 0) && errno == EWOULDBLOCK; ++wait)
             ::usleep(5000);
         if (!locked) {
-            char owner[32] = {0};
-            ssize_t n = ::pread(fd, owner, sizeof owner - 1, 0);
+            const std::string pid = lockPid(lockText(fd, nullptr));
             ::close(fd);
-            std::string who = n > 0 ? " (pid " + std::string(owner, size_t(n)) + ")" : "";
+            const std::string who = pid.empty() ? "" : " (pid " + pid + ")";
             throw InputError(shortPath(dir), "", "output directory is in use by another shadowlab run" + who +
                                           "; wait for it or choose another --out");
         }
         struct stat held {}, named {};
         if (::fstat(fd, &held) == 0 && ::stat(lockPath.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
             held.st_dev == named.st_dev) {
-            std::string pid = pidSuffix();
-            if (::ftruncate(fd, 0) == 0) (void)!::pwrite(fd, pid.data(), pid.size(), 0);
+            const std::string text = kLockPrefix + pidSuffix();
+            if (::ftruncate(fd, 0) == 0) (void)!::pwrite(fd, text.data(), text.size(), 0);
             return fd;
         }
         ::close(fd);  // the holder unlinked it meanwhile: lock the new one
@@ -228,13 +282,43 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
 
 } // namespace
 
-void OutputPlace::check(const std::string& given) {
-    const std::string dir = normalize(given);
+namespace {
+/// What check() and checkSweepPlace() share: a path that can name a folder of its own.
+void checkPlace(const std::string& dir, bool allowRunSlot, const char* example) {
     if (dir.empty()) throw InputError("--out", "", "the output directory must not be empty");
     if (dir == "/" || containsWorkingDir(dir))
-        throw InputError(shortPath(dir), "", "the output directory cannot be the working directory or one above it "
-                                  "(an output is a directory of its own, e.g. --out results/run1)");
-    checkAncestors(dir);
+        throw InputError(shortPath(dir), "", std::string("the output directory cannot be the working directory or one above it "
+                                                         "(an output is a directory of its own, e.g. --out ") + example + ")");
+    checkAncestors(dir, allowRunSlot);
+}
+} // namespace
+
+void OutputPlace::checkSweepPlace(const std::string& given) {
+    const std::string dir = normalize(given);
+    checkPlace(dir, false, "results/sweep1");
+    std::error_code ec;
+    const auto status = fs::symlink_status(dir, ec);
+    if (fs::is_symlink(status))
+        throw InputError(shortPath(dir), "", "the sweep's folder is a symbolic link; give the directory it should name instead");
+    if (!fs::exists(status)) return;
+    if (!fs::is_directory(status)) throw InputError(shortPath(dir), "", "is not a folder (the sweep's output folder goes there)");
+    if (isRegularFile(fs::path(dir) / "sweep.json")) return;
+    // Empty, or nothing but what `sweep run` makes before it writes sweep.json: runs/ and the lock.
+    bool skeleton = true;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        const std::string n = e.path().filename().string();
+        std::error_code ec2;
+        skeleton = skeleton && ((n == "runs" && fs::is_directory(fs::symlink_status(e.path(), ec2))) ||
+                                (n == "sweep.lock" && isRegularFile(e.path())));
+    }
+    if (skeleton && !ec) return;
+    throw InputError(shortPath(dir), "", "exists and is not a sweep's folder (it holds no sweep.json): a sweep writes sweep.json, "
+                                         "runs/, plan.json, sweep.csv and sweep.md there; choose another --out or an empty folder");
+}
+
+void OutputPlace::check(const std::string& given) {
+    const std::string dir = normalize(given);
+    checkPlace(dir, true, "results/run1");
     std::error_code ec;
     const auto status = fs::symlink_status(dir, ec);
     if (fs::is_symlink(status))
@@ -305,15 +389,15 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
                                                                                      (output || inside.find(".lock") != std::string::npos))
             throw InputError(shortPath(dir), "", "the directory holds " + inside + "; --force replaces only a single run's output");
         if (!output)
-            throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no summary.json or "
-                                      "config.resolved.json); --force replaces only outputs");
+            throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no " + std::string(kOutputMark) +
+                                      " mark, nor a summary.json of a run); --force replaces only outputs");
         struct stat st {};
         if (::lstat(dir.c_str(), &st) == 0) place.existed_ = true, place.dev_ = uint64_t(st.st_dev), place.ino_ = uint64_t(st.st_ino);
     }
     place.partial_ = dir + ".partial-" + pidSuffix();
     fs::create_directories(place.partial_ + "/images", ec);
     if (ec) throw InputError(shortPath(dir), "", "cannot create " + shortPath(place.partial_) + ": " + ec.message());
-    if (!writeMark(fs::path(place.partial_) / kPartialMark))
+    if (!writeMark(fs::path(place.partial_) / kPartialMark) || !writeMark(fs::path(place.partial_) / kOutputMark))
         throw InputError(shortPath(dir), "", "cannot write in " + shortPath(place.partial_));
     return place;
 }
@@ -331,7 +415,7 @@ OutputPlace::~OutputPlace() {
     release();
 }
 
-void OutputPlace::refuseNestedPlace(const std::string& dir) { checkAncestors(normalize(dir)); }
+void OutputPlace::refuseNestedPlace(const std::string& dir) { checkAncestors(normalize(dir), true); }
 
 void OutputPlace::release() {
     if (lockFd_ < 0) return;

@@ -6,8 +6,10 @@
 //             lock (DIR.lock, flock: released by the kernel even on SIGKILL), removes what earlier
 //             killed runs left behind (DIR.partial-PID, DIR.old-PID), and creates DIR.partial-PID.
 //             An output inside another run's output, inside a run in progress or inside a sweep
-//             (but a sweep's own SWEEP/runs/ID) is refused, and so is --force on a directory that
-//             holds a run in progress or another output or sweep.
+//             (but a sweep's own SWEEP/runs/ID, where it wrote ID.config.json) is refused, and so
+//             is --force on a directory that holds a run in progress or another output or sweep,
+//             or that is not marked as an output (.shadowlab-output, written into every output).
+//             DIR.lock holds "shadowlab-lock PID"; a file there that is anything else is refused.
 //   commit(): swaps the finished DIR.partial-PID with DIR in one step (renameat2 RENAME_EXCHANGE),
 //             so DIR always holds either the previous or the new results, then drops the old ones.
 //             It replaces only the directory open() checked: one that appeared since, or now holds
@@ -34,6 +36,9 @@ public:
     /// working directory or one above it, nested (refuseNestedPlace), a link or a non-directory.
     /// open() checks it first; `validate` checks a config's output.dir with it.
     static void check(const std::string& dir);
+    /// InputError when `dir` cannot be a sweep's folder: as check() (but no place inside a sweep at
+    /// all, not even its runs/ID), and an existing folder must be empty or hold a sweep (sweep.json).
+    static void checkSweepPlace(const std::string& dir);
 
     OutputPlace(OutputPlace&& other) noexcept;
     OutputPlace& operator=(OutputPlace&&) = delete;

@@ -4,6 +4,7 @@
 
 #include "framework/core/JsonNode.h"
 #include "framework/core/JsonParse.h"
+#include "framework/core/Text.h"
 
 #include <tiny_gltf.h>
 
@@ -210,6 +211,70 @@ std::string glbJson(const std::string& file, const std::vector<unsigned char>& b
     // The chunk is padded to 4 bytes with spaces; some exporters pad with NULs, which JSON parsers reject.
     while (!json.empty() && json.back() == '\0') json.pop_back();
     return json;
+}
+
+/// The GLB's binary chunk length (0 when it has none): what buffer 0 may take from it.
+size_t glbBinLength(const std::vector<unsigned char>& bytes) {
+    const size_t at = 20 + size_t(readU32(bytes, 12));
+    const size_t json = (at + 3) & ~size_t(3);
+    if (json + 8 > bytes.size() || readU32(bytes, json + 4) != 0x004E4942u) return 0;
+    return size_t(readU32(bytes, json));
+}
+
+/// The decoded length of a base64 data URI's payload, or SIZE_MAX when `uri` is not one.
+size_t dataUriLength(const std::string& uri) {
+    if (uri.rfind("data:", 0) != 0) return SIZE_MAX;
+    const size_t comma = uri.find(',');
+    if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos) return SIZE_MAX;
+    size_t n = uri.size() - comma - 1, pad = 0;
+    for (size_t i = uri.size(); i > comma + 1 && uri[i - 1] == '=' && pad < 2; --i) ++pad;
+    return n / 4 * 3 - (n % 4 == 0 ? pad : 0);
+}
+
+/// What the glTF reader (tinygltf) refuses without saying where, checked first so that the error
+/// names its JSON path: a byteStride outside 4..252 or not a multiple of 4, a buffer whose bytes
+/// (a data URI's, a file's, the GLB's binary chunk) are fewer than its byteLength, a missing buffer
+/// file, a skin without inverseBindMatrices (optional in glTF 2.0, but required by the reader).
+void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool binary, size_t binLength) {
+    if (doc.contains("bufferViews"))
+        for (size_t i = 0; i < doc["bufferViews"].size(); ++i) {
+            const Json& v = doc["bufferViews"][i];
+            if (!v.contains("byteStride")) continue;
+            const uint64_t stride = v["byteStride"].get<uint64_t>();
+            if (stride < 4 || stride > 252 || stride % 4 != 0)
+                throw InputError(file, "/bufferViews/" + std::to_string(i) + "/byteStride",
+                                 std::to_string(stride) + " is not a stride glTF allows (a multiple of 4 from 4 to 252)");
+        }
+    if (doc.contains("buffers"))
+        for (size_t i = 0; i < doc["buffers"].size(); ++i) {
+            const Json& b = doc["buffers"][i];
+            const std::string where = "/buffers/" + std::to_string(i);
+            const uint64_t length = b.contains("byteLength") ? b["byteLength"].get<uint64_t>() : 0;
+            size_t have = SIZE_MAX;
+            if (!b.contains("uri")) {
+                if (!binary || i != 0) continue; // the reader refuses it with its own words, or it is unused
+                have = binLength;
+            } else {
+                const std::string uri = b["uri"].get<std::string>();
+                have = dataUriLength(uri);
+                // (A percent-encoded name is left to the reader, which resolves it its own way.)
+                if (have == SIZE_MAX && uri.rfind("data:", 0) != 0 && uri.find('%') == std::string::npos) {
+                    const std::string path = resolvePath(parentDir(file), uri);
+                    struct stat st {};
+                    if (::stat(path.c_str(), &st) != 0)
+                        throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " does not exist");
+                    have = S_ISREG(st.st_mode) ? size_t(st.st_size) : SIZE_MAX;
+                }
+            }
+            if (have != SIZE_MAX && have < length)
+                throw InputError(file, where + "/byteLength", std::to_string(length) + " bytes declared, the buffer holds " +
+                                                                 std::to_string(have));
+        }
+    if (doc.contains("skins"))
+        for (size_t i = 0; i < doc["skins"].size(); ++i)
+            if (!doc["skins"][i].contains("inverseBindMatrices"))
+                throw InputError(file, "/skins/" + std::to_string(i) + "/inverseBindMatrices",
+                                 "required here (the glTF reader used needs it, though glTF 2.0 does not; skins are not used)");
 }
 
 // Images are never used (only geometry and base colour factors), so skip decoding them.
@@ -921,6 +986,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
     Json doc = parseJson(jsonText, file, limits);
     if (!doc.is_object()) throw InputError(file, "", "not a glTF file (the JSON document is not an object)");
     TypeChecker(file).checkObject(doc, kRoot, "");
+    checkWhatTheReaderRefuses(doc, file, binary, binary ? glbBinLength(bytes) : 0);
 
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(skipImage, nullptr);

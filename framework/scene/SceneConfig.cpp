@@ -83,6 +83,9 @@ struct Builder {
     std::function<Scene()> make;
     std::function<size_t()> count;
     bool moves = false; ///< it has a path, an animation or node paths (or holds an object that does)
+    /// The materials it brings (Scene::append keeps every one of them): 1 when not set.
+    std::function<size_t()> materials;
+    size_t materialCount() const { return materials ? materials() : 1; }
     Scene operator()() const { return make(); }
 };
 
@@ -239,7 +242,8 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         Scene object = inner();
         gridTriangles(node, object.triangleCount(), copies, budget);
         return makeGrid(object, count, spacing, rotateStep);
-    }, [=] { return gridTriangles(node, inner.count(), copies, budget); }, inner.moves};
+    }, [=] { return gridTriangles(node, inner.count(), copies, budget); }, inner.moves,
+                   [=] { return saturatingMul(inner.materialCount(), copies); }};
 }
 
 /// The built object must be usable: an overflowing radius or scale turns every triangle into
@@ -313,7 +317,17 @@ Builder parseObject(JsonNode node, int depth, int budget) {
                 throw InputError(e.file(), e.jsonPath(), e.cause() + " (loaded from " + where + ")");
             }
         };
-        build.count = [make = build.make] { return make().triangleCount(); };
+        // Counted by loading it, once for both counts.
+        auto counted = std::make_shared<std::optional<std::pair<size_t, size_t>>>();
+        auto load = [make = build.make, counted] {
+            if (!*counted) {
+                const Scene s = make();
+                *counted = std::make_pair(s.triangleCount(), s.materials.size());
+            }
+            return **counted;
+        };
+        build.count = [load] { return load().first; };
+        build.materials = [load] { return load().second; };
         build.moves = !motion.animation.empty() || !motion.nodes.empty();
     } else {
         build = parseGenerator(node, kind, material, depth, budget);
@@ -329,6 +343,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
 
     Builder placed;
     placed.count = build.count;
+    placed.materials = build.materials;
     placed.moves = build.moves || path != nullptr;
     placed.make = [=]() mutable {
         Scene s = build();
@@ -388,6 +403,7 @@ ScenePrediction predictScene(JsonNode sceneNode) {
     for (size_t i = 0; i < parsed.builders.size(); ++i) {
         p.triangles = addWithinBudget(parsed.objects[i], p.triangles, parsed.builders[i].count(), parsed.budget);
         p.moving |= parsed.builders[i].moves;
+        p.materials = saturatingSum({p.materials, parsed.builders[i].materialCount()});
     }
     return p;
 }

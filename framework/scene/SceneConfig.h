@@ -24,6 +24,7 @@ void checkScene(JsonNode sceneNode);
 struct ScenePrediction {
     size_t triangles = 0;
     bool moving = false; ///< some object has a path, an animation or node paths
+    size_t materials = 0; ///< the materials its objects bring (a grid's copies each bring theirs)
 };
 ScenePrediction predictScene(JsonNode sceneNode);
 /// Rewrites every "gltf" path of a scene (or of one object, and of grids' inner objects) against

@@ -402,6 +402,9 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     JsonNode out = root.child("output");
     if (out.has("dir") && out.raw()["dir"].is_string() && out.raw()["dir"].get<std::string>().empty())
         out.fail("dir", "must not be empty (the sweep's folder: DIR/sweep.json, DIR/runs/)");
+    if (!out.has("dir") && !isFileName(s.name))
+        root.fail("name", "\"" + shortText(s.name, 60) + "\" cannot name the default output folder results/NAME (it holds '/' or "
+                          "'\\', or is '.' or '..'): give output.dir");
     s.outputDir = out.getPath("dir", "results/" + s.name);
     if (const std::string why = pathTextProblem(s.outputDir); !why.empty()) out.fail("dir", "the folder's name " + why);
     out.finish();
