@@ -345,7 +345,10 @@ TEST(UserTextTest, ForceNeedsARealOutputNotItsFileNames) {
     fs::create_directories(dir + "/b");
     std::ofstream(dir + "/b/config.resolved.json") << "{}\n";
     std::ofstream(dir + "/b/precious.txt") << "keep\n";
-    for (const char* name : {"a", "b"}) {
+    fs::create_directories(dir + "/c"); // a third probe: an empty JSON object is nobody's summary
+    std::ofstream(dir + "/c/summary.json") << "{}\n";
+    std::ofstream(dir + "/c/precious.txt") << "keep\n";
+    for (const char* name : {"a", "b", "c"}) {
         const Result r = shell(kBin + " run " + config + " --out " + dir + "/" + name + " --force --no-progress");
         expectOneLineNaming(r, name);
         EXPECT_EQ(readText(dir + "/" + name + "/precious.txt"), "keep\n");

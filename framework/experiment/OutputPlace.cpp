@@ -59,12 +59,13 @@ bool isRegularFile(const fs::path& path) {
     return ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-/// An output written before the mark existed: its summary.json a regular file holding a JSON object.
+/// An output written before the mark existed: its summary.json a regular file holding a JSON object
+/// with the "complete" and "algorithms" keys every run's summary has (`{}` is nobody's summary).
 bool isLegacyOutput(const fs::path& dir) {
     if (!isRegularFile(dir / "summary.json")) return false;
     try {
         const Json j = JsonNode::parseFile((dir / "summary.json").string());
-        return j.is_object();
+        return j.is_object() && j.contains("complete") && j.contains("algorithms");
     } catch (const std::exception&) {
         return false;
     }
