@@ -65,8 +65,12 @@ TEST_P(ShadowVolumesAccuracyGLTest, MatchesReference) {
                 count("stencil_wrapped_pixels"));
     expectAccurateRow(o, c.maxMismatch);
     // Close calls are the exception, not the method: the stencil decides at least nine pixels in
-    // ten (the most measured: 5.3 % on the engine, 3.7 % amid the clutter).
-    EXPECT_LT(count("close_call_pixels"), 0.1 * double(o.accuracy.litPixels));
+    // ten (the most measured: 5.3 % on the engine, 3.7 % amid the clutter) where the rasteriser has
+    // 8 subpixel bits. With GL's minimum of 4 (zink over lavapipe reports it) the border margin is
+    // 16 times wider, and on the engine, whose triangles are a pixel or less at 96², 22 % of the
+    // lit pixels are close calls (measured): there the bound is that with room, a third.
+    const double share = count("subpixel_bits") > 4.0 ? 0.1 : 0.34;
+    EXPECT_LT(count("close_call_pixels"), share * double(o.accuracy.litPixels));
     EXPECT_EQ(count("loop_capped_pixels"), 0.0);
 }
 
@@ -157,15 +161,15 @@ TEST_F(ShadowVolumesGLTest, StencilWrapAt256IsCaughtByTheExactCount) {
 // svClosestAlong says so with a flag, and volume.frag makes the pixel a close call. It used to
 // return a NaN t that `t == t` tested, which a compiler may fold to true (NaNs need not be kept,
 // GLSL 4.50 section 4.7.1): the border then counted as one at a garbage t, and the close call was
-// missed. The probe asks for exactly parallel, anti-parallel and nearly parallel borders, and one
-// at a known crossing.
+// missed. The probe asks for exactly parallel and anti-parallel borders (a nearly parallel one is
+// decided by rounding, differently on each GL), and one at a known crossing.
 TEST_F(ShadowVolumesGLTest, ParallelBorderIsFlaggedNotANaN) {
     const glm::vec3 eye{1.0f, 2.0f, 3.0f}, v = glm::normalize(glm::vec3{0.3f, -0.2f, -1.0f});
     const std::vector<glm::vec4> cases = {
-        // eye, a, d, v: parallel, anti-parallel, parallel within 1e-7, crossing at t = 5
+        // eye, a, d, v: parallel, anti-parallel, parallel scaled by 1/4 (exact), crossing at t = 5
         glm::vec4(eye, 0), glm::vec4(eye + glm::vec3(0.1f, 0, 0), 0), glm::vec4(v * 3.0f, 0), glm::vec4(v, 0),
         glm::vec4(eye, 0), glm::vec4(eye + glm::vec3(0, 0.5f, 0), 0), glm::vec4(-v, 0), glm::vec4(v, 0),
-        glm::vec4(eye, 0), glm::vec4(eye + glm::vec3(0, 0, 2), 0), glm::vec4(v + glm::vec3(1e-7f, 0, 0), 0), glm::vec4(v, 0),
+        glm::vec4(eye, 0), glm::vec4(eye + glm::vec3(0, 0, 2), 0), glm::vec4(v * 0.25f, 0), glm::vec4(v, 0),
         glm::vec4(eye, 0), glm::vec4(eye + v * 5.0f - glm::vec3(0, 0, 0), 0), glm::vec4(glm::normalize(glm::cross(v, glm::vec3(0, 1, 0))), 0), glm::vec4(v, 0),
     };
     GlBuffer in = GlBuffer::fromVector(cases);
@@ -199,7 +203,10 @@ TEST_F(ShadowVolumesGLTest, FaultCoarseSubpixelGridWidensTheBorderMargin) {
     EXPECT_EQ(coarse.counters.at("subpixel_bits"), 4.0);
     std::printf("[shadow_volumes] close calls at %.0f subpixel bits: %.0f, at 4: %.0f\n", fine.counters.at("subpixel_bits"),
                 fine.counters.at("close_call_pixels"), coarse.counters.at("close_call_pixels"));
-    EXPECT_GT(coarse.counters.at("close_call_pixels"), fine.counters.at("close_call_pixels"));
+    // A GL that reports 4 bits itself (zink over lavapipe does) has the wide margin already.
+    if (fine.counters.at("subpixel_bits") > 4.0)
+        EXPECT_GT(coarse.counters.at("close_call_pixels"), fine.counters.at("close_call_pixels"));
+    EXPECT_LE(fine.accuracy.mismatchRatio, 1e-4);
     EXPECT_LE(coarse.accuracy.mismatchRatio, 1e-4);
     EXPECT_EQ(coarse.overflow, 0u);
 }

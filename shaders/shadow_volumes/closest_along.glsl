@@ -6,7 +6,10 @@ bool svClosestAlong(vec3 eye, vec3 a, vec3 d, vec3 v, out float t) {
     vec3 w = eye - a;
     float bd = dot(v, d), dd = dot(d, d), denom = dd - bd * bd;
     t = 0.0;
-    if (!(denom > 1e-12 * dd)) return false;
+    // dd - bd * bd cancels for parallel lines, to its rounding error (a few ulps of dd, ~1e-7 dd),
+    // not to 0: below 1e-5 dd (an angle under ~3e-3 rad) the lines are taken as parallel, which only
+    // ever adds a close call.
+    if (!(denom > 1e-5 * dd)) return false;
     t = (bd * dot(d, w) - dd * dot(v, w)) / denom;
     return true;
 }
