@@ -64,6 +64,13 @@ protected:
         o.heat = std::move(o.views["tests_per_pixel"]);
         return o;
     }
+    /// Without ARB_shader_ballot ptsv refuses `vote: ballot`: checked here; true when that is all
+    /// there is to test on this GL.
+    bool refusesBallotVotesHere() {
+        if (querySubgroupSize() != 0) return false;
+        EXPECT_THROW(run(thousandsOfTriangles(), {kCooperative, {"vote", std::string("ballot")}}), std::exception);
+        return true;
+    }
 };
 
 // ---- Accuracy table ------------------------------------------------------------------------------
@@ -255,12 +262,7 @@ TEST_F(PtsvGLTest, FaultFlushedStatusAndStalePlanesCastNothing) {
 // lane 0 (the job-list slot in pass one, which matters when the list is full) makes the subtree
 // finish where it is.
 TEST_F(PtsvGLTest, FaultLaneMissingFromVotesIsRecoveredExactly) {
-    const int width = querySubgroupSize();
-    if (width == 0) {
-        // Votes are ballots only with ARB_shader_ballot: without it ptsv refuses `vote: ballot`.
-        EXPECT_THROW(run(thousandsOfTriangles(), {kCooperative, {"vote", std::string("ballot")}}), std::exception);
-        return;
-    }
+    if (refusesBallotVotesHere()) return;
     const std::map<std::string, ParamValue> ballot = {kCooperative, {"vote", std::string("ballot")}};
     Outcome clean = run(thousandsOfTriangles(), ballot);
     EXPECT_EQ(clean.counters["vote_recoveries"], 0.0) << "no lane is ever missing on its own";
@@ -294,10 +296,7 @@ TEST_F(PtsvGLTest, FaultLaneMissingFromVotesIsRecoveredExactly) {
 // A lane that recovered once now walks alone for the rest of its batch, and the voting lanes
 // follow it at their next ballot.
 TEST_F(PtsvGLTest, FaultLanesThatPartWaysNeverVoteAgain) {
-    if (querySubgroupSize() == 0) { // without ARB_shader_ballot ptsv refuses `vote: ballot`
-        EXPECT_THROW(run(thousandsOfTriangles(), {kCooperative, {"vote", std::string("ballot")}}), std::exception);
-        return;
-    }
+    if (refusesBallotVotesHere()) return;
     for (bool twoPass : {true, false}) {
         SCOPED_TRACE(twoPass ? "two passes" : "one pass");
         const std::map<std::string, ParamValue> ballot = {kCooperative, {"vote", std::string("ballot")}, {"two_pass", twoPass}};
@@ -316,10 +315,7 @@ TEST_F(PtsvGLTest, FaultLanesThatPartWaysNeverVoteAgain) {
 // frame is as exact as any (it used to run none of its jobs: every shadow of them lit), and it is
 // counted, so the host compiles shared-memory votes for the next frame.
 TEST_F(PtsvGLTest, FaultSubgroupMismatchFrameStaysExact) {
-    if (querySubgroupSize() == 0) { // without ARB_shader_ballot ptsv refuses `vote: ballot`
-        EXPECT_THROW(run(thousandsOfTriangles(), {kCooperative, {"vote", std::string("ballot")}}), std::exception);
-        return;
-    }
+    if (refusesBallotVotesHere()) return;
     for (bool twoPass : {true, false}) {
         SCOPED_TRACE(twoPass ? "two passes" : "one pass");
         const std::map<std::string, ParamValue> ballot = {kCooperative, {"vote", std::string("ballot")}, {"two_pass", twoPass}};

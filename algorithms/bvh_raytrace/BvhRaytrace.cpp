@@ -80,10 +80,10 @@ public:
         opt.maxLeafSize = p_.leafSize;
         opt.bins = p_.sahBins;
         opt.traversalCost = p_.traversalCost;
-        const bvh::Bvh& tree = bvh_.build(scene, opt, maxShaderStorageBlockBytes(), "bvh_raytrace");
+        const bvh::BvhStats tree = bvh_.build(scene, opt, maxShaderStorageBlockBytes(), "bvh_raytrace");
         buildMs_ = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         counters_.allocate();
-        nodeCount_ = tree.nodes.size();
+        nodeCount_ = tree.nodes;
         depth_ = tree.depth;
         leaves_ = tree.leaves;
         sahCost_ = tree.sahCost;

@@ -523,13 +523,6 @@ private:
     mutable std::optional<ls::SampleClasses> classes_;
 };
 
-} // namespace
-
-/// Its pools depend on (N, d), not on the scene, and are checked in setScene; what grows with the
-/// scene is the exact start region's leaf lists (>= 4 bytes a triangle) and its check that the
-/// scene positions fit one storage block (the reported size), as setScene does; with
-/// start_triangles culled a plane per triangle (16 bytes), with leaf_split > 1 8 bytes per occupied
-/// leaf (at most about one per triangle).
 /// An upper bound of the N-tree's pools for `triangles` triangles, without the scene: level l of the
 /// tree has k³ cells (k = N^l), of which a triangle, lying in a plane, touches at most 4k² (a plane
 /// crosses at most three cells of each column along its normal's largest axis, four with the cells
@@ -554,6 +547,13 @@ size_t lineSpacePoolBound(int n, int d, size_t triangles, size_t blockBytes) {
     return saturatingSum({bits, nodePool, treePool, saturatingMul(nodes, 4 * ls::occupancyWords(n))});
 }
 
+} // namespace
+
+/// Its pools: lineSpacePoolBound (held on the host while they are built, then on the GPU). Besides,
+/// what grows with the scene is the exact start region's leaf lists (>= 4 bytes a triangle) and its check that the
+/// scene positions fit one storage block (the reported size), as setScene does; with
+/// start_triangles culled a plane per triangle (16 bytes), with leaf_split > 1 8 bytes per occupied
+/// leaf (at most about one per triangle).
 Footprint lineSpaceFootprint(const FootprintQuery& q) {
     Footprint f;
     const std::string& region = std::get<std::string>(q.params->get("start_region"));
@@ -565,8 +565,7 @@ Footprint lineSpaceFootprint(const FootprintQuery& q) {
                                             q.reportedStorageBlockBytes);
     // The pools are built on the host and uploaded: both copies are held while setScene() runs.
     f.bytes = saturatingSum({saturatingMul(8 + (culled ? 16 : 0) + (split ? 8 : 0), n), pools});
-    f.peakBytes = pools;
-    f.peakBytes = saturatingSum({f.peakBytes, saturatingMul(8, n)});
+    f.peakBytes = saturatingSum({pools, saturatingMul(8, n)});
     if (exact) f.refusal = storageRefusal(q, "the scene positions its exact start region reads", saturatingMul(36, n), true);
     if (region == "bvh") {
         // bvh_raytrace's tree with its default leaves of 4: triangles 48 bytes, nodes ~32 bytes a triangle.

@@ -2,14 +2,19 @@
 
 namespace shadowlab::bvh {
 
-const Bvh& SceneBvh::build(const SceneGpu& scene, const BuildOptions& options, size_t limit, const std::string& owner) {
-    gpu_ = BvhGpu(); // free the old tree before building the new one
-    tree_ = buildBvh(scene.cpu(), options);
-    const GLbitfield flags = scene.dynamic() ? GL_DYNAMIC_STORAGE_BIT : 0; // refitted trees are re-uploaded
-    gpu_ = uploadBvh(tree_, limit, flags, owner);
+BvhStats SceneBvh::build(const SceneGpu& scene, const BuildOptions& options, size_t limit, const std::string& owner) {
+    gpu_ = BvhGpu(); // free the old trees before building the new one
+    tree_ = Bvh();
     posed_.clear();
-    if (scene.dynamic()) posed_ = scene.cpu().positions;
-    return tree_;
+    Bvh tree = buildBvh(scene.cpu(), options);
+    const GLbitfield flags = scene.dynamic() ? GL_DYNAMIC_STORAGE_BIT : 0; // refitted trees are re-uploaded
+    gpu_ = uploadBvh(tree, limit, flags, owner);
+    const BvhStats stats{tree.nodes.size(), tree.leaves, tree.depth, tree.sahCost};
+    if (scene.dynamic()) {
+        tree_ = std::move(tree);
+        posed_ = scene.cpu().positions;
+    }
+    return stats;
 }
 
 void SceneBvh::refit(const SceneGpu& scene, StageTimer& timer) {

@@ -13,11 +13,17 @@
 
 namespace shadowlab::bvh {
 
+/// What a build made, for counters: the host tree itself is kept only where refits need it.
+struct BvhStats {
+    size_t nodes = 0, leaves = 0;
+    int depth = 0;
+    double sahCost = 0;
+};
+
 class SceneBvh {
 public:
-    /// Builds the tree of `scene` with `options` and uploads it (uploadBvh: `limit`, `owner`);
-    /// returns it for its statistics.
-    const Bvh& build(const SceneGpu& scene, const BuildOptions& options, size_t limit, const std::string& owner);
+    /// Builds the tree of `scene` with `options` and uploads it (uploadBvh: `limit`, `owner`).
+    BvhStats build(const SceneGpu& scene, const BuildOptions& options, size_t limit, const std::string& owner);
     /// The scene moved: the tree refitted to its posed triangles (stages read_scene, refit, upload).
     void refit(const SceneGpu& scene, StageTimer& timer);
 
@@ -25,7 +31,7 @@ public:
 
 private:
     BvhGpu gpu_;
-    Bvh tree_;                     ///< the last build (kept for refits; emptied of nothing: statistics)
+    Bvh tree_;                     ///< the last build, for refits (moving scenes only)
     std::vector<glm::vec3> posed_; ///< the posed scene positions the last refit used
 };
 

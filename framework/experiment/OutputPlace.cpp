@@ -94,8 +94,27 @@ bool lockIsLive(const std::string& lockPath) {
     return live;
 }
 
-std::string lockText(int fd, bool* regular);
-std::string lockPid(const std::string& text);
+/// What a lock file holds: this prefix and its holder's pid.
+constexpr const char* kLockPrefix = "shadowlab-lock ";
+
+/// The lock file's text ("" when unreadable, or not a regular file of at most 40 bytes).
+std::string lockText(int fd, bool* regular = nullptr) {
+    struct stat st {};
+    const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size <= 40;
+    if (regular) *regular = ok;
+    if (!ok) return "";
+    char buf[41] = {0};
+    const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+    return n > 0 ? std::string(buf, size_t(n)) : "";
+}
+
+/// The pid in a lock file's text "shadowlab-lock PID", or "" when the text is not that.
+std::string lockPid(const std::string& text) {
+    const size_t p = std::strlen(kLockPrefix);
+    if (text.size() <= p || text.compare(0, p, kLockPrefix) != 0) return "";
+    const std::string pid = text.substr(p);
+    return pid.find_first_not_of("0123456789") == std::string::npos ? pid : "";
+}
 
 std::string lockOwner(const std::string& lockPath) {
     const int fd = ::open(lockPath.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOFOLLOW);
@@ -199,28 +218,6 @@ std::string nestedInside(const fs::path& dir, size_t limit = 200000) {
     return "";
 }
 
-/// What a lock file holds: this prefix and its holder's pid.
-constexpr const char* kLockPrefix = "shadowlab-lock ";
-
-/// The lock file's text ("" when unreadable, or not a regular file of at most 40 bytes).
-std::string lockText(int fd, bool* regular = nullptr) {
-    struct stat st {};
-    const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size <= 40;
-    if (regular) *regular = ok;
-    if (!ok) return "";
-    char buf[41] = {0};
-    const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
-    return n > 0 ? std::string(buf, size_t(n)) : "";
-}
-
-/// The pid in a lock file's text "shadowlab-lock PID", or "" when the text is not that.
-std::string lockPid(const std::string& text) {
-    const size_t p = std::strlen(kLockPrefix);
-    if (text.size() <= p || text.compare(0, p, kLockPrefix) != 0) return "";
-    const std::string pid = text.substr(p);
-    return pid.find_first_not_of("0123456789") == std::string::npos ? pid : "";
-}
-
 /// Whether fd is a shadowlab lock: "shadowlab-lock PID", or empty while its creator is writing it
 /// (that creator holds its flock from the start, so an empty file nobody holds is looked at again
 /// 50 ms later; still empty and free, it is somebody else's file).
@@ -284,25 +281,28 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
 } // namespace
 
 namespace {
-/// What check() and checkSweepPlace() share: a path that can name a folder of its own.
-void checkPlace(const std::string& dir, bool allowRunSlot, const char* example) {
+/// What check() and checkSweepPlace() share: a path that can name a folder of its own, and is
+/// not a link or something other than a directory. Returns whether the directory exists.
+bool checkPlace(const std::string& dir, bool allowRunSlot, const char* example) {
     if (dir.empty()) throw InputError("--out", "", "the output directory must not be empty");
     if (dir == "/" || containsWorkingDir(dir))
         throw InputError(shortPath(dir), "", std::string("the output directory cannot be the working directory or one above it "
                                                          "(an output is a directory of its own, e.g. --out ") + example + ")");
     checkAncestors(dir, allowRunSlot);
+    std::error_code ec;
+    const auto status = fs::symlink_status(dir, ec);
+    if (fs::is_symlink(status))
+        throw InputError(shortPath(dir), "", "the output path is a symbolic link; give the directory it should name instead");
+    if (fs::exists(status) && !fs::is_directory(status))
+        throw InputError(shortPath(dir), "", "the output path exists and is not a directory");
+    return fs::exists(status);
 }
 } // namespace
 
 void OutputPlace::checkSweepPlace(const std::string& given) {
     const std::string dir = normalize(given);
-    checkPlace(dir, false, "results/sweep1");
+    if (!checkPlace(dir, false, "results/sweep1")) return;
     std::error_code ec;
-    const auto status = fs::symlink_status(dir, ec);
-    if (fs::is_symlink(status))
-        throw InputError(shortPath(dir), "", "the sweep's folder is a symbolic link; give the directory it should name instead");
-    if (!fs::exists(status)) return;
-    if (!fs::is_directory(status)) throw InputError(shortPath(dir), "", "is not a folder (the sweep's output folder goes there)");
     if (isRegularFile(fs::path(dir) / "sweep.json")) return;
     // Empty, or nothing but what `sweep run` makes before it writes sweep.json: runs/ and the lock.
     bool skeleton = true;
@@ -318,14 +318,7 @@ void OutputPlace::checkSweepPlace(const std::string& given) {
 }
 
 void OutputPlace::check(const std::string& given) {
-    const std::string dir = normalize(given);
-    checkPlace(dir, true, "results/run1");
-    std::error_code ec;
-    const auto status = fs::symlink_status(dir, ec);
-    if (fs::is_symlink(status))
-        throw InputError(shortPath(dir), "", "the output path is a symbolic link; give the directory it should name instead");
-    if (fs::exists(status) && !fs::is_directory(status))
-        throw InputError(shortPath(dir), "", "the output path exists and is not a directory");
+    checkPlace(normalize(given), true, "results/run1");
 }
 
 OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<std::string>* notes) {

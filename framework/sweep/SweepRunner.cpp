@@ -67,10 +67,10 @@ std::string describeStatus(int status) {
 /// DIR and DIR/runs, made where absent; InputError where something else than a folder is there.
 void makeFolders(const std::string& outputDir) {
     if (outputDir.empty()) throw InputError("--out", "", "the output folder must not be empty");
-    // Inside a run's output or another sweep a sweep would be deleted by that run's next --force, or
-    // mix its runs with the other's; a folder of the user's would be written over.
     // A run's output is not a sweep's folder: writing runs/ and plan.json into it would leave a
-    // mixture that neither a run's --force nor a sweep can use.
+    // mixture that neither a run's --force nor a sweep can use. Inside a run's output or another
+    // sweep a sweep would be deleted by that run's next --force, or mix its runs with the other's;
+    // a folder of the user's would be written over (checkSweepPlace).
     if (OutputPlace::isRunOutput(outputDir))
         throw InputError(shortText(outputDir, 300), "", "is a run's output (it holds summary.json or config.resolved.json); "
                                                        "a sweep needs a folder of its own");
