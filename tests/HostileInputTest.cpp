@@ -138,6 +138,17 @@ std::vector<BadCase> badCases() {
          {"m.gltf", "/skins/0/inverseBindMatrices"}},
         {"GlbBufferLongerThanItsBinaryChunk", "m.glb", test::glbOf(test::triangleGltf({{"buffers", R"([{"byteLength": 36}])"}})),
          {"m.glb", "/buffers/0/byteLength"}},
+        // validate plans memory before it makes the scene, as run does: 198 M triangles are refused
+        // by the plan in a second instead of built until the memory limit kills it.
+        {"GridPastTheMemoryPlan", "c.json",
+         configWith({{"scene", R"({"max_triangles": 200000000, "objects": [{"procedural": "grid", "count": [9900, 1, 10000],
+                                   "object": {"procedural": "plane", "size": [1, 1]}}]})"}}),
+         {"/scene", "would need about"}},
+        // The tree's shape exists only once the scene does: validate builds it (no line spaces), as
+        // the run's setScene would refuse it.
+        {"LineSpacePoolPastTheDevice", "c.json",
+         configWith({{"algorithms", R"([{"algorithm": "line_space", "params": {"n": 8, "d": 4}}])"}}),
+         {"/algorithms/0", "line-space pool", "use a smaller N or d"}},
         {"UnbackedAccessorOfGigabytes", "m.gltf", test::triangleGltf({{"accessors", R"([{"componentType": 5126, "type": "MAT4", "count": 120000000}])"}}), {"/accessors/0/count", "too large"}},
     };
 }

@@ -154,5 +154,19 @@ TEST(RunSafetyTest, FramesWithoutLitPixelsAreFlaggedNotScoredZero) {
     EXPECT_NE(slurp(base + "/out/report.md").find("**warning**"), std::string::npos);
 }
 
+// An algorithm that refuses the scene only once it exists (line_space's tree past a storage block)
+// is bad input at its entry, exit 2, as validate says; the output folder is not made.
+TEST(RunSafetyTest, AnAlgorithmRefusingTheBuiltSceneIsExitTwoAtItsEntryAndWritesNothing) {
+    const std::string base = test::makeTempDir("scene-refusal");
+    std::ofstream(base + "/c.json") << test::configWith(
+        {{"algorithms", R"([{"algorithm": "shadow_map"}, {"algorithm": "line_space", "params": {"n": 8, "d": 4}}])"}});
+    for (const std::string& command : {" validate " + base + "/c.json", " run " + base + "/c.json --no-progress --out " + base + "/out"}) {
+        std::string log;
+        EXPECT_EQ(test::runCommand(std::string("(") + SHADOWLAB_BINARY + command + " >/dev/null)", log), 2) << command << log;
+        EXPECT_NE(log.find("c.json: at /algorithms/1: line_space cannot hold this scene"), std::string::npos) << log;
+    }
+    EXPECT_FALSE(fs::exists(base + "/out"));
+}
+
 } // namespace
 } // namespace shadowlab

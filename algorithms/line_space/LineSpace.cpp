@@ -36,6 +36,12 @@ struct LineSpaceParams {
     int samplesPerDispatch;              ///< most light samples per pixel one dispatch traces
 };
 
+/// What one of its storage blocks may hold here: max_block_mib (0: no cap) within the context's limit.
+size_t poolBlockLimit(int maxBlockMib) {
+    const size_t cap = size_t(maxBlockMib) << 20;
+    return cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
+}
+
 const ParamStruct<LineSpaceParams>& lineSpaceParams() {
     using P = LineSpaceParams;
     static const ParamStruct<P> s = ParamStruct<P>()
@@ -144,8 +150,7 @@ public:
         nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(), occBuf_ = GlBuffer(); // free the old pools first
         for (GlBuffer& b : bitsBuf_) b = GlBuffer();
         const int n = p_.n, d = p_.d;
-        const size_t cap = size_t(p_.maxBlockMib) << 20;
-        const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
+        const size_t limit = poolBlockLimit(p_.maxBlockMib);
         tree_ = obtainTree(cpu, n, d, limit, useCache);
         // The occupancy pool is read (and counted) only by the distance and exact start regions; the
         // leaf lists and the scene's triangles only by the exact one.
@@ -193,7 +198,7 @@ public:
             return std::string(text);
         };
         if (poolBytes_[0] > limit || poolBytes_[1] > limit || chunks > LS_BIT_CHUNKS)
-            throw RuntimeError("line_space: the pools of (N, d) = (" + std::to_string(n) + ", " + std::to_string(d) + ") need " +
+            throw SceneRefusal("line_space: the pools of (N, d) = (" + std::to_string(n) + ", " + std::to_string(d) + ") need " +
                                mib(poolBytes_[0]) + " + " + mib(poolBytes_[1]) + " + " + mib(poolBytes_[2]) +
                                " MiB (node, tree, line space); one SSBO may hold " + mib(limit) +
                                " MiB here (GL_MAX_SHADER_STORAGE_BLOCK_SIZE, or max_block_mib) and the line space may span " +
@@ -205,7 +210,7 @@ public:
             for (auto [what, bytes] : {std::pair{"leaf triangle lists", lists.tris.size() * sizeof(uint32_t)},
                                        std::pair{"scene positions", scene_->positions().size()}})
                 if (bytes > limit)
-                    throw RuntimeError(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
+                    throw SceneRefusal(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
                                        " MiB; one SSBO may hold " + mib(limit) + " MiB here");
             leafPrefix_ = GlBuffer::fromVector(lists.prefix, 0);
             leafTris_ = GlBuffer::fromVector(lists.tris, 0);
@@ -395,9 +400,7 @@ public:
 
     /// The storage block size build() splits the line-space pool by, in MiB, on this device.
     std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
-        const size_t cap = size_t(p_.maxBlockMib) << 20;
-        const size_t limit = cap > 0 ? std::min(cap, maxShaderStorageBlockBytes()) : maxShaderStorageBlockBytes();
-        return {{"max_block_mib", std::to_string(limit >> 20)}};
+        return {{"max_block_mib", std::to_string(poolBlockLimit(p_.maxBlockMib) >> 20)}};
     }
 
 private:
@@ -529,7 +532,7 @@ private:
 /// it only touches), and a cell is a node only where a triangle touches it. Every node holds its
 /// line space (wordsPerNode words), its occupancy bits, its entry in the node pool and a children
 /// group of N³ entries in the tree pool. The build refuses more than LS_BIT_CHUNKS storage blocks of
-/// line space and one block of nodes or tree (NTreeBuilder), so neither can exceed that.
+/// line space and one block of nodes, tree or occupancy (NTreeBuilder), so none can exceed that.
 size_t lineSpacePoolBound(int n, int d, size_t triangles, size_t blockBytes) {
     size_t nodes = 0, k = 1;
     for (int level = 0; level < d; ++level, k = saturatingMul(k, size_t(n))) {
@@ -539,12 +542,14 @@ size_t lineSpacePoolBound(int n, int d, size_t triangles, size_t blockBytes) {
     const size_t cube = size_t(n) * size_t(n) * size_t(n);
     size_t bits = saturatingMul(nodes, 4 * ls::wordsPerNode(n));
     size_t nodePool = saturatingMul(nodes, sizeof(ls::NodeGpu)), treePool = saturatingMul(nodes, 4 * cube);
+    size_t occupancy = saturatingMul(nodes, 4 * ls::occupancyWords(n));
     if (blockBytes > 0) {
         bits = std::min(bits, saturatingMul(LS_BIT_CHUNKS, blockBytes));
         nodePool = std::min(nodePool, blockBytes);
         treePool = std::min(treePool, blockBytes);
+        occupancy = std::min(occupancy, blockBytes);
     }
-    return saturatingSum({bits, nodePool, treePool, saturatingMul(nodes, 4 * ls::occupancyWords(n))});
+    return saturatingSum({bits, nodePool, treePool, occupancy});
 }
 
 } // namespace
@@ -575,6 +580,24 @@ Footprint lineSpaceFootprint(const FootprintQuery& q) {
     }
     return f;
 }
+/// The tree's shape for this scene (nodes, tree and occupancy, no line spaces) against the same
+/// limits build() checks, and with start_region exact the leaf lists' triangles: a parameter set the
+/// build would refuse is refused here, in the time of its occupancy tests.
+std::string lineSpaceSceneCheck(const Scene& scene, const ParamValues& params) {
+    const size_t limit = poolBlockLimit(std::get<int>(params.get("max_block_mib")));
+    try {
+        const ls::NTree shape = ls::buildNTree(scene, std::get<int>(params.get("n")), std::get<int>(params.get("d")), 0, limit, true);
+        if (std::get<std::string>(params.get("start_region")) != "exact") return "";
+        const size_t listBytes = ls::buildLeafLists(scene, shape).tris.size() * sizeof(uint32_t);
+        if (listBytes > limit)
+            return "the leaf triangle lists of start_region exact need " + std::to_string((listBytes + (1u << 20) - 1) >> 20) +
+                   " MiB; one storage block may hold " + std::to_string(limit >> 20) + " MiB here";
+    } catch (const SceneRefusal& e) {
+        return e.what();
+    }
+    return "";
+}
+
 AlgorithmInfo lineSpaceInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<LineSpace>(
         "line_space", "approximate shadows from precomputed line-space visibility in an N-tree (no triangle tests)",
@@ -582,6 +605,7 @@ AlgorithmInfo lineSpaceInfo() {
     info.motion = MotionHandling::StaticOnly;
     info.rebuildParam = "rebuild_every_frame";
     info.footprint = &lineSpaceFootprint;
+    info.sceneCheck = &lineSpaceSceneCheck;
     return info;
 }
 

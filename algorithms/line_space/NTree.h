@@ -69,11 +69,12 @@ struct NTree {
 
 /// Builds the N-tree of `scene` with branching factor n (2..kMaxN) and depth d (1..kMaxDepth), on
 /// `threads` threads (0 = all). Deterministic: the pools do not depend on the thread count.
-/// Throws RuntimeError as soon as the node or tree pool would exceed `maxBlockBytes` (the GPU's
+/// Throws SceneRefusal as soon as the node or tree pool would exceed `maxBlockBytes` (the GPU's
 /// SSBO limit) or the line-space pool LS_BIT_CHUNKS blocks of that size: a level's node count is
 /// known before its line spaces are computed, so an impossible parameter set fails in seconds
-/// instead of after the whole build.
-NTree buildNTree(const Scene& scene, int n, int d, int threads = 0, size_t maxBlockBytes = SIZE_MAX);
+/// instead of after the whole build. `shapeOnly`: nodes, tree and occupancy without the line
+/// spaces (bits left empty), the same checks at a fraction of the cost (`validate`).
+NTree buildNTree(const Scene& scene, int n, int d, int threads = 0, size_t maxBlockBytes = SIZE_MAX, bool shapeOnly = false);
 
 /// Triangles of the leaves of the last subdivided level, for start_region = exact (the start region
 /// tested against the triangles themselves). Occupied leaves are numbered in node order, then child

@@ -108,7 +108,7 @@ DBox subFaceBox(glm::dvec3 lo, glm::dvec3 size, int n, int f, int i, int j) {
     return b;
 }
 
-NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockBytes) {
+NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockBytes, bool shapeOnly) {
     const auto t0 = std::chrono::steady_clock::now();
     NTree t;
     t.n = n, t.d = d;
@@ -131,7 +131,7 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
     auto check = [&](const char* pool, size_t bytes, size_t limit) {
         if (bytes <= limit) return;
         auto mib = [](size_t b) { return std::to_string((b + (1u << 20) - 1) >> 20); };
-        throw RuntimeError("line_space: the " + std::string(pool) + " pool of (N, d) = (" + std::to_string(n) + ", " +
+        throw SceneRefusal("line_space: the " + std::string(pool) + " pool of (N, d) = (" + std::to_string(n) + ", " +
                            std::to_string(d) + ") needs at least " + mib(bytes) + " MiB, more than the " + mib(limit) +
                            " MiB it may take here (GL shader storage blocks); use a smaller N or d");
     };
@@ -149,15 +149,16 @@ NTree buildNTree(const Scene& scene, int n, int d, int threads, size_t maxBlockB
         parallelFor(level.size(), threads, [&](size_t i) {
             builder.occupancy(level[i], !last, results[i]);
             level[i].tris = {}; // the children's lists replace it
+            if (shapeOnly) return;
             results[i].words.assign(words, 0u);
             fillLineSpace(n, level[i].lo, level[i].size, results[i].occupied, t.margin, results[i].words.data());
         });
-        t.bits.resize(t.nodes.size() * words);
+        if (!shapeOnly) t.bits.resize(t.nodes.size() * words);
         t.occupancy.resize(t.nodes.size() * occupancyWords(n));
         std::vector<Pending> next;
         for (size_t i = 0; i < level.size(); ++i) {
             NodeResult& r = results[i];
-            std::copy(r.words.begin(), r.words.end(), t.bits.begin() + std::ptrdiff_t((base + i) * words));
+            if (!shapeOnly) std::copy(r.words.begin(), r.words.end(), t.bits.begin() + std::ptrdiff_t((base + i) * words));
             uint32_t* occ = t.occupancy.data() + (base + i) * occupancyWords(n);
             for (int c = 0; c < n3; ++c)
                 if (r.occupied[size_t(c)]) occ[c >> 5] |= 1u << (c & 31);

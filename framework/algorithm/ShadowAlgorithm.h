@@ -142,6 +142,11 @@ struct AlgorithmInfo {
     /// Its memory estimate for a scene, before the scene exists; nullptr: nothing that grows with the
     /// scene. The runner refuses a run up front when one refuses or the sum exceeds the machine.
     Footprint (*footprint)(const FootprintQuery& query) = nullptr;
+    /// Once the scene exists, before anything is built for it: "" when the algorithm's structures
+    /// for `scene` fit this device (current GL context) with `params`, else why not (the refusal
+    /// setScene() would throw as SceneRefusal). nullptr: the footprint decides everything. Run by
+    /// `validate`, so that what it accepts, run runs.
+    std::string (*sceneCheck)(const Scene& scene, const ParamValues& params) = nullptr;
 
     bool supports(LightType t) const;
     /// "" when the algorithm can run on a scene that moves with these parameter values, else why not.

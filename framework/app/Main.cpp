@@ -232,6 +232,29 @@ int plan(const std::vector<std::string>& args) {
     return 0;
 }
 
+/// `shadowlab validate CONFIG [--set PATH=VALUE]`: every check `run` makes before its first frame,
+/// in the same order (the output place, the memory plan before the scene is made, the scene, each
+/// algorithm's fit on it), then the resolved config on standard output. What validate accepts, run runs.
+int validate(const std::string& config, const std::vector<std::string>& overrides) {
+    ExperimentConfig cfg = loadConfig(config, false, overrides);
+    // The output place too (run --out may name another).
+    try {
+        OutputPlace::check(cfg.outputDir);
+    } catch (const InputError& e) {
+        throw InputError(config, "/output/dir", e.cause());
+    }
+    auto context = createHeadlessContext(false);
+    installGlDebugCallback(true);
+    const ScenePrediction predicted = predictConfigScene(config, overrides);
+    checkMemoryPlan(cfg, predicted.triangles, predicted.moving, currentDeviceLimits(predicted.triangles), predicted.materials);
+    cfg = loadConfig(config, true, overrides);
+    checkAlgorithmsTakeScene(cfg);
+    std::cout << cfg.resolved.dump(2) << "\n";
+    std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", shortText(config, 300).c_str(), cfg.scene->triangleCount(),
+                 cfg.algorithms.size(), cfg.reference ? " + reference" : "");
+    return 0;
+}
+
 /// `shadowlab info`: the device and what each algorithm's auto parameters resolve to on it. Exit 1
 /// when an algorithm cannot be created here or GL reported an error.
 int info(const std::vector<std::string>& args) {
@@ -331,17 +354,7 @@ static int dispatch(std::vector<std::string> args) {
                 }
             }
             if (config.empty()) usageError("validate needs a config file");
-            ExperimentConfig cfg = loadConfig(config, true, overrides);
-            // What validate accepts, run runs: the output place too (run --out may name another).
-            try {
-                OutputPlace::check(cfg.outputDir);
-            } catch (const InputError& e) {
-                throw InputError(config, "/output/dir", e.cause());
-            }
-            std::cout << cfg.resolved.dump(2) << "\n";
-            std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", shortText(config, 300).c_str(), cfg.scene->triangleCount(),
-                         cfg.algorithms.size(), cfg.reference ? " + reference" : "");
-            return 0;
+            return validate(config, overrides);
         }
         if (args[0] == "plan") return plan(args);
         if (args[0] == "run") return run(args);

@@ -41,4 +41,12 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// An algorithm cannot hold this scene with these parameter values on this device (a pool past
+/// what a storage block addresses): an input problem found only once the scene exists. The runner
+/// and `validate` report it at the algorithm's entry in the config (exit 2), never as a failure.
+class SceneRefusal : public RuntimeError {
+public:
+    using RuntimeError::RuntimeError;
+};
+
 } // namespace shadowlab

@@ -116,10 +116,28 @@ std::vector<std::string> describeFootprints(const ExperimentConfig& cfg, size_t 
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
         lines.push_back(e->id + " (" + e->info->name + "): " +
-                        (f.refusal.empty() ? formatGiB(f.bytes) + " held, " + formatGiB(f.peakBytes) + " more while it sets up"
+                        (f.refusal.empty() ? formatGiB(f.bytes) + " held, " + formatGiB(f.peakBytes) + " more while it sets up" +
+                                                 (e->info->sceneCheck ? " (at most; whether its structures fit this device "
+                                                                        "is decided on the scene, by validate and run)"
+                                                                      : "")
                                            : "refuses: " + f.refusal));
     }
     return lines;
+}
+
+InputError sceneRefusalError(const ExperimentConfig& cfg, const AlgorithmEntry& entry, std::string why) {
+    if (why.starts_with(entry.info->name + ": ")) why.erase(0, entry.info->name.size() + 2);
+    return InputError(cfg.file, entryPath(cfg, entry), entry.info->name + " cannot hold this scene (" +
+                                                          std::to_string(cfg.scene->triangleCount()) +
+                                                          " triangles) with these parameters on this device: " + why);
+}
+
+void checkAlgorithmsTakeScene(const ExperimentConfig& cfg) {
+    for (const AlgorithmEntry* e : planEntries(cfg)) {
+        if (!e->info->sceneCheck) continue;
+        const std::string why = e->info->sceneCheck(*cfg.scene, e->params);
+        if (!why.empty()) throw sceneRefusalError(cfg, *e, why);
+    }
 }
 
 MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,

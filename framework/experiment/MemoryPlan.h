@@ -3,6 +3,7 @@
 // GPU, what loading it holds at its peak, and each algorithm's own Footprint. A run that cannot fit
 // (or that an algorithm refuses on this device) stops with a one-line InputError (exit 2) before
 // anything large is allocated; the plan is also written to summary.json beside what was measured.
+#include "framework/core/Error.h"
 #include "framework/core/JsonNode.h"
 #include "framework/core/SystemMemory.h"
 #include "framework/experiment/Config.h"
@@ -45,6 +46,13 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool m
 /// As above against `machine` instead of this machine's /proc/meminfo (tests).
 MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
                            const SystemMemory& machine, size_t materials = 0);
+
+/// Once cfg.scene exists: every algorithm entry's sceneCheck on it (current GL context); throws
+/// InputError at the first entry that refuses, naming its JSON path (`validate`, so that what it
+/// accepts, run runs).
+void checkAlgorithmsTakeScene(const ExperimentConfig& cfg);
+/// The InputError for an algorithm entry whose setScene() threw SceneRefusal.
+InputError sceneRefusalError(const ExperimentConfig& cfg, const AlgorithmEntry& entry, std::string why);
 
 /// One line per algorithm entry: its estimate, or why it refuses the scene here (never throws):
 /// what `shadowlab plan` prints, to find the size where each algorithm stops.

@@ -10,6 +10,7 @@
 #include "framework/gl/GlContext.h"
 #include "framework/gl/Shader.h"
 #include "framework/experiment/FrameImages.h"
+#include "framework/experiment/MemoryPlan.h"
 #include "framework/render/ShadingPass.h"
 
 #include <algorithm>
@@ -132,7 +133,13 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     sceneGpu.setTime(cfg.sceneTimeAt(0));
     std::vector<Instance> instances;
     for (const AlgorithmEntry* e : entries) {
-        Instance inst{e, makeHost(*e, false, sceneGpu, res), {}, {}};
+        std::unique_ptr<AlgorithmHost> host;
+        try {
+            host = makeHost(*e, false, sceneGpu, res);
+        } catch (const SceneRefusal& refusal) {
+            throw sceneRefusalError(cfg, *e, refusal.what());
+        }
+        Instance inst{e, std::move(host), {}, {}};
         inst.results.id = e->id;
         inst.results.algorithm = e->info->name;
         inst.results.params = e->params.toJson();

@@ -84,7 +84,7 @@ struct Builder {
     std::function<size_t()> count;
     bool moves = false; ///< it has a path, an animation or node paths (or holds an object that does)
     /// The materials it brings (Scene::append keeps every one of them): 1 when not set.
-    std::function<size_t()> materials;
+    std::function<size_t()> materials = {};
     size_t materialCount() const { return materials ? materials() : 1; }
     Scene operator()() const { return make(); }
 };
