@@ -43,7 +43,7 @@ TEST(MemoryPlanTest, ARunThatCannotFitIsRefusedWithItsEstimate) {
     ScenePrediction p;
     const ExperimentConfig cfg = planned(Json::array({{{"algorithm", "metric_tree"}}}), 74, p);
     try {
-        checkMemoryPlan(cfg, p.triangles, p.moving, kLlvmpipe, SystemMemory{8 * kGiB, 6 * kGiB});
+        checkMemoryPlan(cfg, p, kLlvmpipe, SystemMemory{8 * kGiB, 6 * kGiB});
         FAIL() << "a 74 M triangle run fit in 6 GiB";
     } catch (const InputError& e) {
         EXPECT_EQ(e.file(), "plan.json");
@@ -53,7 +53,7 @@ TEST(MemoryPlanTest, ARunThatCannotFitIsRefusedWithItsEstimate) {
             EXPECT_NE(why.find(part), std::string::npos) << part << " in: " << why;
     }
     // The same run on a machine that holds it: planned, with every part named.
-    const MemoryPlan plan = checkMemoryPlan(cfg, p.triangles, p.moving, kLlvmpipe, SystemMemory{64 * kGiB, 60 * kGiB}, p.materials);
+    const MemoryPlan plan = checkMemoryPlan(cfg, p, kLlvmpipe, SystemMemory{64 * kGiB, 60 * kGiB});
     EXPECT_GT(plan.peak, 10 * kGiB);
     EXPECT_LT(plan.peak, 25 * kGiB);
     ASSERT_EQ(plan.held.size(), 4u);
@@ -84,11 +84,11 @@ TEST(MemoryPlanTest, EachAlgorithmRefusesPastItsDeviceLimitByName) {
         const ExperimentConfig cfg = planned(Json::array({{{"algorithm", r.algorithm}}}), r.engines, p);
         const SystemMemory roomy{1024 * kGiB, 1024 * kGiB};
         if (!r.reason) {
-            EXPECT_NO_THROW(checkMemoryPlan(cfg, p.triangles, false, kLlvmpipe, roomy)) << r.algorithm << " " << p.triangles;
+            EXPECT_NO_THROW(checkMemoryPlan(cfg, p, kLlvmpipe, roomy)) << r.algorithm << " " << p.triangles;
             continue;
         }
         try {
-            checkMemoryPlan(cfg, p.triangles, false, kLlvmpipe, roomy);
+            checkMemoryPlan(cfg, p, kLlvmpipe, roomy);
             ADD_FAILURE() << r.algorithm << " took " << p.triangles << " triangles";
         } catch (const InputError& e) {
             EXPECT_EQ(e.jsonPath(), "/algorithms/0") << r.algorithm;
@@ -103,8 +103,8 @@ TEST(MemoryPlanTest, AMovingScenePastThePosingBlockIsRefused) {
     ScenePrediction p;
     const ExperimentConfig cfg = planned(Json::array(), 10, p);
     const DeviceLimits strict{size_t(128) << 20, 134217728, size_t(128) << 20};
-    EXPECT_THROW(checkMemoryPlan(cfg, p.triangles, true, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}), InputError);
-    EXPECT_NO_THROW(checkMemoryPlan(cfg, 1'000'000, true, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}));
+    EXPECT_THROW(checkMemoryPlan(cfg, ScenePrediction{p.triangles, true}, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}), InputError);
+    EXPECT_NO_THROW(checkMemoryPlan(cfg, ScenePrediction{1'000'000, true}, strict, SystemMemory{1024 * kGiB, 1024 * kGiB}));
 }
 
 // A plan whose byte totals would pass 64 bits is refused, naming the scene, instead of wrapping to
@@ -116,7 +116,7 @@ TEST(MemoryPlanTest, APlanPast64BitsIsRefusedNotWrapped) {
     const DeviceLimits unlimited{}; // no device limit: only the arithmetic can stop the plan
     for (size_t triangles : {size_t(1) << 62, size_t(1) << 63, SIZE_MAX}) {
         try {
-            checkMemoryPlan(cfg, triangles, false, unlimited, roomy);
+            checkMemoryPlan(cfg, ScenePrediction{triangles}, unlimited, roomy);
             ADD_FAILURE() << triangles << " triangles were planned";
         } catch (const InputError& e) {
             EXPECT_EQ(e.file(), "plan.json");

@@ -170,8 +170,7 @@ int run(const std::vector<std::string>& args) {
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
     const ScenePrediction predicted = predictConfigScene(config, overrides);
-    const MemoryPlan plan =
-        checkMemoryPlan(cfg, predicted.triangles, predicted.moving, currentDeviceLimits(predicted.triangles), predicted.materials);
+    const MemoryPlan plan = checkMemoryPlan(cfg, predicted, currentDeviceLimits(predicted.triangles));
     std::fprintf(stderr, "shadowlab: memory: %s\n", plan.summary().c_str());
     opt.memoryPlan = plan.toJson();
     cfg = loadConfig(config, true, overrides);
@@ -220,14 +219,18 @@ int plan(const std::vector<std::string>& args) {
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
     ScenePrediction predicted = predictConfigScene(config, overrides);
-    if (triangles > 0) predicted.triangles = triangles;
+    if (triangles > 0) {
+        // The config's scene scaled to N triangles: its moving share is unknown, so all of it moves.
+        predicted.triangles = triangles;
+        if (predicted.moving) predicted.movingTriangles = triangles;
+    }
     const DeviceLimits limits = currentDeviceLimits(predicted.triangles);
     std::printf("scene: up to %zu triangles%s; storage block %zu MiB (reported %zu), buffer-texture view %zu texels\n",
                 predicted.triangles, predicted.moving ? ", moving" : "", limits.storageBlockBytes >> 20,
                 limits.reportedStorageBlockBytes >> 20, limits.textureBufferTexels);
     for (const std::string& line : describeFootprints(cfg, predicted.triangles, predicted.moving, limits))
         std::printf("%s\n", line.c_str());
-    const MemoryPlan p = checkMemoryPlan(cfg, predicted.triangles, predicted.moving, limits, predicted.materials);
+    const MemoryPlan p = checkMemoryPlan(cfg, predicted, limits);
     std::printf("plan: %s\n", p.summary().c_str());
     return 0;
 }
@@ -246,7 +249,7 @@ int validate(const std::string& config, const std::vector<std::string>& override
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
     const ScenePrediction predicted = predictConfigScene(config, overrides);
-    checkMemoryPlan(cfg, predicted.triangles, predicted.moving, currentDeviceLimits(predicted.triangles), predicted.materials);
+    checkMemoryPlan(cfg, predicted, currentDeviceLimits(predicted.triangles));
     cfg = loadConfig(config, true, overrides);
     checkAlgorithmsTakeScene(cfg);
     std::cout << cfg.resolved.dump(2) << "\n";

@@ -140,13 +140,30 @@ void checkAlgorithmsTakeScene(const ExperimentConfig& cfg) {
     }
 }
 
-MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
-                           size_t materials) {
-    return checkMemoryPlan(cfg, triangles, moving, limits, systemMemory(), materials);
+size_t predictedSceneBytes(const ScenePrediction& scene) {
+    // Per triangle, plus one vertex of slack (Scene::append reserves it), 16 bytes a material
+    // (Material), and per moving triangle its three local vertices (MovingPart::local).
+    return saturatingSum({saturatingMul(scene.triangles, kSceneBytesPerTriangle), sizeof(glm::vec3),
+                          saturatingMul(scene.materials, sizeof(Material)), saturatingMul(scene.movingTriangles, 3 * sizeof(glm::vec3)),
+                          saturatingMul(scene.movingParts, sizeof(MovingPart))});
 }
 
-MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
-                           const SystemMemory& machine, size_t materials) {
+/// SceneGpu's buffers: per triangle, 16 bytes a material (RGBA32F), and per moving triangle its
+/// local vertices (three vec4) and index (uvec2), per moving part its matrix.
+size_t predictedSceneGpuBytes(const ScenePrediction& scene) {
+    return saturatingSum({saturatingMul(scene.triangles, kSceneGpuBytesPerTriangle), saturatingMul(scene.materials, 16),
+                          saturatingMul(scene.movingTriangles, kMovingGpuBytesPerTriangle),
+                          saturatingMul(scene.movingParts, sizeof(glm::mat4))});
+}
+
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& scene, const DeviceLimits& limits) {
+    return checkMemoryPlan(cfg, scene, limits, systemMemory());
+}
+
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& scene, const DeviceLimits& limits,
+                           const SystemMemory& machine) {
+    const size_t triangles = scene.triangles;
+    const bool moving = scene.moving;
     MemoryPlan plan;
     plan.triangles = triangles;
     plan.moving = moving;
@@ -162,14 +179,14 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool m
                              std::to_string(limits.storageBlockBytes >> 20) + " MiB on this device, " +
                              std::to_string(poseLimit) + " triangles; this one has up to " + std::to_string(triangles));
 
-    // Per triangle, plus one vertex of slack (Scene::append reserves it) and the materials: 16 bytes
-    // each on the host (Material) and on the GPU (its RGBA32F record).
-    const size_t materialBytes = saturatingMul(materials, 16);
-    plan.held.emplace_back("scene", saturatingSum({saturatingMul(triangles, kSceneBytesPerTriangle), sizeof(glm::vec3), materialBytes}));
-    plan.held.emplace_back("scene_gpu", saturatingSum({saturatingMul(triangles, kSceneGpuBytesPerTriangle), materialBytes}));
+    plan.held.emplace_back("scene", predictedSceneBytes(scene));
+    plan.held.emplace_back("scene_gpu", predictedSceneGpuBytes(scene));
     // The largest object (a grid's copies) is made whole and then appended to the scene.
     plan.loadPeak = saturatingMul(2, plan.held[0].second);
     refuseOverflow(cfg, "/scene", "the scene", plan.loadPeak, triangles);
+    // SceneGpu stages the moving parts' local vertices and indices on the host while it uploads them.
+    const size_t gpuUploadPeak = saturatingSum({plan.held[0].second, plan.held[1].second,
+                                                saturatingMul(scene.movingTriangles, kMovingGpuBytesPerTriangle)});
 
     // Algorithms set up one after the other (the reference first): each one's transient sits on
     // top of the scene and of what it and the ones before it hold, not of what comes after.
@@ -186,7 +203,7 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool m
         setupPeak = std::max(setupPeak, saturatingSum({held, f.peakBytes}));
         refuseOverflow(cfg, where, e->info->name + "'s estimate with what is held before it", setupPeak, triangles);
     }
-    plan.peak = std::max({plan.loadPeak, held, setupPeak});
+    plan.peak = std::max({plan.loadPeak, gpuUploadPeak, held, setupPeak});
     if (plan.available > 0 && plan.peak > plan.available)
         throw InputError(cfg.file, "/scene",
                          "the run would need about " + plan.summary() + " for up to " + std::to_string(triangles) +

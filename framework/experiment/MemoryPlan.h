@@ -7,6 +7,7 @@
 #include "framework/core/JsonNode.h"
 #include "framework/core/SystemMemory.h"
 #include "framework/experiment/Config.h"
+#include "framework/scene/SceneConfig.h"
 
 #include <string>
 #include <utility>
@@ -37,15 +38,16 @@ struct MemoryPlan {
     std::string summary() const;
 };
 
-/// The plan for `cfg` with a scene of (at most) `triangles`; throws InputError naming cfg.file and
-/// the JSON path (the algorithm entry that refuses, or /scene) when an algorithm refuses the scene on
-/// this device or the plan's peak exceeds the memory available.
-/// `materials`: the scene's materials (ScenePrediction::materials), held on the host and the GPU.
-MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
-                           size_t materials = 0);
+/// The plan for `cfg` with the predicted `scene` (predictScene: its triangles are at most these);
+/// throws InputError naming cfg.file and the JSON path (the algorithm entry that refuses, or /scene)
+/// when an algorithm refuses the scene on this device or the plan's peak exceeds the memory available.
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& scene, const DeviceLimits& limits);
 /// As above against `machine` instead of this machine's /proc/meminfo (tests).
-MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits,
-                           const SystemMemory& machine, size_t materials = 0);
+MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& scene, const DeviceLimits& limits,
+                           const SystemMemory& machine);
+/// What the predicted scene holds on the host (Scene::bytes()) and on the GPU (SceneGpu::bytes()).
+size_t predictedSceneBytes(const ScenePrediction& scene);
+size_t predictedSceneGpuBytes(const ScenePrediction& scene);
 
 /// Once cfg.scene exists: every algorithm entry's sceneCheck on it (current GL context); throws
 /// InputError at the first entry that refuses, naming its JSON path (`validate`, so that what it

@@ -207,6 +207,11 @@ Scene makeFence(int posts, float spacing, float height, float radius, int rails,
     Scene post = makeCylinder(radius, height, trianglesPerCylinder, m);
     Scene rail = layout.rails ? makeCylinder(radius, layout.length, trianglesPerCylinder, m) : Scene{};
     Scene scene;
+    // Reserved at its exact size (+ 1 vertex: see Scene::append), so the fence holds no slack.
+    const size_t triangles = size_t(layout.posts) * post.triangleCount() + size_t(layout.rails) * rail.triangleCount();
+    scene.positions.reserve(3 * triangles + 1);
+    scene.normals.reserve(triangles);
+    scene.materialIds.reserve(triangles);
     for (int i = 0; i < layout.posts; ++i)
         scene.append(post, glm::translate(glm::mat4(1.0f), {firstX + float(i) * spacing, 0, 0}));
     // A cylinder along +Y turned −90° about Z lies along +X, starting at the first post.
@@ -217,7 +222,7 @@ Scene makeFence(int posts, float spacing, float height, float radius, int rails,
         scene.append(rail, glm::translate(glm::mat4(1.0f), {firstX, y, 0}) * toX);
     }
     // append() copies the material per copy; one material is enough since they are all `m`.
-    scene.materials = {m};
+    scene.materials = std::vector<Material>{m}; // a new vector: the copies' capacity goes with the old one
     std::fill(scene.materialIds.begin(), scene.materialIds.end(), 0u);
     return scene;
 }

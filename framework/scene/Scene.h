@@ -55,6 +55,8 @@ glm::mat4 poseOf(const MovingPart& part, double time);
 /// (positions 36, normal + material 16), which a software renderer keeps in host memory too.
 constexpr size_t kSceneBytesPerTriangle = 52;
 constexpr size_t kSceneGpuBytesPerTriangle = 52;
+/// Bytes a moving triangle adds in SceneGpu: its three local vertices (vec4 each) and its index.
+constexpr size_t kMovingGpuBytesPerTriangle = 3 * 16 + 8;
 /// The least a triangle costs a run: the scene on the host and on the GPU, nothing else.
 constexpr size_t kMinBytesPerTriangle = kSceneBytesPerTriangle + kSceneGpuBytesPerTriangle;
 

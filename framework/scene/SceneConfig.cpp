@@ -52,6 +52,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <array>
 #include <functional>
 #include <map>
 #include <memory>
@@ -86,6 +87,9 @@ struct Builder {
     /// The materials it brings (Scene::append keeps every one of them): 1 when not set.
     std::function<size_t()> materials = {};
     size_t materialCount() const { return materials ? materials() : 1; }
+    /// Triangles in moving parts and the parts (upper bounds); none when not set.
+    std::function<std::pair<size_t, size_t>()> moving = {};
+    std::pair<size_t, size_t> movingCount() const { return moving ? moving() : std::pair<size_t, size_t>{0, 0}; }
     Scene operator()() const { return make(); }
 };
 
@@ -243,7 +247,11 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         gridTriangles(node, object.triangleCount(), copies, budget);
         return makeGrid(object, count, spacing, rotateStep);
     }, [=] { return gridTriangles(node, inner.count(), copies, budget); }, inner.moves,
-                   [=] { return saturatingMul(inner.materialCount(), copies); }};
+                   [=] { return saturatingMul(inner.materialCount(), copies); },
+                   [=] {
+                       const auto [triangles, parts] = inner.movingCount();
+                       return std::pair{saturatingMul(triangles, copies), saturatingMul(parts, copies)};
+                   }};
 }
 
 /// The built object must be usable: an overflowing radius or scale turns every triangle into
@@ -318,16 +326,17 @@ Builder parseObject(JsonNode node, int depth, int budget) {
             }
         };
         // Counted by loading it, once for both counts.
-        auto counted = std::make_shared<std::optional<std::pair<size_t, size_t>>>();
+        auto counted = std::make_shared<std::optional<std::array<size_t, 4>>>();
         auto load = [make = build.make, counted] {
             if (!*counted) {
                 const Scene s = make();
-                *counted = std::make_pair(s.triangleCount(), s.materials.size());
+                *counted = {s.triangleCount(), s.materials.size(), s.movingTriangleCount(), s.moving.size()};
             }
             return **counted;
         };
-        build.count = [load] { return load().first; };
-        build.materials = [load] { return load().second; };
+        build.count = [load] { return load()[0]; };
+        build.materials = [load] { return load()[1]; };
+        build.moving = [load] { return std::pair{load()[2], load()[3]}; };
         build.moves = !motion.animation.empty() || !motion.nodes.empty();
     } else {
         build = parseGenerator(node, kind, material, depth, budget);
@@ -345,6 +354,11 @@ Builder parseObject(JsonNode node, int depth, int budget) {
     placed.count = build.count;
     placed.materials = build.materials;
     placed.moves = build.moves || path != nullptr;
+    // A path moves the whole object: its static runs (at most one more than its parts) become parts.
+    placed.moving = path ? std::function<std::pair<size_t, size_t>()>([build] {
+        return std::pair{build.count(), saturatingSum({saturatingMul(2, build.movingCount().second), 1})};
+    })
+                         : build.moving;
     placed.make = [=]() mutable {
         Scene s = build();
         if (overrideMaterial && (kind == "gltf" || kind == "grid")) overrideMaterials(s, material);
@@ -404,6 +418,9 @@ ScenePrediction predictScene(JsonNode sceneNode) {
         p.triangles = addWithinBudget(parsed.objects[i], p.triangles, parsed.builders[i].count(), parsed.budget);
         p.moving |= parsed.builders[i].moves;
         p.materials = saturatingSum({p.materials, parsed.builders[i].materialCount()});
+        const auto [movingTriangles, movingParts] = parsed.builders[i].movingCount();
+        p.movingTriangles = saturatingSum({p.movingTriangles, movingTriangles});
+        p.movingParts = saturatingSum({p.movingParts, movingParts});
     }
     return p;
 }
@@ -415,6 +432,21 @@ void absolutiseScenePaths(Json& object, const std::string& baseDir) {
     if (object.contains("object")) absolutiseScenePaths(object["object"], baseDir);
     if (object.contains("objects") && object["objects"].is_array())
         for (Json& o : object["objects"]) absolutiseScenePaths(o, baseDir);
+}
+
+/// An object that grew while it was made (a glTF file's meshes appended one by one) keeps no
+/// slack for the run: its vectors are copied to their size (positions + 1 vertex, see
+/// Scene::append), within the load's peak of twice the scene.
+static void fitCapacity(Scene& scene) {
+    if (scene.positions.capacity() > scene.positions.size() + 1) {
+        std::vector<glm::vec3> tight;
+        tight.reserve(scene.positions.size() + 1);
+        tight.assign(scene.positions.begin(), scene.positions.end());
+        scene.positions.swap(tight);
+    }
+    scene.normals.shrink_to_fit();
+    scene.materialIds.shrink_to_fit();
+    scene.materials.shrink_to_fit();
 }
 
 Scene buildScene(JsonNode sceneNode) {
@@ -435,10 +467,14 @@ Scene buildScene(JsonNode sceneNode) {
     Scene scene;
     if (made.size() == 1) {
         scene = std::move(made[0]);
+        fitCapacity(scene);
     } else {
+        size_t materials = 0;
+        for (const Scene& s : made) materials += s.materials.size();
         scene.positions.reserve(3 * total + 1);
         scene.normals.reserve(total);
         scene.materialIds.reserve(total);
+        scene.materials.reserve(materials);
         for (Scene& s : made) {
             scene.append(s, glm::mat4(1.0f));
             s = Scene();

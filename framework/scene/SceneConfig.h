@@ -25,6 +25,9 @@ struct ScenePrediction {
     size_t triangles = 0;
     bool moving = false; ///< some object has a path, an animation or node paths
     size_t materials = 0; ///< the materials its objects bring (a grid's copies each bring theirs)
+    /// Upper bounds of the triangles in moving parts and of the parts (an object with a path moves
+    /// whole; a glTF file's animated nodes as loaded; a grid's copies each move).
+    size_t movingTriangles = 0, movingParts = 0;
 };
 ScenePrediction predictScene(JsonNode sceneNode);
 /// Rewrites every "gltf" path of a scene (or of one object, and of grids' inner objects) against
