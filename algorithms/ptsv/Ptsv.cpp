@@ -538,13 +538,32 @@ private:
 } // namespace
 
 /// 128 bytes a triangle of planes (one storage block, checked against the reported limit as
-/// setScene does), the view-sample hierarchy and job lists per pixel.
+/// setScene does), and what ensureLayout() allocates for the config's resolution and camera: the
+/// view-sample hierarchy's masks and bounds (refused past a storage block as there), the per-sample
+/// slots of whole tiles (a resolution that is no multiple of tile_size is padded), the job list.
 Footprint ptsvFootprint(const FootprintQuery& q) {
     Footprint f;
+    const ParamValues& p = *q.params;
     const size_t planes = saturatingMul(q.triangles, PTSV_PLANES_PER_TRIANGLE * 16);
-    const size_t jobs = std::get<bool>(q.params->get("two_pass")) ? size_t(std::get<int>(q.params->get("job_capacity"))) * 8 : 0;
-    f.bytes = saturatingSum({planes, 40 * size_t(q.resolution.x) * size_t(q.resolution.y), jobs});
+    const bool twoPass = std::get<bool>(p.get("two_pass"));
+    const size_t capacity = size_t(std::get<int>(p.get("job_capacity")));
+    const size_t jobs = twoPass ? capacity * 8 : 8;
+    const size_t jobIterations = std::get<bool>(p.get("job_iterations")) ? saturatingMul(saturatingSum({q.triangles, twoPass ? capacity : 0, 1}), 4) : 4;
+    const int tile = std::get<int>(p.get("tile_size"));
+    ptsv::KeyLayout layout;
+    try {
+        layout = ptsv::makeKeyLayout(q.resolution, tile, q.fovYDeg, q.nearPlane, q.farPlane, std::get<int>(p.get("max_key_bits")));
+    } catch (const RuntimeError& e) {
+        f.refusal = std::string(e.what()).substr(std::string("ptsv: ").size());
+        return f;
+    }
+    const size_t bounds = std::get<std::string>(p.get("bounds")) == "explicit" ? layout.boundsNodes * 6 * sizeof(float) : 4;
+    const size_t slots = size_t(layout.tilesX) * size_t(layout.tilesY) * size_t(tile) * size_t(tile);
+    const size_t pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
+    const size_t perSlot = 16 + 4 + (std::get<bool>(p.get("heat_map")) ? 4 : 0); // samples, shadow marks, heat counts
+    f.bytes = saturatingSum({planes, layout.maskWords * 4, bounds, saturatingMul(slots, perSlot), 4 * pixels, jobs, jobIterations});
     f.refusal = storageRefusal(q, "its shadow-volume planes", planes, true);
+    if (f.refusal.empty()) f.refusal = storageRefusal(q, "the explicit bounds of its view-sample hierarchy", bounds, true);
     return f;
 }
 AlgorithmInfo ptsvInfo() {

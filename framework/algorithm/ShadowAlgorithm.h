@@ -81,6 +81,7 @@ struct AlgorithmOptions {
 struct FootprintQuery {
     size_t triangles = 0;           ///< an upper bound of the scene's triangles
     glm::ivec2 resolution{0};
+    float fovYDeg = 60, nearPlane = 0.05f, farPlane = 100; ///< the config's camera (fixed for a run)
     bool moving = false;            ///< the scene has moving parts
     const ParamValues* params = nullptr;
     size_t storageBlockBytes = 0;   ///< what one storage block addresses on this device, measured (MemoryPlan.cpp)

@@ -88,6 +88,9 @@ Footprint footprintOf(const AlgorithmEntry& e, const ExperimentConfig& cfg, size
     FootprintQuery q;
     q.triangles = triangles;
     q.resolution = cfg.resolution;
+    q.fovYDeg = cfg.camera.fovYDeg;
+    q.nearPlane = cfg.camera.nearPlane;
+    q.farPlane = cfg.camera.farPlane;
     q.moving = moving;
     q.params = &e.params;
     q.storageBlockBytes = limits.storageBlockBytes;
