@@ -218,8 +218,20 @@ TEST(OutputPlaceTest, ASweepsRunSlotsAreTheOnlyOutputsInsideIt) {
     // Only a slot the sweep planned: it writes runs/ID.config.json before it starts the run there.
     EXPECT_NE(errorOf(sweep + "/runs/abc123", false).find("inside the sweep directory"), std::string::npos);
     std::ofstream(sweep + "/runs/abc123.config.json") << "{}";
+    // Only a run of that config (third probe: `run other.json --out SWEEP/runs/ID --force` was
+    // taken, its results then read as the sweep's), and not one changed by --set (no config given).
+    std::ofstream(base + "/other.json") << "{}";
+    for (const std::string& config : {base + "/other.json", std::string()})
+        try {
+            OutputPlace::open(sweep + "/runs/abc123", true, nullptr, config);
+            ADD_FAILURE() << "a run of '" << config << "' took the sweep's slot";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("takes only a run of its own config"), std::string::npos) << e.what();
+        }
+    EXPECT_FALSE(fs::exists(sweep + "/runs/abc123"));
     {
-        OutputPlace run = OutputPlace::open(sweep + "/runs/abc123", true);  // as `sweep run` starts its runs
+        // As `sweep run` starts its runs: `run runs/ID.config.json --out runs/ID --force`.
+        OutputPlace run = OutputPlace::open(sweep + "/runs/abc123", true, nullptr, sweep + "/runs/./abc123.config.json");
         std::ofstream(run.partialDir() + "/summary.json") << "run";
         run.commit();
     }

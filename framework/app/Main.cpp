@@ -162,7 +162,8 @@ int run(const std::vector<std::string>& args) {
     // run that could not save its results fails at once instead of after the work.
     ExperimentConfig cfg = loadConfig(config, false, overrides);
     std::vector<std::string> notes;
-    OutputPlace place = OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes);
+    OutputPlace place = OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes,
+                                          overrides.empty() ? config : std::string());
     for (const auto& n : notes) std::fprintf(stderr, "shadowlab: %s\n", shortText(n, 600).c_str());
     opt.place = &place;
     // The context first: the memory plan needs the device's limits, and is checked before the
@@ -242,7 +243,7 @@ int validate(const std::string& config, const std::vector<std::string>& override
     ExperimentConfig cfg = loadConfig(config, false, overrides);
     // The output place too (run --out may name another).
     try {
-        OutputPlace::check(cfg.outputDir);
+        OutputPlace::check(cfg.outputDir, overrides.empty() ? config : std::string());
     } catch (const InputError& e) {
         throw InputError(config, "/output/dir", e.cause());
     }

@@ -161,8 +161,10 @@ bool isRunTemporary(const std::string& name) {
 /// An output inside another run's output, inside a run in progress, or inside a sweep (other than a
 /// sweep's own run slot, SWEEP/runs/ID) would be lost or corrupt when that one is replaced, or
 /// would replace part of it: refused before anything is created.
-/// `allowRunSlot`: a run (not a sweep) may go to SWEEP/runs/ID, where the sweep wrote ID.config.json.
-void checkAncestors(const std::string& dir, bool allowRunSlot) {
+/// `runConfig`: the config file of the run going there ("" for a sweep, or a run with --set): a
+/// run may go to SWEEP/runs/ID only when it runs SWEEP/runs/ID.config.json itself, the config the
+/// sweep wrote for that slot, so no other experiment's results land among the sweep's.
+void checkAncestors(const std::string& dir, const std::string& runConfig) {
     std::error_code ec;
     const fs::path lexical = fs::absolute(dir, ec).lexically_normal();
     std::vector<fs::path> chains = {lexical};
@@ -184,9 +186,13 @@ void checkAncestors(const std::string& dir, bool allowRunSlot) {
             if (marker == "sweep.json") {
                 // A sweep runs each of its runs into SWEEP/runs/ID, after writing ID.config.json
                 // there; anything else inside it is not its.
-                if (allowRunSlot && depth == 2 && target.parent_path().filename() == "runs" &&
-                    isRegularFile(target.string() + ".config.json"))
-                    continue;
+                const std::string slotConfig = target.string() + ".config.json";
+                if (depth == 2 && target.parent_path().filename() == "runs" && isRegularFile(slotConfig)) {
+                    if (!runConfig.empty() && fs::equivalent(runConfig, slotConfig, ec)) continue;
+                    throw InputError(shortPath(dir), "", "the output is the sweep " + shortPath(a.string()) + "'s run slot " +
+                                                  target.filename().string() + ", which takes only a run of its own config, " +
+                                                  shortPath(slotConfig) + ", without --set; choose --out outside the sweep");
+                }
                 throw InputError(shortPath(dir), "", "the output lies inside the sweep directory " + shortPath(a.string()) +
                                               " (it holds sweep.json); only the sweep's own runs go to its runs/ID. Choose --out outside it");
             }
@@ -283,12 +289,12 @@ int acquireLock(const std::string& lockPath, const std::string& dir) {
 namespace {
 /// What check() and checkSweepPlace() share: a path that can name a folder of its own, and is
 /// not a link or something other than a directory. Returns whether the directory exists.
-bool checkPlace(const std::string& dir, bool allowRunSlot, const char* example) {
+bool checkPlace(const std::string& dir, const std::string& runConfig, const char* example) {
     if (dir.empty()) throw InputError("--out", "", "the output directory must not be empty");
     if (dir == "/" || containsWorkingDir(dir))
         throw InputError(shortPath(dir), "", std::string("the output directory cannot be the working directory or one above it "
                                                          "(an output is a directory of its own, e.g. --out ") + example + ")");
-    checkAncestors(dir, allowRunSlot);
+    checkAncestors(dir, runConfig);
     std::error_code ec;
     const auto status = fs::symlink_status(dir, ec);
     if (fs::is_symlink(status))
@@ -301,7 +307,7 @@ bool checkPlace(const std::string& dir, bool allowRunSlot, const char* example) 
 
 void OutputPlace::checkSweepPlace(const std::string& given) {
     const std::string dir = normalize(given);
-    if (!checkPlace(dir, false, "results/sweep1")) return;
+    if (!checkPlace(dir, "", "results/sweep1")) return;
     std::error_code ec;
     if (isRegularFile(fs::path(dir) / "sweep.json")) return;
     // Empty, or nothing but what `sweep run` makes before it writes sweep.json: runs/ and the lock.
@@ -317,13 +323,13 @@ void OutputPlace::checkSweepPlace(const std::string& given) {
                                          "runs/, plan.json, sweep.csv and sweep.md there; choose another --out or an empty folder");
 }
 
-void OutputPlace::check(const std::string& given) {
-    checkPlace(normalize(given), true, "results/run1");
+void OutputPlace::check(const std::string& given, const std::string& runConfig) {
+    checkPlace(normalize(given), runConfig, "results/run1");
 }
 
-OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<std::string>* notes) {
+OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<std::string>* notes, const std::string& runConfig) {
     const std::string dir = normalize(given);
-    check(dir);  // before anything is created
+    check(dir, runConfig);  // before anything is created
     fs::path finalPath(dir);
     fs::path parent = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
     std::error_code ec;
@@ -409,7 +415,6 @@ OutputPlace::~OutputPlace() {
     release();
 }
 
-void OutputPlace::refuseNestedPlace(const std::string& dir) { checkAncestors(normalize(dir), true); }
 
 void OutputPlace::release() {
     if (lockFd_ < 0) return;

@@ -27,15 +27,15 @@ class OutputPlace {
 public:
     /// `dir` as given (--out or output.dir); `force` allows replacing an existing shadowlab output.
     /// Throws InputError (exit 2) for a place that cannot be used; `notes` receives what was
-    /// cleaned up or recovered, one line each, for the user.
-    static OutputPlace open(const std::string& dir, bool force, std::vector<std::string>* notes = nullptr);
-    /// InputError when `dir` lies inside a run in progress, a run's temporary folder, another run's
-    /// output or a sweep (but for a sweep's own runs/ID): checked before anything is created there.
-    static void refuseNestedPlace(const std::string& dir);
+    /// cleaned up or recovered, one line each, for the user. `runConfig`: the config file the run
+    /// runs, unchanged by --set (else ""): a sweep's run slot SWEEP/runs/ID takes only ID.config.json.
+    static OutputPlace open(const std::string& dir, bool force, std::vector<std::string>* notes = nullptr,
+                            const std::string& runConfig = "");
     /// InputError when `dir` can never hold an output, whatever --force says: empty, "/", the
-    /// working directory or one above it, nested (refuseNestedPlace), a link or a non-directory.
+    /// working directory or one above it, nested (inside a run in progress, a run's temporary folder,
+    /// another run's output or a sweep, but for a sweep's own runs/ID), a link or a non-directory.
     /// open() checks it first; `validate` checks a config's output.dir with it.
-    static void check(const std::string& dir);
+    static void check(const std::string& dir, const std::string& runConfig = "");
     /// InputError when `dir` cannot be a sweep's folder: as check() (but no place inside a sweep at
     /// all, not even its runs/ID), and an existing folder must be empty or hold a sweep (sweep.json).
     static void checkSweepPlace(const std::string& dir);
