@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace shadowlab {
@@ -96,6 +97,13 @@ int JsonNode::getInt(const std::string& key, int def, int minValue, int maxValue
     return out;
 }
 
+namespace {
+/// Not 0, yet below the smallest normal float: it would read as 0 (a setting silently off, as a
+/// fit_size of 1e-300 was) or lose its precision in the float it is stored in.
+bool tooSmallForAFloat(double v) { return v != 0.0 && std::abs(v) < double(std::numeric_limits<float>::min()); }
+constexpr const char* kTooSmallForAFloat = " is too small for a float (not 0, yet below 1.2e-38 in magnitude: it would read as 0)";
+} // namespace
+
 double JsonNode::getFloat(const std::string& key, double def, double minValue, double maxValue) {
     const Json* v = lookup(key);
     double out = def;
@@ -107,6 +115,7 @@ double JsonNode::getFloat(const std::string& key, double def, double minValue, d
             os << "value " << shortDump(*v) << " is out of range [" << minValue << ", " << maxValue << "]";
             fail(key, os.str());
         }
+        if (tooSmallForAFloat(out)) fail(key, "value " + shortDump(*v) + kTooSmallForAFloat);
     }
     record(key, out);
     return out;
@@ -155,6 +164,7 @@ std::vector<T> JsonNode::numberArray(const std::string& key, size_t n, bool inte
         double d = e.get<double>();
         if (!std::isfinite(d)) fail(key, "non-finite number in " + shortDump(*v));
         if (!integral && std::abs(d) > kFloatMax) fail(key, "number too large for a float in " + shortDump(*v));
+        if (!integral && tooSmallForAFloat(d)) fail(key, shortDump(e) + " in " + shortDump(*v) + kTooSmallForAFloat);
         if (integral && (d < INT32_MIN || d > INT32_MAX)) fail(key, "integer out of the 32-bit range in " + shortDump(*v));
         out.push_back(static_cast<T>(d));
     }

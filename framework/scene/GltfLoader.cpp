@@ -221,20 +221,57 @@ size_t glbBinLength(const std::vector<unsigned char>& bytes) {
     return size_t(readU32(bytes, json));
 }
 
-/// The decoded length of a base64 data URI's payload, or SIZE_MAX when `uri` is not one.
-size_t dataUriLength(const std::string& uri) {
-    if (uri.rfind("data:", 0) != 0) return SIZE_MAX;
-    const size_t comma = uri.find(',');
-    if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos) return SIZE_MAX;
-    size_t n = uri.size() - comma - 1, pad = 0;
-    for (size_t i = uri.size(); i > comma + 1 && uri[i - 1] == '=' && pad < 2; --i) ++pad;
-    return n / 4 * 3 - (n % 4 == 0 ? pad : 0);
+/// A uri's percent-encoded characters decoded, as the reader decodes a buffer file's name (tinygltf's
+/// urldecode: "%XX" is a byte, "+" a space).
+std::string percentDecoded(const std::string& uri) {
+    auto hex = [](char c) { // a non-hex digit counts 0, as there
+        if (c >= '0' && c <= '9') return c - '0';
+        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+        return c >= 'A' && c <= 'F' ? c - 'A' + 10 : 0;
+    };
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '+') out += ' ';
+        else if (uri[i] == '%' && i + 2 < uri.size()) out += char((hex(uri[i + 1]) << 4) | hex(uri[i + 2])), i += 2;
+        else out += uri[i];
+    }
+    return out;
 }
 
-/// What the glTF reader (tinygltf) refuses without saying where, checked first so that the error
-/// names its JSON path: a byteStride outside 4..252 or not a multiple of 4, a buffer whose bytes
-/// (a data URI's, a file's, the GLB's binary chunk) are fewer than its byteLength, a missing buffer
-/// file, a skin without inverseBindMatrices (optional in glTF 2.0, but required by the reader).
+/// The data URIs the reader decodes (others it would take for file names).
+constexpr const char* kDataUriPrefixes[] = {"data:application/octet-stream;base64,", "data:application/gltf-buffer;base64,"};
+
+/// The decoded length of a buffer's data URI, or why the reader cannot decode it (another media
+/// type or encoding, or a payload that is not base64).
+size_t dataUriLength(const std::string& uri, std::string& problem) {
+    for (const char* prefix : kDataUriPrefixes) {
+        const size_t start = std::strlen(prefix);
+        if (uri.compare(0, start, prefix) != 0) continue;
+        size_t n = uri.size() - start, pad = 0;
+        while (pad < 2 && n > pad && uri[uri.size() - 1 - pad] == '=') ++pad;
+        for (size_t i = start; i < uri.size() - pad; ++i)
+            if (!std::isalnum(static_cast<unsigned char>(uri[i])) && uri[i] != '+' && uri[i] != '/') {
+                problem = "the data URI's payload is not base64 (character " + std::to_string(i - start + 1) + ")";
+                return 0;
+            }
+        if (n % 4 != 0) {
+            problem = "the data URI's payload is not base64 (its length is not a multiple of 4)";
+            return 0;
+        }
+        return n / 4 * 3 - pad;
+    }
+    problem = "a data URI of a buffer must begin with data:application/octet-stream;base64, or "
+              "data:application/gltf-buffer;base64,";
+    return 0;
+}
+
+/// What the glTF reader (tinygltf) refuses without saying where (or saying it by echoing the
+/// file's text), checked first so that the error names its JSON path: a byteStride outside 4..252
+/// or not a multiple of 4; a buffer without a uri outside a GLB's first; a data URI the reader
+/// cannot decode; a buffer file missing or not a regular file; a buffer whose bytes differ from its
+/// byteLength (a data URI's or a file's must equal it, the GLB's binary chunk may be up to 3 bytes
+/// longer, its padding); a skin without inverseBindMatrices (optional in glTF 2.0, but required by
+/// the reader).
 void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool binary, size_t binLength) {
     if (doc.contains("bufferViews"))
         for (size_t i = 0; i < doc["bufferViews"].size(); ++i) {
@@ -249,24 +286,37 @@ void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool bi
         for (size_t i = 0; i < doc["buffers"].size(); ++i) {
             const Json& b = doc["buffers"][i];
             const std::string where = "/buffers/" + std::to_string(i);
-            const uint64_t length = b.contains("byteLength") ? b["byteLength"].get<uint64_t>() : 0;
-            size_t have = SIZE_MAX;
+            if (!b.contains("byteLength")) throw InputError(file, where + "/byteLength", "required (the buffer's length in bytes)");
+            const uint64_t length = b["byteLength"].get<uint64_t>();
+            if (length == 0) throw InputError(file, where + "/byteLength", "must be at least 1");
             if (!b.contains("uri")) {
-                if (!binary || i != 0) continue; // the reader refuses it with its own words, or it is unused
-                have = binLength;
-            } else {
-                const std::string uri = b["uri"].get<std::string>();
-                have = dataUriLength(uri);
-                // (A percent-encoded name is left to the reader, which resolves it its own way.)
-                if (have == SIZE_MAX && uri.rfind("data:", 0) != 0 && uri.find('%') == std::string::npos) {
-                    const std::string path = resolvePath(parentDir(file), uri);
-                    struct stat st {};
-                    if (::stat(path.c_str(), &st) != 0)
-                        throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " does not exist");
-                    have = S_ISREG(st.st_mode) ? size_t(st.st_size) : SIZE_MAX;
-                }
+                if (!binary || i != 0)
+                    throw InputError(file, where + "/uri",
+                                     "required: only the first buffer of a .glb file may leave it out (its binary chunk)");
+                // The reader takes the first byteLength bytes of the chunk (padded to 4 bytes).
+                if (binLength < length)
+                    throw InputError(file, where + "/byteLength", std::to_string(length) + " bytes declared, the binary chunk holds " +
+                                                                     std::to_string(binLength));
+                continue;
             }
-            if (have != SIZE_MAX && have < length)
+            const std::string uri = b["uri"].get<std::string>();
+            size_t have = 0;
+            if (uri.rfind("data:", 0) == 0) {
+                std::string problem;
+                have = dataUriLength(uri, problem);
+                if (!problem.empty()) throw InputError(file, where + "/uri", problem);
+            } else {
+                // The reader decodes percent-encoded names (%20); so does this check.
+                const std::string path = resolvePath(parentDir(file), percentDecoded(uri));
+                struct stat st {};
+                if (::stat(path.c_str(), &st) != 0)
+                    throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " does not exist");
+                if (!S_ISREG(st.st_mode))
+                    throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " is " +
+                                                               nonRegularKind(path, true) + ", not a regular file");
+                have = size_t(st.st_size);
+            }
+            if (have != length)
                 throw InputError(file, where + "/byteLength", std::to_string(length) + " bytes declared, the buffer holds " +
                                                                  std::to_string(have));
         }
