@@ -240,6 +240,16 @@ TEST(OutputPlaceTest, ASweepsRunSlotsAreTheOnlyOutputsInsideIt) {
     EXPECT_NE(errorOf(sweep + "/runs/abc123/x", false).find("a shadowlab run's output"), std::string::npos);
 }
 
+// Third probe: --out X/n/. made n (the parent of ".") and was then refused, leaving n behind empty.
+TEST(OutputPlaceTest, APathEndingInDotOrDotDotIsRefusedBeforeAnythingIsMade) {
+    const std::string base = test::makeTempDir("place-dot");
+    for (const char* tail : {"/n/.", "/n/..", "/n/./", "/n/../"}) {
+        EXPECT_NE(errorOf(base + tail, false).find("the output path ends in"), std::string::npos) << tail;
+        EXPECT_NE(errorOf(base + tail, true).find("the output path ends in"), std::string::npos) << tail;
+        EXPECT_FALSE(fs::exists(base + "/n")) << tail;
+    }
+}
+
 TEST(OutputPlaceTest, ACommitKeepsWhatAppearedAtThePlaceAfterOpenAndKeepsItsOwnResultsBeside) {
     std::string base = test::makeTempDir("place-appeared"), out = base + "/X/L";
     std::string kept = out + ".kept-" + std::to_string(::getpid());

@@ -57,6 +57,10 @@ const BadSweep kBadSweeps[] = {
     {"SameRunTwice", R"({"axes": [{"name": "pcf", "values": {"algorithms.0.params.pcf": [1, 1.0]}, "labels": ["one", "also one"]}]})",
      "/axes|resolve to the same config"},
     {"UnknownTopLevelKey", R"({"axis": []})", "/axis|unknown"},
+    // The accepted keys are every key the object takes, not the ones the file happens to give.
+    {"UnknownMergeKey", R"({"merge": {"ratio": []}})", "/merge/ratio|accepted keys: counters, paper, ratios, stages"},
+    {"UnknownAxisKey", R"({"axes": [{"name": "f", "values": {"frames": [1, 2]}, "label": ["a", "b"]}]})",
+     "/axes/0/label|accepted keys: labels, name, scale, values"},
     {"BadBaseOutsideAnyAxis", R"({"base": {"frames": -1}})", "/base/frames|out of range"},
     {"NoBase", R"({"base": null})", "/base|required"},
     {"BadRatio", R"({"merge": {"ratios": ["psv"]}})", "/merge/ratios|not ID/ID"},

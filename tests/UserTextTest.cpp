@@ -314,10 +314,15 @@ TEST(UserTextTest, NothingButASweepsOwnRunsGoesInsideIt) {
     EXPECT_FALSE(fs::exists(dir + "/sw/runs/xx"));
     const std::string config = tinyConfig(dir);
     expectOneLineNaming(shell(kBin + " validate " + config + " --set output.dir=" + dir + "/sw/runs/abc"), "sweep");
-    // The sweep's own slot, where it wrote the run's config: accepted.
-    std::ofstream(dir + "/sw/runs/abc.config.json") << "{}\n";
-    const Result ok = shell(kBin + " validate " + config + " --set output.dir=" + dir + "/sw/runs/abc");
+    // The sweep's own slot, where it wrote the run's config: accepted for that config only, as it
+    // is (third probe: a run of another config, or changed by --set, was taken there too).
+    Json slotConfig = Json::parse(readText(config));
+    slotConfig["output"]["dir"] = dir + "/sw/runs/abc";
+    test::writeJson(dir + "/sw/runs/abc.config.json", slotConfig);
+    const Result ok = shell(kBin + " validate " + dir + "/sw/runs/abc.config.json");
     EXPECT_EQ(ok.rc, 0) << ok.out;
+    expectOneLineNaming(shell(kBin + " validate " + config + " --set output.dir=" + dir + "/sw/runs/abc"), "takes only a run of its own config");
+    expectOneLineNaming(shell(kBin + " validate " + dir + "/sw/runs/abc.config.json --set frames=2"), "takes only a run of its own config");
 }
 
 // D7: DIR.lock holds "shadowlab-lock PID"; a user's file there, even an empty one or one holding

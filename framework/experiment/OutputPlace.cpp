@@ -23,9 +23,13 @@ std::string pidSuffix() { return std::to_string(::getpid()); }
 
 std::string shortPath(const fs::path& path) { return shadowlab::shortPath(path.string()); }
 
-/// "results/run/" → "results/run"; "" stays "" (rejected by the caller).
+/// "results/run/" → "results/run"; "" stays "" (rejected by the caller); one ending in "." or ".." is refused: its parent would be made
+/// for it and then found to be the output (left behind, empty, when the run is refused).
 std::string normalize(std::string dir) {
     while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+    const std::string last = fs::path(dir).filename().string();
+    if ((last == "." || last == "..") && dir != last) // "." alone: the working directory, refused as such
+        throw InputError(shortPath(dir), "", "the output path ends in \"" + last + "\": name the output folder itself (e.g. --out results/run1)");
     return dir;
 }
 

@@ -141,9 +141,9 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
         for (Json& v : axis.values.back()) absolutiseAxisValue(v, path, sweepDir);
     }
 
+    node.markRead("labels"); // accepted, given or not: an unknown key's error lists it
     if (node.has("labels")) {
         const Json& labels = node.raw()["labels"];
-        node.markRead("labels");
         if (!labels.is_array() || labels.size() != count)
             node.fail("labels", "expected a list of " + std::to_string(count) + " strings, one per value");
         for (size_t k = 0; k < labels.size(); ++k) {
@@ -369,10 +369,11 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     }
 
     JsonNode merge = root.child("merge");
+    // Every key merge takes is marked read, given or not, so an unknown one's error lists them all.
+    for (const char* key : {"stages", "counters", "ratios", "paper"}) merge.markRead(key);
     for (const char* key : {"stages", "counters", "ratios"}) {
         if (!merge.has(key)) continue;
         const Json& list = merge.raw()[key];
-        merge.markRead(key);
         bool ok = list.is_array();
         for (const Json& v : list) ok = ok && v.is_string() && userTextProblem(v.get<std::string>()).empty();
         if (!ok) merge.fail(key, "expected a list of strings (one line each, at most " + std::to_string(kMaxLabelChars) + " characters)");
