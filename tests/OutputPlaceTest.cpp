@@ -250,6 +250,28 @@ TEST(OutputPlaceTest, APathEndingInDotOrDotDotIsRefusedBeforeAnythingIsMade) {
     }
 }
 
+// Fourth probe: a run refused after its place was opened (by the memory plan, or an algorithm
+// refusing the scene) left the folders made for --out new/deeper/out behind, empty.
+TEST(OutputPlaceTest, APlaceNeverCommittedRemovesTheFoldersItMadeWhenEmpty) {
+    const std::string base = test::makeTempDir("place-parents");
+    { OutputPlace p = OutputPlace::open(base + "/new/deeper/out", false); }
+    EXPECT_FALSE(fs::exists(base + "/new"));
+    // A folder that is not empty by then (the user put a file there meanwhile) is left as it is.
+    {
+        OutputPlace p = OutputPlace::open(base + "/new/deeper/out", false);
+        std::ofstream(base + "/new/mine.txt") << "keep";
+    }
+    EXPECT_TRUE(fs::exists(base + "/new/mine.txt"));
+    EXPECT_FALSE(fs::exists(base + "/new/deeper"));
+    // A committed place keeps them, of course.
+    {
+        OutputPlace p = OutputPlace::open(base + "/made/out", false);
+        std::ofstream(p.partialDir() + "/summary.json") << "run";
+        p.commit();
+    }
+    EXPECT_TRUE(fs::exists(base + "/made/out/summary.json"));
+}
+
 TEST(OutputPlaceTest, ACommitKeepsWhatAppearedAtThePlaceAfterOpenAndKeepsItsOwnResultsBeside) {
     std::string base = test::makeTempDir("place-appeared"), out = base + "/X/L";
     std::string kept = out + ".kept-" + std::to_string(::getpid());

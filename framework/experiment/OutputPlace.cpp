@@ -331,16 +331,34 @@ void OutputPlace::check(const std::string& given, const std::string& runConfig) 
     checkPlace(normalize(given), runConfig, "results/run1");
 }
 
+namespace {
+/// Each folder in turn, deepest first, if it is (still) empty: rmdir never removes anything else.
+void removeEmptyFolders(const std::vector<std::string>& folders) {
+    for (const std::string& f : folders) ::rmdir(f.c_str());
+}
+} // namespace
+
 OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<std::string>* notes, const std::string& runConfig) {
     const std::string dir = normalize(given);
     check(dir, runConfig);  // before anything is created
     fs::path finalPath(dir);
     fs::path parent = finalPath.has_parent_path() ? finalPath.parent_path() : fs::path(".");
     std::error_code ec;
+    // The folders made for it, deepest first: a run that stops before its commit removes them again
+    // (when still empty), so a refused run leaves no trace.
+    std::vector<std::string> made;
+    for (fs::path p = parent; !p.empty() && !fs::exists(fs::symlink_status(p, ec)); p = p.parent_path()) {
+        made.push_back(p.string());
+        if (p == p.parent_path()) break;
+    }
     fs::create_directories(parent, ec);
-    if (ec) throw InputError(shortPath(dir), "", "cannot create the parent directory " + shortPath(parent.string()) + ": " + ec.message());
+    if (ec) {
+        removeEmptyFolders(made);
+        throw InputError(shortPath(dir), "", "cannot create the parent directory " + shortPath(parent.string()) + ": " + ec.message());
+    }
 
     OutputPlace place;
+    place.madeParents_ = std::move(made);
     place.final_ = dir;
     place.lockPath_ = dir + ".lock";
     place.lockFd_ = acquireLock(place.lockPath_, dir);
@@ -407,16 +425,19 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
 }
 
 OutputPlace::OutputPlace(OutputPlace&& o) noexcept
-    : final_(std::move(o.final_)), partial_(std::move(o.partial_)), lockPath_(std::move(o.lockPath_)), lockFd_(o.lockFd_),
-      committed_(o.committed_), kept_(o.kept_), existed_(o.existed_), dev_(o.dev_), ino_(o.ino_) {
+    : final_(std::move(o.final_)), partial_(std::move(o.partial_)), lockPath_(std::move(o.lockPath_)),
+      madeParents_(std::move(o.madeParents_)), lockFd_(o.lockFd_), committed_(o.committed_), kept_(o.kept_),
+      existed_(o.existed_), dev_(o.dev_), ino_(o.ino_) {
     o.lockFd_ = -1;
     o.partial_.clear();
+    o.madeParents_.clear();
 }
 
 OutputPlace::~OutputPlace() {
     std::error_code ec;
     if (!committed_ && !kept_ && !partial_.empty()) fs::remove_all(partial_, ec);
     release();
+    if (!committed_ && !kept_) removeEmptyFolders(madeParents_);
 }
 
 

@@ -61,6 +61,7 @@ private:
     [[noreturn]] void refuseCommit(const std::string& why);
 
     std::string final_, partial_, lockPath_;
+    std::vector<std::string> madeParents_; ///< folders open() made above DIR, deepest first
     int lockFd_ = -1;
     bool committed_ = false;
     bool kept_ = false;  ///< the results were moved to DIR.kept-PID by a refused commit
