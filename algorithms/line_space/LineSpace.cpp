@@ -533,12 +533,17 @@ private:
 /// line space (wordsPerNode words), its occupancy bits, its entry in the node pool and a children
 /// group of N³ entries in the tree pool. The build refuses more than LS_BIT_CHUNKS storage blocks of
 /// line space and one block of nodes, tree or occupancy (NTreeBuilder), so none can exceed that.
-size_t lineSpacePoolBound(int n, int d, size_t triangles, size_t blockBytes) {
+size_t lineSpaceNodeBound(int n, int d, size_t triangles) {
     size_t nodes = 0, k = 1;
     for (int level = 0; level < d; ++level, k = saturatingMul(k, size_t(n))) {
         const size_t cells = saturatingMul(saturatingMul(k, k), k);
         nodes = saturatingSum({nodes, std::min(cells, saturatingMul(saturatingMul(4, saturatingMul(k, k)), std::max<size_t>(triangles, 1)))});
     }
+    return nodes;
+}
+
+size_t lineSpacePoolBound(int n, int d, size_t triangles, size_t blockBytes) {
+    const size_t nodes = lineSpaceNodeBound(n, d, triangles);
     const size_t cube = size_t(n) * size_t(n) * size_t(n);
     size_t bits = saturatingMul(nodes, 4 * ls::wordsPerNode(n));
     size_t nodePool = saturatingMul(nodes, sizeof(ls::NodeGpu)), treePool = saturatingMul(nodes, 4 * cube);
@@ -585,9 +590,18 @@ Footprint lineSpaceFootprint(const FootprintQuery& q) {
 /// build would refuse is refused here, in the time of its occupancy tests.
 std::string lineSpaceSceneCheck(const Scene& scene, const ParamValues& params) {
     const size_t limit = poolBlockLimit(std::get<int>(params.get("max_block_mib")));
+    const int n = std::get<int>(params.get("n")), d = std::get<int>(params.get("d"));
+    const bool exact = std::get<std::string>(params.get("start_region")) == "exact";
+    // Where even the bound of the tree's nodes fits every pool (the build's checks), no tree can fail
+    // them: the shape is built only for the leaf lists, or when the bound does not fit.
+    const size_t nodes = lineSpaceNodeBound(n, d, scene.triangleCount());
+    const size_t cube = size_t(n) * size_t(n) * size_t(n);
+    const bool boundFits = nodes <= ls::nodesPerChunk(n, limit) * LS_BIT_CHUNKS && saturatingMul(nodes, sizeof(ls::NodeGpu)) <= limit &&
+                           saturatingMul(nodes, 4 * ls::occupancyWords(n)) <= limit && saturatingMul(nodes, 4 * cube) <= limit;
+    if (boundFits && !exact) return "";
     try {
-        const ls::NTree shape = ls::buildNTree(scene, std::get<int>(params.get("n")), std::get<int>(params.get("d")), 0, limit, true);
-        if (std::get<std::string>(params.get("start_region")) != "exact") return "";
+        const ls::NTree shape = ls::buildNTree(scene, n, d, 0, limit, true);
+        if (!exact) return "";
         const size_t listBytes = ls::buildLeafLists(scene, shape).tris.size() * sizeof(uint32_t);
         if (listBytes > limit)
             return "the leaf triangle lists of start_region exact need " + std::to_string((listBytes + (1u << 20) - 1) >> 20) +
