@@ -240,6 +240,17 @@ TEST(OutputPlaceTest, ASweepsRunSlotsAreTheOnlyOutputsInsideIt) {
     EXPECT_NE(errorOf(sweep + "/runs/abc123/x", false).find("a shadowlab run's output"), std::string::npos);
 }
 
+// Fourth probe: `run --out A.partial-PID --force` took over the temporary folder of the run in
+// progress into A, which then committed the other run's images as its own.
+TEST(OutputPlaceTest, ARunsTemporaryFolderIsNeverAnOutput) {
+    const std::string base = test::makeTempDir("place-temporary");
+    for (const char* name : {"/A.partial-123", "/A.old-7", "/A.kept-42"}) {
+        makeOutput(base + name, "a run's");
+        EXPECT_NE(errorOf(base + name, true).find("a shadowlab run's temporary directory"), std::string::npos) << name;
+        EXPECT_EQ(slurp(base + name + "/summary.json"), "a run's") << name;
+    }
+}
+
 // Third probe: --out X/n/. made n (the parent of ".") and was then refused, leaving n behind empty.
 TEST(OutputPlaceTest, APathEndingInDotOrDotDotIsRefusedBeforeAnythingIsMade) {
     const std::string base = test::makeTempDir("place-dot");

@@ -5,6 +5,7 @@
 #include "tests/HostileInputs.h"
 #include "tests/TestSupport.h"
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -164,6 +165,8 @@ TEST(RunSafetyTest, AnAlgorithmRefusingTheBuiltSceneIsExitTwoAtItsEntryAndWrites
         std::string log;
         EXPECT_EQ(test::runCommand(std::string("(") + SHADOWLAB_BINARY + command + " >/dev/null)", log), 2) << command << log;
         EXPECT_NE(log.find("c.json: at /algorithms/1: line_space cannot hold this scene"), std::string::npos) << log;
+        // One line, as any bad input: the run says nothing about itself before the refusal.
+        EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
     }
     EXPECT_FALSE(fs::exists(base + "/out"));
 }

@@ -162,8 +162,16 @@ int run(const std::vector<std::string>& args) {
     // run that could not save its results fails at once instead of after the work.
     ExperimentConfig cfg = loadConfig(config, false, overrides);
     std::vector<std::string> notes;
-    OutputPlace place = OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes,
-                                          overrides.empty() ? config : std::string());
+    // A place from the config is named as validate names it: the config and /output/dir.
+    OutputPlace place = [&] {
+        try {
+            return OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes,
+                                     overrides.empty() ? config : std::string());
+        } catch (const InputError& e) {
+            if (!opt.outputDir.empty()) throw;
+            throw InputError(config, "/output/dir", e.cause());
+        }
+    }();
     for (const auto& n : notes) std::fprintf(stderr, "shadowlab: %s\n", shortText(n, 600).c_str());
     opt.place = &place;
     // The context first: the memory plan needs the device's limits, and is checked before the
@@ -172,10 +180,13 @@ int run(const std::vector<std::string>& args) {
     installGlDebugCallback(true);
     const ScenePrediction predicted = predictConfigScene(config, overrides);
     const MemoryPlan plan = checkMemoryPlan(cfg, predicted, currentDeviceLimits(predicted.triangles));
-    std::fprintf(stderr, "shadowlab: memory: %s\n", plan.summary().c_str());
     opt.memoryPlan = plan.toJson();
     cfg = loadConfig(config, true, overrides);
+    // As validate: an algorithm that cannot hold the built scene is refused before anything is said
+    // about the run, so a refused run prints its one error line only.
+    checkAlgorithmsTakeScene(cfg);
     throwIfInterrupted();
+    std::fprintf(stderr, "shadowlab: memory: %s\n", plan.summary().c_str());
     // The name is the config's text: cut, so a huge or multi-line one stays one short line.
     std::fprintf(stderr, "shadowlab: %s, %zu triangles, %d×%d, %d frames on %s (%s)\n", shortText(cfg.name, 100).c_str(),
                  cfg.scene->triangleCount(), cfg.resolution.x, cfg.resolution.y, cfg.frames, glRendererString().c_str(),

@@ -28,6 +28,7 @@ private:
         for (char c : text) {
             if (out.size() >= maxChars) return out + "...";
             if (c == '\n') out += "; ";
+            else if (c == '\0') out += '?'; // what() is a C string: a NUL would end the line there
             else if (c != '\r') out += c;
         }
         return out;

@@ -65,13 +65,23 @@ Json MemoryPlan::toJson() const {
 std::string MemoryPlan::summary() const {
     std::string s = formatGiB(peak) + " estimated at the peak, of " + formatGiB(available) + " available (";
     bool first = true;
-    for (const auto& [name, bytes] : held) {
+    // The largest parts, at most five: a plan of 2000 algorithm entries stays one short line.
+    std::vector<std::pair<std::string, size_t>> parts = held;
+    std::stable_sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+    size_t listed = 0, rest = 0;
+    for (const auto& [name, bytes] : parts) {
         if (bytes < (size_t(1) << 20)) continue; // below a MiB: noise in a line about gigabytes
+        if (listed == 5) {
+            ++rest;
+            continue;
+        }
+        ++listed;
         char part[96];
         std::snprintf(part, sizeof part, "%s%s %.2f", first ? "" : ", ", name.c_str(), double(bytes) / double(size_t(1) << 30));
         s += part;
         first = false;
     }
+    if (rest > 0) s += ", and " + std::to_string(rest) + " more";
     return s + (first ? "nothing large" : "") + ")";
 }
 

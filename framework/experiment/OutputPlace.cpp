@@ -299,6 +299,11 @@ bool checkPlace(const std::string& dir, const std::string& runConfig, const char
         throw InputError(shortPath(dir), "", std::string("the output directory cannot be the working directory or one above it "
                                                          "(an output is a directory of its own, e.g. --out ") + example + ")");
     checkAncestors(dir, runConfig);
+    // A run's DIR.partial-PID, DIR.old-PID or DIR.kept-PID: replacing it with --force would mix two
+    // runs' results (fourth probe: the running one then committed the other's images as its own).
+    if (isRunTemporary(fs::path(dir).filename().string()))
+        throw InputError(shortPath(dir), "", "the output path is a shadowlab run's temporary directory (DIR.partial-PID, "
+                                             "DIR.old-PID or DIR.kept-PID); choose another --out");
     std::error_code ec;
     const auto status = fs::symlink_status(dir, ec);
     if (fs::is_symlink(status))

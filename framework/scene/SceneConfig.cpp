@@ -237,19 +237,21 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
     // grid
     if (depth >= kMaxGridDepth) node.fail("object", "grids nest deeper than " + std::to_string(kMaxGridDepth) + " levels");
     if (!node.has("object")) node.fail("object", "a grid needs the \"object\" to repeat");
-    Builder inner = parseObject(node.child("object"), depth + 1, budget);
+    // Shared by the four functions below, never copied into each: a copy per function and level
+    // grew as 8^depth (fourth probe: 8 nested grids of one plane took 10 GB before anything was made).
+    const auto inner = std::make_shared<const Builder>(parseObject(node.child("object"), depth + 1, budget));
     glm::ivec3 count = node.getIVec3("count", glm::ivec3(2, 1, 2), 1, 100000);
     glm::vec3 spacing = node.getVec3("spacing", glm::vec3(2.0f));
     glm::vec3 rotateStep = node.getVec3("rotate_step_deg", glm::vec3(0.0f));
     const size_t copies = gridCopies(count);
     return Builder{[=] {
-        Scene object = inner();
+        Scene object = (*inner)();
         gridTriangles(node, object.triangleCount(), copies, budget);
         return makeGrid(object, count, spacing, rotateStep);
-    }, [=] { return gridTriangles(node, inner.count(), copies, budget); }, inner.moves,
-                   [=] { return saturatingMul(inner.materialCount(), copies); },
+    }, [=] { return gridTriangles(node, inner->count(), copies, budget); }, inner->moves,
+                   [=] { return saturatingMul(inner->materialCount(), copies); },
                    [=] {
-                       const auto [triangles, parts] = inner.movingCount();
+                       const auto [triangles, parts] = inner->movingCount();
                        return std::pair{saturatingMul(triangles, copies), saturatingMul(parts, copies)};
                    }};
 }
@@ -350,17 +352,19 @@ Builder parseObject(JsonNode node, int depth, int budget) {
     const MotionFn motion = path ? MotionFn([path](double time) { return path->at(time); }) : MotionFn();
     node.finish();
 
+    // One shared copy of what it places (see the grid's).
+    const auto built = std::make_shared<const Builder>(std::move(build));
     Builder placed;
-    placed.count = build.count;
-    placed.materials = build.materials;
-    placed.moves = build.moves || path != nullptr;
+    placed.count = [built] { return built->count(); };
+    placed.materials = [built] { return built->materialCount(); };
+    placed.moves = built->moves || path != nullptr;
     // A path moves the whole object: its static runs (at most one more than its parts) become parts.
-    placed.moving = path ? std::function<std::pair<size_t, size_t>()>([build] {
-        return std::pair{build.count(), saturatingSum({saturatingMul(2, build.movingCount().second), 1})};
-    })
-                         : build.moving;
+    placed.moving = [built, moves = path != nullptr] {
+        if (!moves) return built->movingCount();
+        return std::pair{built->count(), saturatingSum({saturatingMul(2, built->movingCount().second), 1})};
+    };
     placed.make = [=]() mutable {
-        Scene s = build();
+        Scene s = (*built)();
         if (overrideMaterial && (kind == "gltf" || kind == "grid")) overrideMaterials(s, material);
         glm::mat4 m = transform.matrix;
         if (transform.fitSize > 0.0f) {
