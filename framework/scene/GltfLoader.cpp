@@ -21,6 +21,7 @@
 #include <memory>
 #include <sys/stat.h>
 #include <tuple>
+#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -44,26 +45,28 @@ struct Prop {
     const char* key;
     Kind kind;
     const std::vector<Prop>* schema = nullptr;  // for Object / ObjectArray
+    bool required = false; ///< the reader refuses an object without it (checked first, so the error has a path)
 };
+constexpr bool kRequired = true;
 using Schema = std::vector<Prop>;
 
-const Schema kAsset{{"version", Kind::String}, {"generator", Kind::String}, {"minVersion", Kind::String},
+const Schema kAsset{{"version", Kind::String, nullptr, kRequired}, {"generator", Kind::String}, {"minVersion", Kind::String},
                     {"copyright", Kind::String}};
 const Schema kSceneS{{"nodes", Kind::UintArray}};
 const Schema kNodeS{{"camera", Kind::Uint}, {"skin", Kind::Uint}, {"mesh", Kind::Uint}, {"children", Kind::UintArray},
                     {"matrix", Kind::NumberArray}, {"translation", Kind::NumberArray}, {"rotation", Kind::NumberArray},
                     {"scale", Kind::NumberArray}, {"weights", Kind::NumberArray}};
-const Schema kPrimitiveS{{"attributes", Kind::UintMap}, {"indices", Kind::Uint}, {"material", Kind::Uint},
+const Schema kPrimitiveS{{"attributes", Kind::UintMap, nullptr, kRequired}, {"indices", Kind::Uint}, {"material", Kind::Uint},
                          {"mode", Kind::Uint}, {"targets", Kind::UintMapArray}};
 const Schema kMeshS{{"primitives", Kind::ObjectArray, &kPrimitiveS}, {"weights", Kind::NumberArray}};
 const Schema kSparseIndicesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint}};
 const Schema kSparseValuesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}};
 const Schema kSparseS{{"count", Kind::Uint}, {"indices", Kind::Object, &kSparseIndicesS},
                       {"values", Kind::Object, &kSparseValuesS}};
-const Schema kAccessorS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint},
-                        {"normalized", Kind::Bool}, {"count", Kind::Uint}, {"type", Kind::String},
+const Schema kAccessorS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint, nullptr, kRequired},
+                        {"normalized", Kind::Bool}, {"count", Kind::Uint, nullptr, kRequired}, {"type", Kind::String, nullptr, kRequired},
                         {"max", Kind::NumberArray}, {"min", Kind::NumberArray}, {"sparse", Kind::Object, &kSparseS}};
-const Schema kBufferViewS{{"buffer", Kind::Uint}, {"byteOffset", Kind::Uint}, {"byteLength", Kind::Uint},
+const Schema kBufferViewS{{"buffer", Kind::Uint, nullptr, kRequired}, {"byteOffset", Kind::Uint}, {"byteLength", Kind::Uint, nullptr, kRequired},
                           {"byteStride", Kind::Uint}, {"target", Kind::Uint}};
 const Schema kBufferS{{"uri", Kind::String}, {"byteLength", Kind::Uint}};
 const Schema kTexInfoS{{"index", Kind::Uint}, {"texCoord", Kind::Uint}};
@@ -83,11 +86,11 @@ const Schema kOrthoS{{"xmag", Kind::Number}, {"ymag", Kind::Number}, {"zfar", Ki
 const Schema kPerspS{{"aspectRatio", Kind::Number}, {"yfov", Kind::Number}, {"zfar", Kind::Number}, {"znear", Kind::Number}};
 const Schema kCameraS{{"type", Kind::String}, {"orthographic", Kind::Object, &kOrthoS}, {"perspective", Kind::Object, &kPerspS}};
 const Schema kSkinS{{"inverseBindMatrices", Kind::Uint}, {"skeleton", Kind::Uint}, {"joints", Kind::UintArray}};
-const Schema kTargetS{{"node", Kind::Uint}, {"path", Kind::String}};
-const Schema kChannelS{{"sampler", Kind::Uint}, {"target", Kind::Object, &kTargetS}};
-const Schema kAnimSamplerS{{"input", Kind::Uint}, {"interpolation", Kind::String}, {"output", Kind::Uint}};
+const Schema kTargetS{{"node", Kind::Uint, nullptr, kRequired}, {"path", Kind::String, nullptr, kRequired}};
+const Schema kChannelS{{"sampler", Kind::Uint, nullptr, kRequired}, {"target", Kind::Object, &kTargetS, kRequired}};
+const Schema kAnimSamplerS{{"input", Kind::Uint, nullptr, kRequired}, {"interpolation", Kind::String}, {"output", Kind::Uint, nullptr, kRequired}};
 const Schema kAnimationS{{"channels", Kind::ObjectArray, &kChannelS}, {"samplers", Kind::ObjectArray, &kAnimSamplerS}};
-const Schema kRoot{{"asset", Kind::Object, &kAsset}, {"scene", Kind::Uint}, {"scenes", Kind::ObjectArray, &kSceneS},
+const Schema kRoot{{"asset", Kind::Object, &kAsset, kRequired}, {"scene", Kind::Uint}, {"scenes", Kind::ObjectArray, &kSceneS},
                    {"nodes", Kind::ObjectArray, &kNodeS}, {"meshes", Kind::ObjectArray, &kMeshS},
                    {"accessors", Kind::ObjectArray, &kAccessorS}, {"bufferViews", Kind::ObjectArray, &kBufferViewS},
                    {"buffers", Kind::ObjectArray, &kBufferS}, {"materials", Kind::ObjectArray, &kMaterialS},
@@ -134,6 +137,18 @@ public:
             }
             for (const Prop& prop : schema)
                 if (it.key() == prop.key) checkValue(*it, prop, p);
+        }
+        for (const Prop& prop : schema)
+            if (prop.required && !obj.contains(prop.key)) fail(path + "/" + prop.key, "required here (the glTF reader refuses the file without it)");
+        // The enumerations the reader refuses without a path.
+        if (&schema == &kAccessorS) {
+            static const std::set<std::string> types{"SCALAR", "VEC2", "VEC3", "VEC4", "MAT2", "MAT3", "MAT4"};
+            static const std::set<uint64_t> components{5120, 5121, 5122, 5123, 5125, 5126};
+            if (!types.count(obj["type"].get<std::string>()))
+                fail(path + "/type", "\"" + shortText(obj["type"].get<std::string>(), 20) + "\" is not an accessor type (SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3, MAT4)");
+            if (!components.count(obj["componentType"].get<uint64_t>()))
+                fail(path + "/componentType", std::to_string(obj["componentType"].get<uint64_t>()) +
+                                                  " is not a component type (5120, 5121, 5122, 5123, 5125, 5126)");
         }
     }
 
