@@ -41,7 +41,7 @@ IMAGE = re.compile(r"^(?P<id>.+)_f(?P<frame>\d{4,})_(?P<kind>shaded|diff)\.png$"
 def heat_legends(directory):
     """Every heat map's legend (the runner's JSON), with the path of its labelled PNG added."""
     out = []
-    for path in sorted(glob.glob(os.path.join(directory, "images", "*_heat_*.json"))):
+    for path in sorted(glob.glob(os.path.join(glob.escape(directory), "images", "*_heat_*.json"))):
         with open_regular(path) as f:
             legend = json.load(f)
         legend["labelled"] = path[:-len(".json")] + "_labelled.png"
@@ -132,7 +132,7 @@ def mismatch(directory):
 def frame_images(directory, legends):
     """frame -> id -> {"shaded": path, "diff": path, "heat": [legend, …]}."""
     frames = defaultdict(lambda: defaultdict(lambda: {"heat": []}))
-    for path in sorted(glob.glob(os.path.join(directory, "images", "*.png"))):
+    for path in sorted(glob.glob(os.path.join(glob.escape(directory), "images", "*.png"))):
         m = IMAGE.match(os.path.basename(path))
         if m:
             frames[int(m["frame"])][m["id"]][m["kind"]] = path

@@ -58,6 +58,12 @@ std::vector<BadCase> badCases() {
          {"/scene/objects/0/transform/fit_size", "too small for a float"}},
         {"PointBelowFloat", "c.json", configWith({{"light", R"({"position": [1e-300, 4, 2]})"}}),
          {"/light/position", "too small for a float"}},
+        // Fifth probe: an empty path was ignored (the static pose used), as an object's is refused.
+        {"CameraPathWithoutKeyframes", "c.json",
+         configWith({{"camera", R"({"position": [0, 3, 5], "target": [0, 0.5, 0], "path": {"keyframes": []}})"}}),
+         {"/camera/path/keyframes", "at least one keyframe"}},
+        {"LightPathWithoutKeyframes", "c.json", configWith({{"light", R"({"type": "point", "path": {}})"}}),
+         {"/light/path/keyframes", "at least one keyframe"}},
         {"CameraAtTarget", "c.json", configWith({{"camera", R"({"position": [1, 2, 3], "target": [1, 2, 3]})"}}),
          {"/camera/target", "equals its position"}},
         {"EmptyScene", "c.json", configWith({{"scene", R"({"objects": []})"}}), {"/scene/objects", "no objects"}},
@@ -145,6 +151,9 @@ std::vector<BadCase> badCases() {
          {"m.gltf", "/buffers/0/uri", "not a regular file"}},
         {"GltfBufferFileOfAnotherLength", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "m.gltf"}])"}}),
          {"m.gltf", "/buffers/0/byteLength", "36 bytes declared"}},
+        // Fifth probe: "%00" decoded ended the name, and the file before it was read.
+        {"GltfBufferUriWithNul", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "m.gltf%00x"}])"}}),
+         {"m.gltf", "/buffers/0/uri", "NUL"}},
         {"GltfBufferWithoutUri", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36}])"}}),
          {"m.gltf", "/buffers/0/uri", "required"}},
         {"GltfBufferWithoutByteLength", "m.gltf", test::triangleGltf({{"buffers", R"([{"uri": "m.gltf"}])"}}),

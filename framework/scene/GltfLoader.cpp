@@ -321,8 +321,12 @@ void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool bi
                 have = dataUriLength(uri, problem);
                 if (!problem.empty()) throw InputError(file, where + "/uri", problem);
             } else {
-                // The reader decodes percent-encoded names (%20); so does this check.
-                const std::string path = resolvePath(parentDir(file), percentDecoded(uri));
+                // The reader decodes percent-encoded names (%20); so does this check. A decoded NUL
+                // would end the name there, and another file be read.
+                const std::string decoded = percentDecoded(uri);
+                if (decoded.find('\0') != std::string::npos)
+                    throw InputError(file, where + "/uri", "the buffer's file name holds a NUL (%00)");
+                const std::string path = resolvePath(parentDir(file), decoded);
                 struct stat st {};
                 if (::stat(path.c_str(), &st) != 0)
                     throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " does not exist");

@@ -28,6 +28,8 @@ double Path::frameTime(int i, int frameCount) const {
 Path Path::parse(JsonNode node) {
     std::vector<Keyframe> keys;
     auto items = node.objectArray("keyframes");
+    // A path without keys would be ignored silently (the static pose used): bad input, as an object's.
+    if (items.empty()) node.fail("keyframes", "a path needs at least one keyframe");
     for (auto& k : items) {
         Keyframe kf;
         if (!k.has("time")) k.fail("time", "required key is missing");

@@ -490,7 +490,8 @@ class RunReportTest(unittest.TestCase):
         python = python_with_matplotlib()
         if python is None:
             self.skipTest("no python3 with matplotlib")
-        directory = tempfile.mkdtemp(prefix="run-text-")
+        # "[1]" in the folder: read as a glob pattern, it lost the contact sheet and labelled heat maps (fifth probe).
+        directory = tempfile.mkdtemp(prefix="run-text-[1]-")
         self.addCleanup(shutil.rmtree, directory, True)
         ids = ["reference", "$\\frac{1}$", "[click me](javascript:alert`1`)", "a|b _c_"]
         with open(os.path.join(directory, "frames.csv"), "w", newline="", encoding="utf-8") as f:
