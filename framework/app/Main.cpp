@@ -127,6 +127,17 @@ void checkOverride(const std::string& assignment) {
         usageError("--set " + shortText(path, 80) + ": the path " + why);
 }
 
+/// What run and validate check before the first frame, in this order (GL context current): the
+/// memory plan of the predicted scene, before it is made; the scene, made into `cfg` (loaded without
+/// it); each algorithm's fit on it. What validate accepts, run runs.
+MemoryPlan planAndLoadScene(ExperimentConfig& cfg, const std::string& config, const std::vector<std::string>& overrides) {
+    const ScenePrediction predicted = predictConfigScene(config, overrides);
+    MemoryPlan plan = checkMemoryPlan(cfg, predicted, currentDeviceLimits(predicted.triangles));
+    cfg = loadConfig(config, true, overrides);
+    checkAlgorithmsTakeScene(cfg);
+    return plan;
+}
+
 int run(const std::vector<std::string>& args) {
     std::string config;
     std::vector<std::string> overrides;
@@ -178,13 +189,9 @@ int run(const std::vector<std::string>& args) {
     // scene is made, so a run that cannot fit stops here (exit 2) instead of in the OOM killer.
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
-    const ScenePrediction predicted = predictConfigScene(config, overrides);
-    const MemoryPlan plan = checkMemoryPlan(cfg, predicted, currentDeviceLimits(predicted.triangles));
+    // Refused before anything is said about the run, so a refused run prints its one error line only.
+    const MemoryPlan plan = planAndLoadScene(cfg, config, overrides);
     opt.memoryPlan = plan.toJson();
-    cfg = loadConfig(config, true, overrides);
-    // As validate: an algorithm that cannot hold the built scene is refused before anything is said
-    // about the run, so a refused run prints its one error line only.
-    checkAlgorithmsTakeScene(cfg);
     throwIfInterrupted();
     std::fprintf(stderr, "shadowlab: memory: %s\n", plan.summary().c_str());
     // The name is the config's text: cut, so a huge or multi-line one stays one short line.
@@ -260,10 +267,7 @@ int validate(const std::string& config, const std::vector<std::string>& override
     }
     auto context = createHeadlessContext(false);
     installGlDebugCallback(true);
-    const ScenePrediction predicted = predictConfigScene(config, overrides);
-    checkMemoryPlan(cfg, predicted, currentDeviceLimits(predicted.triangles));
-    cfg = loadConfig(config, true, overrides);
-    checkAlgorithmsTakeScene(cfg);
+    planAndLoadScene(cfg, config, overrides);
     std::cout << cfg.resolved.dump(2) << "\n";
     std::fprintf(stderr, "%s: valid (%zu triangles, %zu algorithms%s)\n", shortText(config, 300).c_str(), cfg.scene->triangleCount(),
                  cfg.algorithms.size(), cfg.reference ? " + reference" : "");
