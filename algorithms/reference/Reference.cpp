@@ -120,9 +120,9 @@ private:
 /// are the Scene's own for a static scene, copied, 36 bytes more, for a moving one), plus the
 /// reference's visibility and G-buffer copies per pixel.
 /// Bounds, not typical values: random triangle soups fill Embree's leaves worst of the scenes
-/// measured (docs/memory.md), models and grids of shapes take 20-40 % less.
-constexpr size_t kEmbreeBytesPerTriangle = 125;       // measured up to 117.7 (4 M random soup); models 79-82
-constexpr size_t kEmbreeCompactBytesPerTriangle = 92; // measured up to 86.3 (4 M random soup); 72.6 at 74 M
+/// measured, models and grids of shapes take 20-40 % less (results/reference/memory_bounds_llvmpipe.md).
+constexpr size_t kEmbreeBytesPerTriangle = 125;
+constexpr size_t kEmbreeCompactBytesPerTriangle = 92;
 Footprint referenceFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
