@@ -64,6 +64,8 @@ std::vector<BadCase> badCases() {
          {"/camera/path/keyframes", "at least one keyframe"}},
         {"LightPathWithoutKeyframes", "c.json", configWith({{"light", R"({"type": "point", "path": {}})"}}),
          {"/light/path/keyframes", "at least one keyframe"}},
+        // Fourth probe: what() is a C string, so a NUL in the echoed key ended the line before its cause.
+        {"NulInAKey", "c.json", configWith({{"name\\u0000", R"("x")"}}), {"unknown key", "accepted keys"}},
         {"CameraAtTarget", "c.json", configWith({{"camera", R"({"position": [1, 2, 3], "target": [1, 2, 3]})"}}),
          {"/camera/target", "equals its position"}},
         {"EmptyScene", "c.json", configWith({{"scene", R"({"objects": []})"}}), {"/scene/objects", "no objects"}},

@@ -64,6 +64,17 @@ TEST(MemoryPlanTest, ARunThatCannotFitIsRefusedWithItsEstimate) {
     EXPECT_EQ(plan.held[1].second, p.triangles * kSceneGpuBytesPerTriangle + 16 * p.materials);
 }
 
+// Fourth probe: the plan's line named every part, 131 KB for 2000 entries; the five largest now.
+TEST(MemoryPlanTest, ThePlansLineNamesItsFiveLargestParts) {
+    Json algorithms = Json::array();
+    for (int i = 0; i < 40; ++i) algorithms.push_back({{"id", "s" + std::to_string(i)}, {"algorithm", "shadow_map"}, {"params", {{"resolution", 8192}}}});
+    ScenePrediction p;
+    const ExperimentConfig cfg = planned(algorithms, 1, p);
+    const std::string line = checkMemoryPlan(cfg, p, kLlvmpipe, SystemMemory{1024 * kGiB, 1024 * kGiB}).summary();
+    EXPECT_NE(line.find("and 38 more"), std::string::npos) << line; // 40 maps, the reference, the scene and scene_gpu: 43 parts
+    EXPECT_LT(line.size(), 300u) << line;
+}
+
 // Every algorithm states its limit on the device: past it the run is refused up front, naming the
 // algorithm's entry and the structure that would not fit, never an allocation failure later.
 TEST(MemoryPlanTest, EachAlgorithmRefusesPastItsDeviceLimitByName) {

@@ -171,5 +171,19 @@ TEST(RunSafetyTest, AnAlgorithmRefusingTheBuiltSceneIsExitTwoAtItsEntryAndWrites
     EXPECT_FALSE(fs::exists(base + "/out"));
 }
 
+// Fourth probe: run named an unusable output.dir from the config by its folder only; validate named
+// the config and /output/dir. Both do now.
+TEST(RunSafetyTest, AnOutputDirFromTheConfigIsNamedAtItsJsonPath) {
+    const std::string base = test::makeTempDir("output-dir-path");
+    std::ofstream(base + "/file") << "mine";
+    std::ofstream(base + "/c.json") << test::configWith({{"output", R"({"dir": "file", "plots": false})"}});
+    for (const char* command : {" validate ", " run "}) {
+        std::string log;
+        EXPECT_EQ(test::runCommand(std::string("(") + SHADOWLAB_BINARY + command + base + "/c.json >/dev/null)", log), 2) << log;
+        EXPECT_NE(log.find("c.json: at /output/dir: the output path exists and is not a directory"), std::string::npos) << log;
+    }
+    EXPECT_EQ(slurp(base + "/file"), "mine");
+}
+
 } // namespace
 } // namespace shadowlab
