@@ -36,6 +36,24 @@ TEST(ConfigTest, ResolvedConfigParsesToTheSameExperiment) {
     EXPECT_EQ(a.resolved, b.resolved);
 }
 
+// Fifth probe: a spot light moving along a path whose keys name no target pointed down -z on
+// every frame, ignoring the light.target the config fixes. Keys without a target aim at it.
+TEST(ConfigTest, PathKeysWithoutTargetAimAtTheFixedTarget) {
+    Json j = minimal();
+    j["frames"] = 3;
+    j["light"] = Json::parse(R"({"type": "spot", "target": [1, 0, 2], "path": {"keyframes": [
+        {"time": 0, "position": [0, 5, 0]}, {"time": 1, "position": [3, 5, 0], "target": [0, 0, 0]},
+        {"time": 2, "position": [0, 6, 1]}]}})");
+    j["camera"] = Json::parse(R"({"target": [0, 1, 0], "path": {"keyframes": [{"time": 0, "position": [0, 2, 6]}]}})");
+    ExperimentConfig c = parseConfig(j, "/tmp/x/cfg.json");
+    EXPECT_EQ(c.lightAt(0).target, glm::vec3(1, 0, 2));
+    EXPECT_EQ(c.lightAt(1).target, glm::vec3(0, 0, 0)); // a key's own target wins
+    EXPECT_EQ(c.lightAt(2).target, glm::vec3(1, 0, 2));
+    EXPECT_EQ(c.cameraAt(0).target, glm::vec3(0, 1, 0));
+    // The resolved config writes every key's target: it replays the same views.
+    EXPECT_EQ(c.resolved["light"]["path"]["keyframes"][0]["target"], Json::parse("[1.0, 0.0, 2.0]"));
+}
+
 struct BadCase {
     const char* name;
     const char* patch;     ///< JSON merged into minimal() (merge_patch)

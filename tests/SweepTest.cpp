@@ -4,6 +4,7 @@
 #include "tests/SweepTestData.h"
 #include "tests/TestSupport.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -305,6 +306,35 @@ TEST(SweepTest, AFailedRunLeavesAnErrorRecordAndTheOthersGoOn) {
     std::stringstream text;
     text << md.rdbuf();
     EXPECT_EQ(countOf(text.str(), ": failed**"), 2u) << text.str();
+}
+
+// Fifth probe: `sweep plan` passed a line_space (n, d) that validate refuses on the scene, and the
+// sweep's run then failed. Plain plan checks configs only and says so; --check validates each run
+// (scene made, each algorithm's fit decided) and stops at the first refusal, naming the run.
+TEST(SweepTest, PlanCheckValidatesEachRunOnItsScene) {
+    const std::string dir = test::makeTempDir("sweep-plan-check");
+    Json sweep = test::smallSweep();
+    sweep["base"]["algorithms"] = Json::parse(R"([{"algorithm": "shadow_map"}, {"algorithm": "line_space", "params": {"n": 4, "d": 2}}])");
+    sweep.erase("merge");
+    sweep["axes"] = Json::parse(R"([{"name": "n", "values": {"algorithms.1.params.n": [4, 8], "algorithms.1.params.d": [2, 4]},
+                                     "labels": ["small", "deep"]}])");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep);
+    std::string log;
+    EXPECT_EQ(test::runCommand("(" + bin() + " sweep plan " + file + " >/dev/null)", log), 0) << log;
+    EXPECT_NE(log.find("every config valid (--check also validates"), std::string::npos) << log;
+    EXPECT_EQ(test::runCommand("(" + bin() + " sweep plan " + file + " --check >/dev/null)", log), 2) << log;
+    const std::string refused = log.substr(log.rfind("shadowlab: "));
+    EXPECT_NE(refused.find("s.sweep.json: run 1 ("), std::string::npos) << log;
+    EXPECT_NE(refused.find("n=deep) is refused: run 1's config: at /algorithms/1: line_space cannot hold this scene"),
+              std::string::npos) << log;
+    EXPECT_EQ(std::count(refused.begin(), refused.end(), '\n'), 1) << log;
+    // The run that fits passes alone; nothing is left in the temporary folder.
+    sweep["axes"][0]["values"] = Json::parse(R"({"algorithms.1.params.n": [4], "algorithms.1.params.d": [2]})");
+    sweep["axes"][0]["labels"] = Json::parse(R"(["small"])");
+    test::writeJson(file, sweep);
+    EXPECT_EQ(test::runCommand("(TMPDIR=" + dir + " " + bin() + " sweep plan " + file + " --check >/dev/null)", log), 0) << log;
+    EXPECT_NE(log.find("1 runs, each validated on this device"), std::string::npos) << log;
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1) << "only s.sweep.json";
 }
 
 TEST(SweepTest, MergeWritesTheTidyTableReportAndPlots) {

@@ -28,7 +28,7 @@ void parseCamera(JsonNode node, ExperimentConfig& c) {
     if (c.camera.farPlane <= c.camera.nearPlane) node.fail("far", "must be greater than near");
     c.camera.position = node.getPoint("position", {0, 2, 6});
     c.camera.target = node.getPoint("target", {0, 0, 0});
-    if (node.has("path")) c.cameraPath = Path::parse(node.child("path"));
+    if (node.has("path")) c.cameraPath = Path::parse(node.child("path"), c.camera.target);
     node.finish();
 }
 
@@ -48,7 +48,7 @@ void parseLight(JsonNode node, ExperimentConfig& c) {
         l.pattern = node.getEnum("pattern", "stratified", {"stratified", "grid", "random"});
         l.seed = uint32_t(node.getInt("seed", 1, 0, INT32_MAX));
     }
-    if (node.has("path")) c.lightPath = Path::parse(node.child("path"));
+    if (node.has("path")) c.lightPath = Path::parse(node.child("path"), l.target);
     node.finish();
 }
 

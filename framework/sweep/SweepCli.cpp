@@ -2,6 +2,7 @@
 
 #include "framework/core/Error.h"
 #include "framework/sweep/SlurmScript.h"
+#include "framework/sweep/SweepCheck.h"
 #include "framework/sweep/SweepFile.h"
 #include "framework/sweep/SweepMerge.h"
 #include "framework/sweep/SweepRunner.h"
@@ -29,8 +30,10 @@ struct Usage {
 };
 
 const Usage kUsages[] = {
-    {"plan", R"(  shadowlab sweep plan SWEEP.json [--json]
-      Validates every run of a sweep (docs/sweep.md) and lists them: index, id, axis values.
+    {"plan", R"(  shadowlab sweep plan SWEEP.json [--json] [--check]
+      Validates every run's config (docs/sweep.md) and lists the runs: index, id, axis values.
+      --check also puts each run through `shadowlab validate` (its memory plan, scene and each
+      algorithm's fit on it, decided on this device), one at a time: slower, as each scene is made.
 )"},
     {"config", R"(  shadowlab sweep config SWEEP.json INDEX
       Prints the experiment config of one run (what `sweep run` gives `shadowlab run`).
@@ -116,9 +119,12 @@ std::string outputDir(const Args& a, const Sweep& s) {
 }
 
 int plan(const std::vector<std::string>& args) {
-    Args a = parseArgs(args, {}, {"--json"});
+    Args a = parseArgs(args, {}, {"--json", "--check"});
     if (a.help) return printUsage("plan");
     const Sweep s = loadSweep(one(a, "sweep file", "plan"));
+    const bool checked = a.options.count("--check") > 0;
+    if (checked)
+        if (const std::string why = checkSweepRuns(s, selfBinary()); !why.empty()) throw InputError(s.file, "", why);
     if (a.options.count("--json")) {
         std::cout << planJson(s).dump(2) << "\n";
         return 0;
@@ -133,7 +139,10 @@ int plan(const std::vector<std::string>& args) {
         std::cout << "\n";
     }
     std::cout.flush();
-    std::fprintf(stderr, "%s: %zu runs, all valid; output %s\n", shortText(s.file, 300).c_str(), s.runs.size(), shortText(s.outputDir, 300).c_str());
+    // Without --check only the configs are checked: said so, as a run can still be refused on its scene.
+    std::fprintf(stderr, "%s: %zu runs, %s; output %s\n", shortText(s.file, 300).c_str(), s.runs.size(),
+                 checked ? "each validated on this device" : "every config valid (--check also validates each run's memory plan and scene)",
+                 shortText(s.outputDir, 300).c_str());
     return 0;
 }
 

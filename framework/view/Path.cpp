@@ -25,7 +25,7 @@ double Path::frameTime(int i, int frameCount) const {
     return startTime() + (endTime() - startTime()) * double(i) / double(frameCount - 1);
 }
 
-Path Path::parse(JsonNode node) {
+Path Path::parse(JsonNode node, glm::vec3 fixedTarget) {
     std::vector<Keyframe> keys;
     auto items = node.objectArray("keyframes");
     // A path without keys would be ignored silently (the static pose used): bad input, as an object's.
@@ -36,7 +36,7 @@ Path Path::parse(JsonNode node) {
         if (!k.has("position")) k.fail("position", "required key is missing");
         kf.time = k.getFloat("time", 0);
         kf.position = k.getPoint("position", glm::vec3(0));
-        kf.target = k.getPoint("target", kf.position + glm::vec3(0, 0, -1));
+        kf.target = k.getPoint("target", fixedTarget);
         if (!keys.empty() && kf.time <= keys.back().time)
             k.fail("time", "keyframe times must increase strictly (previous is " + std::to_string(keys.back().time) + ")");
         k.finish();

@@ -35,8 +35,10 @@ public:
     /// The time of frame `i` of `frameCount`, uniformly from the first to the last keyframe.
     double frameTime(int i, int frameCount) const;
 
-    /// Reads {"keyframes": [{"time", "position", "target"}, ...]}; validates ordering.
-    static Path parse(JsonNode node);
+    /// Reads {"keyframes": [{"time", "position", "target"}, ...]}; validates ordering. A keyframe
+    /// without "target" aims at `fixedTarget` (its owner's static target), so a light or camera
+    /// moving along a path keeps looking at the point the config names.
+    static Path parse(JsonNode node, glm::vec3 fixedTarget);
     Json toJson() const;
 
 private:
