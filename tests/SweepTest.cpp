@@ -244,6 +244,35 @@ TEST(SweepTest, KilledMidwayThenRestartedRunsOnlyTheMissingRuns) {
     EXPECT_EQ(test::runIds(out + "/sweep.csv").size(), 4u);
 }
 
+// Fifth probe: a run slot replaced by a copy of (or a link to) another run's folder counted as
+// complete and was merged as this run. A run's results count only where its config.resolved.json
+// is this run's config.
+TEST(SweepTest, AnotherRunsResultsInASlotAreNotThisRun) {
+    const std::string dir = test::makeTempDir("sweep-foreign-slot");
+    Json sweep = test::smallSweep();
+    sweep["base"]["frames"] = 1;
+    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
+    sweep.erase("merge");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    const Json p = plan(file);
+    const std::string first = p["runs"][0]["id"], second = p["runs"][1]["id"];
+    fs::remove_all(out + "/runs/" + second);
+    fs::copy(out + "/runs/" + first, out + "/runs/" + second, fs::copy_options::recursive);
+    EXPECT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 1) << log;
+    EXPECT_NE(log.find("holds the results of another config (run " + first + ")"), std::string::npos) << log;
+    EXPECT_EQ(test::runIds(out + "/sweep.csv").size(), 1u);
+    // The copy is not taken for the run: the sweep runs it again, into its own folder.
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    EXPECT_EQ(countOf(log, "] done"), 1u) << log;
+    // A link to the other run's folder is not this run's folder either.
+    fs::remove_all(out + "/runs/" + second);
+    fs::create_directory_symlink(first, out + "/runs/" + second);
+    EXPECT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 1) << log;
+    EXPECT_NE(log.find("is not a folder of its own"), std::string::npos) << log;
+}
+
 TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {
     const std::string dir = test::makeTempDir("sweep-term");
     const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";

@@ -87,25 +87,35 @@ void makeFolders(const std::string& outputDir) {
 } // namespace
 
 RunPaths::RunPaths(const std::string& outputDir, const std::string& id)
-    : dir(outputDir + "/runs/" + id), config(dir + ".config.json"), log(dir + ".log"), error(dir + ".error.json"), lock(dir + ".sweep.lock") {}
+    : id(id), dir(outputDir + "/runs/" + id), config(dir + ".config.json"), log(dir + ".log"), error(dir + ".error.json"),
+      lock(dir + ".sweep.lock") {}
 
 bool RunPaths::complete(std::string* why) const {
     if (why) why->clear();
     const std::string summary = dir + "/summary.json";
     std::error_code ec;
-    if (!fs::exists(fs::symlink_status(dir, ec))) return false;
-    if (!fs::exists(fs::symlink_status(summary, ec))) {
-        if (why) *why = "the run's folder has no summary.json";
+    const fs::file_status slot = fs::symlink_status(dir, ec);
+    if (!fs::exists(slot)) return false;
+    auto fail = [&](const std::string& reason) {
+        if (why) *why = reason;
         return false;
-    }
+    };
+    if (!fs::is_directory(slot)) return fail("runs/" + id + " is not a folder of its own (a link or a file)");
+    if (!fs::exists(fs::symlink_status(summary, ec))) return fail("the run's folder has no summary.json");
     try {
         const Json s = JsonNode::parseFile(summary);
-        if (s.is_object() && s.contains("complete") && s["complete"] == true) return true;
-        if (why) *why = "summary.json does not say \"complete\": true";
+        if (!(s.is_object() && s.contains("complete") && s["complete"] == true)) return fail("summary.json does not say \"complete\": true");
     } catch (const InputError& e) {
-        if (why) *why = "summary.json " + e.cause();
+        return fail("summary.json " + e.cause());
     }
-    return false;
+    try {
+        // The results are this run's only if the config they were made from is this run's config.
+        const std::string made = runId(JsonNode::parseFile(dir + "/config.resolved.json"));
+        if (made != id) return fail("the folder holds the results of another config (run " + made + "), not of this run");
+    } catch (const InputError& e) {
+        return fail("config.resolved.json " + e.cause());
+    }
+    return true;
 }
 
 std::string selfBinary() { return fs::read_symlink("/proc/self/exe").string(); }

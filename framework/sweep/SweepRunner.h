@@ -18,12 +18,16 @@ struct SweepRunOptions {
 
 /// Where a run's files go.
 struct RunPaths {
+    std::string id;
     std::string dir, config, log, error, lock; ///< lock: held by the sweep process running it
     RunPaths(const std::string& outputDir, const std::string& id);
-    /// Whether the run finished: its summary.json (written last, see Runner.h) parses and says
-    /// `"complete": true`. When not, `why` (if given) gets the reason, "" when there is no
-    /// summary.json at all (a run not done yet) and the cause when there is a broken one (a
-    /// truncated, garbled or empty file, a directory in its place).
+    /// Whether this run finished here: DIR/runs/ID is a folder of its own (not a link), its
+    /// summary.json (written last, see Runner.h) parses and says `"complete": true`, and its
+    /// config.resolved.json is this run's config (its runId is ID), so another run's folder copied
+    /// or linked into the slot, or a slot run from an edited config, is not taken for this run.
+    /// When not, `why` (if given) gets the reason, "" when there is no summary.json at all (a run
+    /// not done yet) and the cause when there is a broken or foreign one (a truncated, garbled or
+    /// empty file, a directory in its place, another run's results).
     bool complete(std::string* why = nullptr) const;
 };
 
