@@ -273,6 +273,36 @@ TEST(SweepTest, AnotherRunsResultsInASlotAreNotThisRun) {
     EXPECT_NE(log.find("is not a folder of its own"), std::string::npos) << log;
 }
 
+// Fifth probe: the refusal of another sweep's folder advises removing its sweep.json to hand the
+// folder over, but once merged the folder was then refused as not a sweep's. A merged sweep's
+// folder without sweep.json is taken (its runs with equal ids kept); with a file of the user's in it, not.
+TEST(SweepTest, AMergedSweepsFolderWithoutItsSnapshotGoesToANewSweep) {
+    const std::string dir = test::makeTempDir("sweep-handover");
+    Json sweep = test::smallSweep();
+    sweep["base"]["frames"] = 1;
+    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0]}}])");
+    sweep.erase("merge");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 0) << log;
+    sweep["name"] = "bigger";
+    sweep["axes"][0]["values"]["algorithms.0.params.pcf"] = Json::array({0, 1});
+    test::writeJson(file, sweep);
+    EXPECT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 2) << log;
+    EXPECT_NE(log.find("holds another sweep"), std::string::npos) << log;
+    fs::remove(out + "/sweep.json");
+    std::ofstream(out + "/notes.txt") << "mine\n";
+    EXPECT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 2) << log;
+    EXPECT_NE(log.find("is not a sweep's folder"), std::string::npos) << log;
+    fs::remove(out + "/notes.txt");
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    EXPECT_EQ(countOf(log, "] skip"), 1u) << log;
+    EXPECT_EQ(countOf(log, "] done"), 1u) << log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 0) << log;
+    EXPECT_EQ(test::runIds(out + "/sweep.csv").size(), 2u);
+}
+
 TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {
     const std::string dir = test::makeTempDir("sweep-term");
     const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";

@@ -314,6 +314,36 @@ bool checkPlace(const std::string& dir, const std::string& runConfig, const char
 }
 } // namespace
 
+namespace {
+/// A name that `sweep run`, `sweep slurm` or `sweep merge` writes in its folder.
+bool isSweepMade(const fs::path& entry) {
+    const std::string n = entry.filename().string();
+    std::error_code ec;
+    const auto status = fs::symlink_status(entry, ec);
+    if (n == "runs" || n == "slurm") return fs::is_directory(status);
+    if (!fs::is_regular_file(status)) return false;
+    for (const char* name : {"sweep.lock", "plan.json", "sweep.csv", "sweep.md", "sweep.html", "sweep_report.log", "sweep.sbatch"})
+        if (n == name) return true;
+    return n.starts_with("sweep_") && n.ends_with(".png");  // the report's plots
+}
+
+/// The folder a merged sweep left once its sweep.json was removed (as the refusal of another
+/// sweep's folder advises): runs/, a plan.json of a sweep's runs, and nothing but what a sweep writes.
+bool isFormerSweep(const fs::path& dir) {
+    std::error_code ec;
+    if (!fs::is_directory(fs::symlink_status(dir / "runs", ec)) || !isRegularFile(dir / "plan.json")) return false;
+    try {
+        const Json plan = JsonNode::parseFile((dir / "plan.json").string());
+        if (!plan.is_object() || !plan.contains("axes") || !plan.contains("runs")) return false;
+    } catch (const InputError&) {
+        return false;
+    }
+    for (const auto& e : fs::directory_iterator(dir, ec))
+        if (!isSweepMade(e.path())) return false;
+    return !ec;
+}
+} // namespace
+
 void OutputPlace::checkSweepPlace(const std::string& given) {
     const std::string dir = normalize(given);
     if (!checkPlace(dir, "", "results/sweep1")) return;
@@ -328,6 +358,7 @@ void OutputPlace::checkSweepPlace(const std::string& given) {
                                 (n == "sweep.lock" && isRegularFile(e.path())));
     }
     if (skeleton && !ec) return;
+    if (isFormerSweep(dir)) return;
     throw InputError(shortPath(dir), "", "exists and is not a sweep's folder (it holds no sweep.json): a sweep writes sweep.json, "
                                          "runs/, plan.json, sweep.csv and sweep.md there; choose another --out or an empty folder");
 }
