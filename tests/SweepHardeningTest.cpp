@@ -571,8 +571,8 @@ TEST(SweepMemoryTest, ManyRunsOverALargeBaseShareIt) {
         if (row.rfind("12\t", 0) == 0) id = row.substr(3, 12); // index, tab, id
     ASSERT_EQ(id.size(), 12u) << plan.out;
     const std::string out = dir + "/out";
-    fs::create_directories(out + "/runs/" + id);
-    std::ofstream(out + "/runs/" + id + "/summary.json") << test::fakeSummary(10).dump();
+    fs::create_directories(out + "/runs");
+    ASSERT_TRUE(test::fakeRunFolder(kBin, many, 12, out + "/runs/" + id, test::fakeSummary(10)));
     const Ran task = runArgs(sweep({"run", many, "--out", out, "--index", "12"}));
     ASSERT_EQ(task.rc, 0) << task.err;
     EXPECT_NE(task.err.find("skip"), std::string::npos) << task.err;

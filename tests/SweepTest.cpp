@@ -303,6 +303,25 @@ TEST(SweepTest, AMergedSweepsFolderWithoutItsSnapshotGoesToANewSweep) {
     EXPECT_EQ(test::runIds(out + "/sweep.csv").size(), 2u);
 }
 
+// Fifth probe: `sweep run MOVED/sweep.json` without --out ran every run again at the folder's old
+// place (the snapshot's output.dir). The snapshot's own folder is the sweep's: it resumes there.
+TEST(SweepTest, AMovedSweepResumesFromItsSnapshotInPlace) {
+    const std::string dir = test::makeTempDir("sweep-moved");
+    Json sweep = test::smallSweep();
+    sweep["base"]["frames"] = 1;
+    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
+    sweep.erase("merge");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out", moved = dir + "/moved";
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    fs::rename(out, moved);
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + moved + "/sweep.json", log), 0) << log;
+    EXPECT_EQ(countOf(log, "] skip"), 2u) << log;
+    EXPECT_NE(log.find("this folder's runs are used (the folder has moved)"), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(out)) << "nothing at the old place";
+    ASSERT_EQ(test::runCommand(bin() + " sweep merge " + moved + " --no-plots", log), 0) << log;
+}
+
 TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {
     const std::string dir = test::makeTempDir("sweep-term");
     const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";

@@ -169,16 +169,37 @@ inline Json planOf(const std::string& binary, const std::string& file) {
     return r.rc == 0 ? Json::parse(r.out) : Json();
 }
 
+/// DIR/runs/ID of run `index` of the sweep whose snapshot is `snapshot`, as its run leaves it but
+/// without rendering: its config (`sweep config`), its config.resolved.json (what `validate` prints
+/// of it, as the run writes it: the sweep takes the folder for the run's by it) and `summary`.
+/// false when a command failed.
+inline bool fakeRunFolder(const std::string& binary, const std::string& snapshot, size_t index, const std::string& runDir,
+                          const Json& summary) {
+    const Ran config = runArgs({binary, "sweep", "config", snapshot, std::to_string(index)});
+    if (config.rc != 0) return false;
+    // Its own slot as output.dir: validate checks the place as `run --out` would.
+    Json c = Json::parse(config.out);
+    c["output"]["dir"] = runDir;
+    std::ofstream(runDir + ".config.json") << c.dump(2);
+    const Ran resolved = runArgs({binary, "validate", runDir + ".config.json"});
+    if (resolved.rc != 0) return false;
+    std::filesystem::create_directories(runDir);
+    std::ofstream(runDir + "/config.resolved.json") << resolved.out;
+    std::ofstream(runDir + "/summary.json") << summary.dump(2);
+    return true;
+}
+
 /// DIR as `sweep run` leaves it when every run has finished, without rendering anything: the
-/// snapshot (written by `sweep slurm`) and a fakeSummary() per run. Returns the plan.
+/// snapshot (written by `sweep slurm`) and a fakeRunFolder() with a fakeSummary() per run.
+/// Returns the plan (null when a command failed).
 inline Json fakeSweepRuns(const std::string& binary, const std::string& sweepFile, const std::string& out) {
     const Ran r = runArgs({binary, "sweep", "slurm", sweepFile, "--out", out});
     if (r.rc != 0) return Json();
     const Json plan = planOf(binary, out + "/sweep.json");
     for (const Json& run : plan["runs"]) {
-        const std::string dir = out + "/runs/" + run["id"].get<std::string>();
-        std::filesystem::create_directories(dir);
-        std::ofstream(dir + "/summary.json") << fakeSummary(1000 * (run["index"].get<uint64_t>() + 1)).dump(2);
+        const uint64_t index = run["index"].get<uint64_t>();
+        if (!fakeRunFolder(binary, out + "/sweep.json", index, out + "/runs/" + run["id"].get<std::string>(), fakeSummary(1000 * (index + 1))))
+            return Json();
     }
     return plan;
 }

@@ -9,6 +9,7 @@
 #include "framework/sweep/SweepText.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -16,6 +17,8 @@
 namespace shadowlab {
 
 namespace {
+
+namespace fs = std::filesystem;
 
 // Limits of the counts on the command line: beyond them a number is a typo (or an attempt to
 // wrap), never a real request.
@@ -109,10 +112,25 @@ std::string get(const Args& a, const std::string& key, const std::string& def = 
     return it == a.options.end() ? def : it->second;
 }
 
+/// Where a sweep runs without --out: its output.dir, except for a sweep's own DIR/sweep.json (a
+/// sweep.json beside a runs/ folder) in a folder that has moved since the snapshot was written,
+/// which names the old place: the runs are where the snapshot is, so the sweep resumes there.
+std::string snapshotFolder(const Sweep& s) {
+    const fs::path file(s.file);
+    if (file.filename() != "sweep.json") return s.outputDir;
+    const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (!fs::is_directory(fs::symlink_status(folder / "runs", ec))) return s.outputDir;
+    if (fs::equivalent(folder, s.outputDir, ec)) return s.outputDir;
+    std::fprintf(stderr, "sweep: %s was written for %s; this folder's runs are used (the folder has moved)\n",
+                 shortText(s.file, 300).c_str(), shortText(s.outputDir, 300).c_str());
+    return folder.string();
+}
+
 /// --out, or the sweep's output.dir: never empty (DIR + "/runs" would be /runs), and a path that
 /// the snapshot (JSON, so UTF-8) and the progress lines (one line) can hold.
 std::string outputDir(const Args& a, const Sweep& s) {
-    const std::string dir = get(a, "--out", s.outputDir);
+    const std::string dir = get(a, "--out", snapshotFolder(s));
     if (dir.empty()) throw InputError("--out", "", "must not be empty (the sweep's folder: DIR/sweep.json, DIR/runs/)");
     if (const std::string why = pathTextProblem(dir); !why.empty()) throw InputError("--out", "", "the folder's name " + why);
     return dir;
