@@ -1,5 +1,6 @@
 // The command line as a user meets it: exit codes, one-line errors, and malformed scene files.
 #include "framework/core/JsonNode.h"
+#include "tests/HostileInputs.h"
 #include "tests/SweepTestData.h"
 #include "tests/TestSupport.h"
 
@@ -202,6 +203,30 @@ TEST(CliTest, InfoRefusesUnknownArguments) {
         EXPECT_NE(r.err.find(extra.back()), std::string::npos) << r.err;
         EXPECT_EQ(r.out, "");
     }
+}
+
+// Fifth probe: `run C --out --force` made a folder named "--force", an option given twice took
+// its last value silently, `--partition ""` dropped the partition. Each is a one-line usage error.
+TEST(CliTest, AnOptionTwiceOrWithoutItsValueIsBadInput) {
+    const std::string dir = test::makeTempDir("cli-options");
+    const std::string config = dir + "/c.json";
+    std::ofstream(config) << test::configWith({});
+    const std::string sweep = test::writeJson(dir + "/s.sweep.json", test::smallSweep());
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"run " + config + " --out --force", "not the option --force"},
+        {"run " + config + " --out " + dir + "/a --out " + dir + "/b", "--out is given twice"},
+        {"plan " + config + " --triangles 10 --triangles 20", "--triangles is given twice"},
+        {"sweep run " + sweep + " --out " + dir + "/a --out " + dir + "/b", "is given twice"},
+        {"sweep run " + sweep + " --out --jobs 2", "not the option --jobs"},
+        {"sweep slurm " + sweep + " --out " + dir + "/sw --partition ''", "must not be empty"},
+    };
+    for (const auto& [args, cause] : cases) {
+        std::string out;
+        EXPECT_EQ(test::runCommand("cd " + dir + " && " + bin() + " " + args, out), 2) << args << ": " << out;
+        EXPECT_NE(out.find(cause), std::string::npos) << args << ": " << out;
+        EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << args << ": " << out;
+    }
+    for (const char* made : {"--force", "a", "b", "sw", "--jobs"}) EXPECT_FALSE(std::filesystem::exists(dir + "/" + made)) << made;
 }
 
 TEST(CliTest, UnknownCommandIsBadInput) {

@@ -62,6 +62,10 @@ struct BadCase {
 };
 
 const BadCase kBad[] = {
+    // Fifth probe: ids that differ only in case name one file on a case-insensitive file system.
+    {"ids_differ_in_case_only", R"({"algorithms": [{"algorithm": "shadow_map", "id": "SM"}, {"algorithm": "shadow_map", "id": "sm"}]})",
+     "/algorithms/1/id", "only in case"},
+    {"id_reference_in_another_case", R"({"algorithms": [{"algorithm": "shadow_map", "id": "Reference"}]})", "/algorithms/0/id", "only in case"},
     {"unknown_top_key", R"({"framez": 3})", "/framez", "accepted keys"},
     {"wrong_type", R"({"frames": "ten"})", "/frames", "expected an integer"},
     {"out_of_range", R"({"resolution": [0, 64]})", "/resolution", "must lie in"},

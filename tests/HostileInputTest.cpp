@@ -139,6 +139,11 @@ std::vector<BadCase> badCases() {
          test::animatedTriangleGltf({{"translation", "LINEAR", {0, 1}, {0, 0, 0, 3e38f, 0, 0}}}),
          {"m.gltf", "/nodes/0", "beyond ±1e15", "frame 1"}, R"(, "animation": 0)"},
         // What the glTF reader refuses in its own words, named by JSON path (checked before it).
+        // Fifth probe: a glTF 1.0 file failed on the first 2.0 field it lacks; "1.0" on a 2.0 layout loaded.
+        {"GltfVersionOne", "m.gltf", test::triangleGltf({{"asset", R"({"version": "1.0"})"}}), {"m.gltf", "/asset/version", "glTF 2.x only"}},
+        {"GltfVersionNotMajorMinor", "m.gltf", test::triangleGltf({{"asset", R"({"version": "2"})"}}), {"m.gltf", "/asset/version"}},
+        {"GltfMinVersionPastTwoZero", "m.gltf", test::triangleGltf({{"asset", R"({"version": "2.0", "minVersion": "2.1"})"}}),
+         {"m.gltf", "/asset/minVersion", "this reader knows glTF 2.0"}},
         {"GltfByteStrideOfThree", "m.gltf", test::triangleGltf({{"bufferViews", R"([{"buffer": 0, "byteLength": 36, "byteStride": 3}])"}}),
          {"m.gltf", "/bufferViews/0/byteStride"}},
         {"GltfByteStrideOf256", "m.gltf", test::triangleGltf({{"bufferViews", R"([{"buffer": 0, "byteLength": 36, "byteStride": 256}])"}}),

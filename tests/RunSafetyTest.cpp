@@ -108,6 +108,29 @@ TEST(RunSafetyTest, CtrlCWhileRenderingStopsAndKeepsThePreviousResults) {
     f.expectPreviousKept();
 }
 
+// Fifth probe: SIGHUP (a closed terminal, a dropped ssh session) killed the run outright. It stops
+// as Ctrl-C does; where it was ignored when the run started (nohup), it stays ignored.
+TEST(RunSafetyTest, SighupStopsTheRunUnlessItWasIgnoredAtTheStart) {
+    Fixture f("interrupt-hup", 100000);
+    pid_t pid = startRun(f.config, f.out, f.base + "/log", {"--force"});
+    ASSERT_TRUE(waitFor([&] { return hasPartial(f.base); })) << slurp(f.base + "/log");
+    kill(pid, SIGHUP);
+    EXPECT_EQ(waitExit(pid, 60s), 128 + SIGHUP) << slurp(f.base + "/log");
+    EXPECT_NE(slurp(f.base + "/log").find("interrupted by SIGHUP"), std::string::npos);
+    f.expectPreviousKept();
+    // As nohup starts it: SIGHUP ignored, inherited through exec.
+    std::signal(SIGHUP, SIG_IGN);
+    pid = startRun(f.config, f.out, f.base + "/log", {"--force"});
+    std::signal(SIGHUP, SIG_DFL);
+    ASSERT_TRUE(waitFor([&] { return hasPartial(f.base); })) << slurp(f.base + "/log");
+    kill(pid, SIGHUP);
+    std::this_thread::sleep_for(500ms);
+    EXPECT_EQ(waitpid(pid, nullptr, WNOHANG), 0) << "the run stopped on an ignored SIGHUP";
+    kill(pid, SIGINT);
+    EXPECT_EQ(waitExit(pid, 60s), 128 + SIGINT) << slurp(f.base + "/log");
+    f.expectPreviousKept();
+}
+
 TEST(RunSafetyTest, SigtermWhilePlottingStopsThePlotterAndKeepsThePreviousResults) {
     Fixture f("interrupt-plot", 2, true);
     // A plotter that announces itself and then takes far longer than any real plot.

@@ -65,6 +65,10 @@ const BadSweep kBadSweeps[] = {
     {"BadBaseOutsideAnyAxis", R"({"base": {"frames": -1}})", "/base/frames|out of range"},
     {"NoBase", R"({"base": null})", "/base|required"},
     {"BadRatio", R"({"merge": {"ratios": ["psv"]}})", "/merge/ratios|not ID/ID"},
+    // Fifth probe: an id over itself, or a ratio or stage twice, gave rows of 1 or the same numbers twice.
+    {"RatioOfAnIdOverItself", R"({"merge": {"ratios": ["psv/psv"]}})", "/merge/ratios|an id over itself"},
+    {"RatioTwice", R"({"merge": {"ratios": ["psv/shadow_map", "psv/shadow_map"]}})", "/merge/ratios/1|given twice"},
+    {"StageTwice", R"({"merge": {"stages": ["total", "total"]}})", "/merge/stages/1|given twice"},
     {"PaperTimeNotPositive", R"({"merge": {"paper": {"source": "s", "times_ms": {"psv": 0}}}})", "/merge/paper/times_ms/psv|out of range"},
     {"PaperWithoutSource", R"({"merge": {"paper": {"times_ms": {"psv": 1}}}})", "/merge/paper/source|required"},
     {"PaperWithoutTimes", R"({"merge": {"paper": {"source": "s"}}})", "/merge/paper/times_ms|expected an object"},

@@ -147,7 +147,10 @@ int run(const std::vector<std::string>& args) {
         if (isHelp(a)) return commandUsage(kRunUsage);
         if (a == "--out") {
             if (++i >= args.size()) usageError("--out needs a directory");
+            if (!opt.outputDir.empty()) usageError("--out is given twice (one output folder a run)");
             if (args[i].empty()) usageError("--out must not be empty (leave it out for the config's output.dir)");
+            // `--out --force` (the folder forgotten) would make a folder named "--force".
+            if (args[i].starts_with("--")) usageError("--out needs a directory, not the option " + args[i] + " (a folder named so: ./" + args[i] + ")");
             // The folder's name reaches summary.json and the report, which hold UTF-8 text only.
             if (const std::string why = pathTextProblem(args[i]); !why.empty()) usageError("--out: the folder's name " + why);
             opt.outputDir = args[i];
@@ -225,6 +228,7 @@ int plan(const std::vector<std::string>& args) {
             overrides.push_back(args[i]);
         } else if (args[i] == "--triangles") {
             if (++i >= args.size()) usageError("--triangles needs a count");
+            if (triangles > 0) usageError("--triangles is given twice");
             // No scene may hold more (max_triangles' ceiling), so no plan is asked past it.
             triangles = parseCount(args[i], "--triangles", 1, kMaxSceneTriangles);
         } else if (config.empty() && !args[i].empty() && args[i][0] != '-') {

@@ -22,7 +22,10 @@ void onSignal(int sig) { gSignal = sig; }
 } // namespace
 
 Interrupted::Interrupted(int signal)
-    : std::runtime_error(std::string("interrupted by ") + (signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : "a signal")),
+    : std::runtime_error(std::string("interrupted by ") + (signal == SIGINT    ? "SIGINT"
+                                                          : signal == SIGTERM ? "SIGTERM"
+                                                          : signal == SIGHUP  ? "SIGHUP"
+                                                                              : "a signal")),
       signal_(signal) {}
 
 void installInterruptHandlers() {
@@ -30,8 +33,14 @@ void installInterruptHandlers() {
     sa.sa_handler = onSignal;
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESTART;  // I/O in progress completes; the run stops at its next check
-    sigaction(SIGINT, &sa, nullptr);
-    sigaction(SIGTERM, &sa, nullptr);
+    // SIGHUP too: a closed terminal or a dropped ssh session stops the run as Ctrl-C does (its
+    // partial folder removed, exit 129). A signal ignored when this process started (nohup ignores
+    // SIGHUP, a shell's background job SIGINT) stays ignored: the user asked for that.
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+        struct sigaction old {};
+        if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        sigaction(sig, &sa, nullptr);
+    }
 }
 
 int pendingInterrupt() { return gSignal; }

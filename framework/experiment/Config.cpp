@@ -4,9 +4,11 @@
 #include "framework/scene/SceneConfig.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
+#include <map>
 #include <set>
 
 namespace shadowlab {
@@ -258,11 +260,20 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     }
 
     std::set<std::string> ids = {"reference"};
+    std::map<std::string, std::string> folded = {{"reference", "reference"}};  // ids in lower case → as given
     auto entries = root.objectArray("algorithms");
     for (auto& node : entries) {
         AlgorithmEntry e = parseEntry(node, "");
         if (!ids.insert(e.id).second)
             throw InputError(file, node.childPath("id"), "duplicate id \"" + e.id + "\" (ids label results, so each must be unique)");
+        // Ids name files (images, plots): two that differ only in case are one file on a
+        // case-insensitive file system (macOS, Windows shares), and one algorithm's images would
+        // overwrite the other's.
+        std::string lower = e.id;
+        for (char& ch : lower) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+        if (auto [it, fresh] = folded.emplace(lower, e.id); !fresh)
+            throw InputError(file, node.childPath("id"), "id \"" + e.id + "\" differs from \"" + it->second +
+                                                           "\" only in case (ids name files, and case-insensitive file systems would take them for one)");
         if (!e.info->supports(c.light.type))
             throw InputError(file, node.childPath("algorithm"),
                              e.info->name + " does not support " + toString(c.light.type) + " lights");

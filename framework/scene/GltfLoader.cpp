@@ -211,6 +211,29 @@ uint32_t readU32(const std::vector<unsigned char>& b, size_t at) {
     return v;  // GLB is little-endian, as is every platform we build for
 }
 
+/// glTF 2.x only (asset.version "MAJOR.MINOR", asset.minVersion at most what this reader knows):
+/// a glTF 1.0 file would otherwise fail on the first 2.0 field it lacks, with a message that
+/// names that field instead of the version.
+void checkVersion(const Json& doc, const std::string& file) {
+    auto major = [](const Json& v) -> long {
+        if (!v.is_string()) return -1;
+        const std::string t = v.get<std::string>();
+        const size_t dot = t.find('.');
+        if (dot == 0 || dot == std::string::npos || dot > 4 || t.find_first_not_of("0123456789", 0) != dot ||
+            dot + 1 == t.size() || t.find_first_not_of("0123456789", dot + 1) != std::string::npos)
+            return -1;
+        return std::stol(t.substr(0, dot));
+    };
+    if (!doc.contains("asset") || !doc["asset"].is_object()) return;  // the schema names what is missing
+    const Json& asset = doc["asset"];
+    if (asset.contains("version") && asset["version"].is_string() && major(asset["version"]) != 2)
+        throw InputError(file, "/asset/version", "glTF \"" + shortText(asset["version"].get<std::string>(), 20) +
+                                                     "\" is not read here: glTF 2.x only (\"MAJOR.MINOR\", e.g. \"2.0\"); convert the file to glTF 2.0");
+    if (asset.contains("minVersion") && asset["minVersion"].is_string() && asset["minVersion"] != "2.0")
+        throw InputError(file, "/asset/minVersion", "the file needs glTF " + shortText(asset["minVersion"].get<std::string>(), 20) +
+                                                        " to be read; this reader knows glTF 2.0");
+}
+
 /// The JSON chunk of a GLB container, with the header checked so nothing is read past the end.
 std::string glbJson(const std::string& file, const std::vector<unsigned char>& bytes) {
     if (bytes.size() < 20) throw InputError(file, "", "GLB file is truncated (" + std::to_string(bytes.size()) + " bytes)");
@@ -1054,6 +1077,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
     limits.rejectDuplicateKeys = false;  // tolerated in glTF files in the wild (the last one wins)
     Json doc = parseJson(jsonText, file, limits);
     if (!doc.is_object()) throw InputError(file, "", "not a glTF file (the JSON document is not an object)");
+    checkVersion(doc, file);
     TypeChecker(file).checkObject(doc, kRoot, "");
     checkWhatTheReaderRefuses(doc, file, binary, binary ? glbBinLength(bytes) : 0);
 

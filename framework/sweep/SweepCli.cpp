@@ -89,6 +89,12 @@ Args parseArgs(const std::vector<std::string>& args, const std::vector<std::stri
             out.help = true;
         } else if (std::find(valued.begin(), valued.end(), a) != valued.end()) {
             if (++i >= args.size()) throw InputError(a, "", "needs a value (see shadowlab sweep " + args[1] + " --help)");
+            // Twice is a mistake either way (which one was meant?), never the last one silently.
+            if (out.options.count(a)) throw InputError(a, "", "is given twice");
+            // An empty value would read as the option left out (--partition "" as no partition).
+            if (args[i].empty()) throw InputError(a, "", "must not be empty (leave the option out for its default)");
+            // `--out --jobs 2` (the value forgotten) would take the next option for the value.
+            if (args[i].starts_with("--")) throw InputError(a, "", "needs a value, not the option " + shortText(args[i], 40) + " (a folder named so: ./" + shortText(args[i], 40) + ")");
             out.options[a] = args[i];
         } else if (std::find(flags.begin(), flags.end(), a) != flags.end()) {
             out.options[a] = "";
@@ -227,8 +233,9 @@ int merge(const std::vector<std::string>& args) {
     if (a.help) return printUsage("merge");
     const std::string dir = one(a, "output folder", "merge");
     MergeResult r = mergeSweep(dir, !a.options.count("--no-plots"));
-    std::fprintf(stderr, "sweep merge: %zu of %zu runs merged (%zu failed) into %s/sweep.csv, sweep.md\n", r.merged, r.runs, r.failed,
-                 shortText(dir, 300).c_str());
+    // Names only what was written: without the report, sweep.csv alone.
+    std::fprintf(stderr, "sweep merge: %zu of %zu runs merged (%zu failed) into %s/sweep.csv%s\n", r.merged, r.runs, r.failed,
+                 shortText(dir, 300).c_str(), r.reportWritten ? ", sweep.md" : " (no report: see above)");
     return r.merged == r.runs && r.reportWritten ? 0 : 1;
 }
 

@@ -378,9 +378,19 @@ Sweep parseSweep(const Json& json, const std::string& file) {
         for (const Json& v : list) ok = ok && v.is_string() && userTextProblem(v.get<std::string>()).empty();
         if (!ok) merge.fail(key, "expected a list of strings (one line each, at most " + std::to_string(kMaxLabelChars) + " characters)");
         if (std::string(key) == "ratios")
-            for (const Json& v : list)
-                if (v.get<std::string>().find('/') == std::string::npos)
-                    merge.fail(key, "\"" + v.get<std::string>() + "\" is not ID/ID (the total time of one algorithm id over another's)");
+            for (const Json& v : list) {
+                const std::string ratio = v.get<std::string>();
+                const size_t slash = ratio.find('/');
+                if (slash == std::string::npos)
+                    merge.fail(key, "\"" + ratio + "\" is not ID/ID (the total time of one algorithm id over another's)");
+                if (ratio.substr(0, slash) == ratio.substr(slash + 1))
+                    merge.fail(key, "\"" + ratio + "\" is an id over itself (always 1): name two ids");
+            }
+        // A table row or column twice would show the same numbers twice under one name.
+        std::set<std::string> seen;
+        for (size_t k = 0; k < list.size(); ++k)
+            if (!seen.insert(list[k].get<std::string>()).second)
+                merge.fail(std::string(key) + "/" + std::to_string(k), "\"" + list[k].get<std::string>() + "\" is given twice");
     }
     // merge.paper: a paper's own times for some of the algorithm ids, so that sweep.md gives the
     // paper's ratio beside each measured one (its source named, e.g. "Sintorn et al. 2014, Fig. 1").
