@@ -229,6 +229,32 @@ TEST(CliTest, AnOptionTwiceOrWithoutItsValueIsBadInput) {
     for (const char* made : {"--force", "a", "b", "sw", "--jobs"}) EXPECT_FALSE(std::filesystem::exists(dir + "/" + made)) << made;
 }
 
+// A run whose expectations fail writes every result and exits 3 (not 0, not 1): what a CI job keys on.
+TEST(CliTest, UnmetExpectationsExitThreeWithEveryResultWritten) {
+    const std::string dir = test::makeTempDir("cli-expect");
+    std::ofstream(dir + "/c.json") << test::configWith(
+        {{"expect", R"([{"id": "shadow_map", "measure": "overflow", "max": 0},
+                        {"id": "shadow_map", "measure": "memory_bytes", "max": 1, "note": "planted: no map fits in a byte"}])"}});
+    std::string log;
+    EXPECT_EQ(test::runCommand(bin() + " run " + dir + "/c.json --out " + dir + "/out --no-progress", log), 3) << log;
+    EXPECT_NE(log.find("expectation FAILED: shadow_map: memory_bytes = "), std::string::npos) << log;
+    EXPECT_NE(log.find("expectations: 1 of 2 failed (exit 3; every result was written)"), std::string::npos) << log;
+    const Json summary = JsonNode::parseFile(dir + "/out/summary.json");
+    EXPECT_TRUE(summary["complete"].get<bool>());
+    ASSERT_EQ(summary["expectations"].size(), 2u);
+    EXPECT_TRUE(summary["expectations"][0]["passed"].get<bool>());
+    EXPECT_FALSE(summary["expectations"][1]["passed"].get<bool>());
+    std::ifstream junit(dir + "/out/expectations.junit.xml"), report(dir + "/out/report.md");
+    const std::string xml((std::istreambuf_iterator<char>(junit)), {}), md((std::istreambuf_iterator<char>(report)), {});
+    EXPECT_NE(xml.find("tests=\"2\" failures=\"1\""), std::string::npos) << xml;
+    EXPECT_NE(md.find("## Expectations: 1 of 2 failed"), std::string::npos) << md;
+    EXPECT_NE(md.find("planted\\: no map fits in a byte"), std::string::npos) << md; // literal Markdown
+    // Met, the same run exits 0.
+    EXPECT_EQ(test::runCommand(bin() + " run " + dir + "/c.json --out " + dir + "/out --force --no-progress --set expect.1.max=1e12", log), 0)
+        << log;
+    EXPECT_NE(log.find("expectations: all 2 met"), std::string::npos) << log;
+}
+
 TEST(CliTest, UnknownCommandIsBadInput) {
     std::string out;
     EXPECT_EQ(test::runCommand(bin() + " frobnicate", out), 2);

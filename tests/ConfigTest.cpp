@@ -62,6 +62,25 @@ struct BadCase {
 };
 
 const BadCase kBad[] = {
+    // Expectations (docs/config.md, `expect`): each entry's problem at its own path.
+    {"expect_not_a_list", R"({"expect": {"id": "shadow_map"}})", "/expect", "expected a list"},
+    {"expect_unknown_id", R"({"expect": [{"id": "psb", "measure": "overflow", "max": 0}]})", "/expect/0/id", "not an algorithm id"},
+    {"expect_unknown_measure", R"({"expect": [{"id": "shadow_map", "measure": "accuracy.mismatch", "max": 0}]})", "/expect/0/measure",
+     "is not a measure"},
+    {"expect_bad_statistic", R"({"expect": [{"id": "shadow_map", "measure": "time_ms.total.p99", "max": 1}]})", "/expect/0/measure",
+     "STAT: mean, median, min or max"},
+    {"expect_no_bound", R"({"expect": [{"id": "shadow_map", "measure": "overflow"}]})", "/expect/0/max", "needs \"max\", \"min\""},
+    {"expect_min_above_max", R"({"expect": [{"id": "shadow_map", "measure": "overflow", "min": 2, "max": 1}]})", "/expect/0/min",
+     "above max"},
+    {"expect_relative_to_itself", R"({"expect": [{"id": "shadow_map", "measure": "memory_bytes", "relative_to": "shadow_map", "max": 1}]})",
+     "/expect/0/relative_to", "relative to itself"},
+    {"expect_relative_to_unknown", R"({"expect": [{"id": "shadow_map", "measure": "memory_bytes", "relative_to": "x", "max": 1}]})",
+     "/expect/0/relative_to", "not an algorithm id"},
+    {"expect_accuracy_without_reference", R"({"reference": false, "expect": [{"id": "shadow_map", "measure": "accuracy.rmse", "max": 1}]})",
+     "/expect/0/measure", "turns off"},
+    {"expect_unknown_key", R"({"expect": [{"id": "shadow_map", "measure": "overflow", "max": 0, "maximum": 1}]})", "/expect/0/maximum",
+     "accepted keys"},
+    {"expect_bound_not_a_number", R"({"expect": [{"id": "shadow_map", "measure": "overflow", "max": "0"}]})", "/expect/0/max", "number"},
     // Fifth probe: ids that differ only in case name one file on a case-insensitive file system.
     {"ids_differ_in_case_only", R"({"algorithms": [{"algorithm": "shadow_map", "id": "SM"}, {"algorithm": "shadow_map", "id": "sm"}]})",
      "/algorithms/1/id", "only in case"},

@@ -326,6 +326,26 @@ TEST(SweepTest, AMovedSweepResumesFromItsSnapshotInPlace) {
     ASSERT_EQ(test::runCommand(bin() + " sweep merge " + moved + " --no-plots", log), 0) << log;
 }
 
+// A run that exits 3 (expectations not met) has written its results: the sweep counts it complete,
+// says so on its line, and exits 3 itself, also when it resumes.
+TEST(SweepTest, RunsWithUnmetExpectationsAreCompleteAndTheSweepExitsThree) {
+    const std::string dir = test::makeTempDir("sweep-expect");
+    Json sweep = test::smallSweep();
+    sweep["base"]["frames"] = 1;
+    sweep["base"]["expect"] = Json::parse(R"([{"id": "shadow_map", "measure": "memory_bytes", "max": 1}])");
+    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
+    sweep.erase("merge");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
+    std::string log;
+    EXPECT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 3) << log;
+    EXPECT_EQ(countOf(log, "] done"), 2u) << log;
+    EXPECT_EQ(countOf(log, "its expectations failed"), 2u) << log;
+    EXPECT_NE(log.find("2 complete, 0 failed, 2 complete with expectations not met"), std::string::npos) << log;
+    EXPECT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 3) << log;
+    EXPECT_EQ(countOf(log, "] skip"), 2u) << log;
+    EXPECT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 0) << log;
+}
+
 TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {
     const std::string dir = test::makeTempDir("sweep-term");
     const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";

@@ -150,6 +150,9 @@ public:
         f.timer.begin("traverse");
         if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
         else runPixelPass(f, query_, {});
+        // Test fault: the traverse stage done N more times (the same image), a planted slowdown
+        // for the checks that must catch one (expectations, compare).
+        for (int extra = shaderFaultCount("SHADOWLAB_FAULT_SLOW_TRAVERSE"); extra > 0; --extra) runPixelPass(f, query_, {});
         f.timer.end();
         counters_.markStale();
     }

@@ -35,6 +35,8 @@ const char* kRunUsage = R"(  shadowlab run CONFIG.json [--out DIR] [--force] [--
       --set overrides one config value before validation, by dotted path (array elements by
       index), VALUE as JSON or a plain string: --set resolution=[128,128] --set frames=3
       --set algorithms.0.params.pcf=0 --set light.type=directional
+      The config's `expect` bounds are checked once every result is written: exit code 3 when
+      one is not met (report.md's first table, expectations.junit.xml).
 )";
 const char* kValidateUsage = R"(  shadowlab validate CONFIG.json [--set PATH=VALUE]...
       Checks the config (and loads its scene) without rendering; prints the resolved config.
@@ -60,7 +62,8 @@ const char* kInfoUsage = R"(  shadowlab info [--json]
 std::string fullUsage() {
     return std::string("shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.\n\nUsage:\n") +
            kRunUsage + kValidateUsage + kPlanUsage + kListUsage + kInfoUsage + kSweepUsage + "  shadowlab --help | --version\n\n" +
-           "Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure.\n";
+           "Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure,\n"
+           "3 a run's expectations not met (every result written), 128 + N stopped by signal N.\n";
 }
 
 /// `COMMAND --help`: that command's usage on stdout, exit code 0.
@@ -138,6 +141,26 @@ MemoryPlan planAndLoadScene(ExperimentConfig& cfg, const std::string& config, co
     return plan;
 }
 
+/// The config's expectations on stderr, one line each failed (all of them count as one line per
+/// record), and the run's exit code: kExpectationsFailedExit when one failed, else 0.
+int reportExpectations(const Json& meta) {
+    if (!meta.contains("expectations")) return 0;
+    const Json& records = meta["expectations"];
+    size_t failed = 0;
+    for (const Json& r : records)
+        if (!r.value("passed", false)) {
+            ++failed;
+            std::fprintf(stderr, "shadowlab: expectation FAILED: %s\n", shortText(expectationLine(r), 600).c_str());
+        }
+    if (failed == 0) {
+        std::fprintf(stderr, "shadowlab: expectations: all %zu met\n", records.size());
+        return 0;
+    }
+    std::fprintf(stderr, "shadowlab: expectations: %zu of %zu failed (exit %d; every result was written)\n", failed, records.size(),
+                 kExpectationsFailedExit);
+    return kExpectationsFailedExit;
+}
+
 int run(const std::vector<std::string>& args) {
     std::string config;
     std::vector<std::string> overrides;
@@ -210,7 +233,7 @@ int run(const std::vector<std::string>& args) {
         std::fprintf(stderr, "shadowlab: %d OpenGL errors were reported during the run\n", glErrorCount());
         return 1;
     }
-    return 0;
+    return reportExpectations(r.meta);
 }
 
 /// `shadowlab plan CONFIG [--set PATH=VALUE] [--triangles N]`: the memory plan of a run and each

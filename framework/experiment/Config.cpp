@@ -196,6 +196,16 @@ const char* toString(ExperimentConfig::Statistics s) {
     }
 }
 
+ExpectationIds ExperimentConfig::expectationIds() const {
+    ExpectationIds ids;
+    ids.reference = reference;
+    for (const AlgorithmEntry& e : algorithms) {
+        ids.all.push_back(e.id);
+        if (e.info->exact) ids.exact.insert(e.id);
+    }
+    return ids;
+}
+
 std::vector<int> ExperimentConfig::statisticsFrames() const {
     std::vector<int> out;
     if (statistics == Statistics::All)
@@ -283,6 +293,8 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
         c.algorithms.push_back(std::move(e));
     }
     if (c.algorithms.empty() && !c.reference) root.fail("algorithms", "nothing to run: no algorithms and no reference");
+
+    c.expectations = parseExpectations(root, c.expectationIds());
 
     JsonNode out = root.child("output");
     if (out.has("dir") && out.raw()["dir"].is_string() && out.raw()["dir"].get<std::string>().empty())

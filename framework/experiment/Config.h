@@ -3,6 +3,7 @@
 // outputs. Parsing is strict: unknown keys are errors naming their JSON path; missing keys take
 // defaults; `resolved` holds every value actually used (written as config.resolved.json).
 #include "framework/algorithm/ShadowAlgorithm.h"
+#include "framework/experiment/Expectations.h"
 #include "framework/scene/Scene.h"
 #include "framework/scene/SceneConfig.h"
 #include "framework/view/Camera.h"
@@ -43,6 +44,8 @@ struct ExperimentConfig {
     AlgorithmEntry referenceEntry;
     std::vector<AlgorithmEntry> algorithms;
 
+    std::vector<Expectation> expectations; ///< `expect`: bounds checked once the results are written
+
     std::string outputDir;       ///< resolved against the config's folder
     std::vector<int> imagesAtFrames;
     bool plots = true;
@@ -56,6 +59,8 @@ struct ExperimentConfig {
     Light lightAt(int frame) const;
     /// The frames of the statistics pass, in order: images_at_frames, every frame, or none.
     std::vector<int> statisticsFrames() const;
+    /// The ids an expectation can name: the algorithms', which of them are exact, and the reference.
+    ExpectationIds expectationIds() const;
 };
 const char* toString(ExperimentConfig::Statistics s);
 

@@ -242,6 +242,35 @@ void writeMemorySection(std::ostream& os, const Json& s) {
 }
 } // namespace
 
+namespace {
+std::string formatNumber(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+/// The config's expectations first in the report: what a CI job checks, and what failed.
+void writeExpectationsSection(std::ostream& os, const Json& records) {
+    size_t failed = 0;
+    for (const Json& r : records) failed += r.value("passed", false) ? 0 : 1;
+    os << "## Expectations: " << (failed ? std::to_string(failed) + " of " + std::to_string(records.size()) + " failed"
+                                         : "all " + std::to_string(records.size()) + " met")
+       << "\n\n| result | id | measure | bound | value | where | note |\n|---|---|---|---|---:|---|---|\n";
+    auto num = [](const Json& v) { return v.is_null() ? std::string() : markdownLiteral(formatNumber(v.get<double>())); };
+    for (const Json& r : records) {
+        std::string bound;
+        if (!r["min"].is_null()) bound += "≥ " + num(r["min"]);
+        if (!r["max"].is_null()) bound += std::string(bound.empty() ? "" : ", ") + "≤ " + num(r["max"]);
+        std::string measure = r["measure"].get<std::string>();
+        if (!r["relative_to"].is_null()) measure += " / " + r["relative_to"].get<std::string>() + "'s";
+        os << "| " << (r.value("passed", false) ? "met" : "**FAILED**") << " | " << markdownLiteral(r["id"].get<std::string>()) << " | "
+           << markdownLiteral(measure) << " | " << bound << " | " << (r["value"].is_null() ? "not measured" : num(r["value"])) << " | "
+           << markdownLiteral(r["where"].get<std::string>()) << " | " << markdownLiteral(r.value("note", std::string())) << " |\n";
+    }
+    os << "\n";
+}
+} // namespace
+
 void ExperimentResults::writeReport(const std::string& path, const Json& s) const {
     std::ostringstream os;
     os << std::fixed;
@@ -257,6 +286,8 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
     if (s.contains("warnings"))
         for (const auto& w : s["warnings"]) os << "- **warning**: " << markdownLiteral(w.get<std::string>()) << "\n";
     os << "\n";
+
+    if (s.contains("expectations")) writeExpectationsSection(os, s["expectations"]);
 
     if (std::any_of(algorithms.begin(), algorithms.end(), [](const AlgorithmResults& a) { return !a.resolvedParams.empty(); })) {
         os << "## Parameters resolved on this device\n\n"

@@ -305,6 +305,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             warn(a.id + ": " + std::to_string(total) + " overflows or capped walks on " + std::to_string(frames) + " of " +
                  std::to_string(a.frames.size()) + " timed frames (see its overflow counters): those frames' images are not the method's own");
     }
+    // Expectations are checked on the summary as written, so summary.json, the report and the
+    // JUnit file say the same; a failed one changes nothing else (the caller sets the exit code).
+    if (!cfg.expectations.empty()) results.meta["expectations"] = checkExpectations(cfg.expectations, cfg.expectationIds(), results.summary());
     if (!opt.writeOutputs) return results;
     throwIfInterrupted();
 
@@ -315,6 +318,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     if (!statFrames.empty()) results.writeFramesCsv(dir + "/statistics.csv", true);
     Json summary = results.summary();
     results.writeReport(dir + "/report.md", summary);
+    if (summary.contains("expectations"))
+        writeFileAtomic(dir + "/expectations.junit.xml",
+                        expectationsJUnit(cfg.name, summary["expectations"], results.meta["wall_time_s"].get<double>()));
     if (cfg.plots) runPlots(dir, finalDir, results.meta["stage_time_source"].get<std::string>());
     throwIfInterrupted();
     writeFileAtomic(dir + "/summary.json", summary.dump(2) + "\n");

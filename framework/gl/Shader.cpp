@@ -64,6 +64,13 @@ bool shaderFaultActive(const std::string& name) {
     return false;
 }
 
+int shaderFaultCount(const std::string& name) {
+    for (const auto& d : faultDefines())
+        if (d.first == name && !d.second.empty() && d.second.size() <= 6 && d.second.find_first_not_of("0123456789") == std::string::npos)
+            return std::stoi(d.second);
+    return 0;
+}
+
 std::string loadShaderSource(const std::string& relPath, const ShaderDefines& defines) {
     std::set<std::string> seen;
     std::string src = expandIncludes(relPath, seen);

@@ -25,6 +25,8 @@ void setShaderFaultDefines(ShaderDefines defines);
 const ShaderDefines& shaderFaultDefines();
 /// Whether the fault `name` is set (for the few faults that act on the host, e.g. stale buffers).
 bool shaderFaultActive(const std::string& name);
+/// The value of fault define `name` as a count (0 when absent or not a small decimal number).
+int shaderFaultCount(const std::string& name);
 
 /// Loads a stage source with includes expanded and defines prepended.
 std::string loadShaderSource(const std::string& relPath, const ShaderDefines& defines);

@@ -45,7 +45,8 @@ const Usage kUsages[] = {
       Runs the runs into DIR/runs/ID/ (DIR default: the sweep's output.dir), N at once (1 to 256);
       skips complete runs, so it resumes; --shard I/N does runs I, I+N, ...; --index K does run K.
       Exit code 0 when every selected run is complete, 1 when one failed (DIR/runs/ID.error.json),
-      2 for bad input or when another `sweep run` holds DIR (DIR/sweep.lock).
+      2 for bad input or when another `sweep run` holds DIR (DIR/sweep.lock), 3 when all are
+      complete but some run's expectations (its config's `expect`) were not met.
 )"},
     {"slurm", R"(  shadowlab sweep slurm SWEEP.json [--out DIR] [--partition P] [--gpus-per-task G]
                         [--cpus-per-task C] [--time T] [--max-parallel K] [--shards N] [--submit]

@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/Interrupt.h"
+#include "framework/experiment/Expectations.h"
 #include "framework/experiment/OutputPlace.h"
 #include "framework/sweep/SweepProcess.h"
 #include "framework/sweep/SweepText.h"
@@ -118,6 +119,15 @@ bool RunPaths::complete(std::string* why) const {
     return true;
 }
 
+bool RunPaths::expectationsFailed() const {
+    try {
+        const Json s = JsonNode::parseFile(dir + "/summary.json");
+        return s.contains("expectations") && !allPassed(s["expectations"]);
+    } catch (const InputError&) {
+        return false;  // complete() decided already whether the summary can be read
+    }
+}
+
 std::string selfBinary() { return fs::read_symlink("/proc/self/exe").string(); }
 
 void writeSweepSnapshot(const Sweep& sweep, const std::string& outputDir) {
@@ -162,7 +172,7 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
     installInterruptHandlers();
     const size_t n = opt.indices.size();
     const int width = int(std::to_string(n).size());
-    size_t reported = 0, failed = 0, busy = 0, next = 0;
+    size_t reported = 0, failed = 0, busy = 0, unmet = 0, next = 0;
     struct Running {
         size_t index;
         Clock::time_point start;
@@ -193,7 +203,10 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
             if (p.complete(&why)) {
                 // An error record of an earlier failed attempt says nothing about a complete run.
                 const bool stale = fs::remove(p.error, ec);
-                report(run, "skip", stale ? "  (complete already; removed its stale error record)" : "  (complete already)");
+                const bool unmetHere = p.expectationsFailed();
+                unmet += unmetHere ? 1 : 0;
+                report(run, "skip", std::string(stale ? "  (complete already; removed its stale error record)" : "  (complete already)") +
+                                        (unmetHere ? "; its expectations failed (report.md)" : ""));
                 continue;
             }
             if (!why.empty())
@@ -220,15 +233,19 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
         char took[64];
         std::snprintf(took, sizeof took, "  (%.1f s)", seconds);
         std::string why;
-        if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && p.complete(&why)) {
+        // Exit 3: every result written, some of the config's expectations not met (Expectations.h).
+        const bool ran = WIFEXITED(status) && (WEXITSTATUS(status) == 0 || WEXITSTATUS(status) == kExpectationsFailedExit);
+        if (ran && p.complete(&why)) {
             std::error_code ec;
             fs::remove(p.error, ec);
-            report(run, "done", took);
+            const bool unmetHere = p.expectationsFailed();
+            unmet += unmetHere ? 1 : 0;
+            report(run, "done", std::string(took) + (unmetHere ? "; its expectations failed (report.md)" : ""));
             running.erase(it);
             continue;
         }
         ++failed;
-        const std::string cause = describeStatus(status) + (WIFEXITED(status) && WEXITSTATUS(status) == 0 ? "; " + why : "");
+        const std::string cause = describeStatus(status) + (ran ? "; " + why : "");
         Json error = {{"id", run.id},
                       {"index", run.index},
                       {"axes", runLabel(sweep, run)},
@@ -255,9 +272,10 @@ int runSweep(const Sweep& sweep, const SweepRunOptions& opt) {
                      int(pendingInterrupt()), reported, n);
         return 128 + int(pendingInterrupt());
     }
-    std::fprintf(stderr, "sweep: %zu runs: %zu complete, %zu failed%s (%s)\n", n, n - failed - busy, failed,
-                 busy ? (", " + std::to_string(busy) + " run by another sweep process").c_str() : "", where.c_str());
-    return failed ? 1 : busy ? 2 : 0;
+    std::fprintf(stderr, "sweep: %zu runs: %zu complete, %zu failed%s%s (%s)\n", n, n - failed - busy, failed,
+                 busy ? (", " + std::to_string(busy) + " run by another sweep process").c_str() : "",
+                 unmet ? (", " + std::to_string(unmet) + " complete with expectations not met").c_str() : "", where.c_str());
+    return failed ? 1 : busy ? 2 : unmet ? kExpectationsFailedExit : 0;
 }
 
 } // namespace shadowlab

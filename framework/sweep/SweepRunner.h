@@ -29,6 +29,8 @@ struct RunPaths {
     /// not done yet) and the cause when there is a broken or foreign one (a truncated, garbled or
     /// empty file, a directory in its place, another run's results).
     bool complete(std::string* why = nullptr) const;
+    /// Whether the run's summary.json records expectations (its config's `expect`) not all met.
+    bool expectationsFailed() const;
 };
 
 /// Writes DIR/sweep.json (the self-contained snapshot) unless it holds the same sweep already:
@@ -40,6 +42,7 @@ void writeSweepSnapshot(const Sweep& sweep, const std::string& outputDir);
 /// Runs the selected runs that are not complete and prints a line per run on stderr. A failed run
 /// leaves DIR/runs/ID.error.json and the others go on. Returns the exit code: 0 when every
 /// selected run is complete, 1 when one failed, 2 when one was being run by another sweep process,
+/// 3 when all are complete but some run's expectations were not met (kExpectationsFailedExit),
 /// 128 + signal when interrupted by SIGINT/SIGTERM (the running runs are stopped first; their
 /// partial folders never look complete).
 ///

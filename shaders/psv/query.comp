@@ -301,6 +301,11 @@ void main() {
 #endif
             }
         }
+#if SHADOWLAB_FAULT_PLANTED_LIT
+        // Test fault (framework/gl/Shader.h): a planted regression, every 61st pixel written lit,
+        // for the checks that must catch a wrong image (expectations, compare).
+        if ((px.x + px.y * 7) % 61 == 0) visibility = 1.0;
+#endif
         imageStore(uVisibility, px, vec4(visibility));
 #if SHADOWLAB_INSTRUMENTATION
         imageStore(uNodesVisited, px, vec4(float(r.visited)));
