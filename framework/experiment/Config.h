@@ -29,6 +29,10 @@ struct ExperimentConfig {
     glm::ivec2 resolution{256, 256};
     int frames = 30;
     int warmupFrames = 3;
+    /// Times the timed pass is run (every frame, every algorithm), the algorithms' order rotated
+    /// each time so a load spike on a shared machine falls on all of them alike; the first one's
+    /// images and accuracy are reported, every one's times (Results.h).
+    int repeats = 1;
     /// Which frames the untimed statistics pass runs on (counters, heat maps). Timed frames always
     /// run with the statistics compiled out (AlgorithmOptions::instrumentation off).
     enum class Statistics { Images, All, None };

@@ -1,5 +1,7 @@
 #include "framework/experiment/Results.h"
 
+#include "framework/metrics/Noise.h"
+
 #include "framework/core/Text.h"
 
 #include "framework/core/Error.h"
@@ -148,6 +150,47 @@ std::string deviceLine(const Json& d) {
 
 } // namespace
 
+namespace {
+/// Each stage's mean time per frame in each repetition of the timed pass (the first included), and
+/// from three repetitions on, the median of those means with its 95 % bootstrap interval: the noise
+/// of this machine between repetitions, which is what a comparison of two runs must exceed.
+void addRepetitions(Json& j, const AlgorithmResults& a, bool gpuTimes) {
+    Json perRep = Json::object();
+    auto add = [&](const std::vector<FrameRecord>& frames) {
+        const Json t = stageTimes(frames, gpuTimes).first;
+        for (const auto& [stage, stats] : t.items()) perRep[stage].push_back(stats["mean"]);
+    };
+    add(a.frames);
+    for (const auto& rep : a.repetitions) add(rep);
+    j["repetitions"] = {{"count", a.repetitions.size() + 1}, {"time_ms", perRep}};
+    if (a.repetitions.size() + 1 < 3) return;
+    Json intervals = Json::object();
+    for (const auto& [stage, means] : perRep.items()) {
+        const Interval ci = bootstrapMedian(means.get<std::vector<double>>());
+        intervals[stage] = {{"median", ci.median}, {"low", ci.low}, {"high", ci.high}, {"level", ci.level}};
+    }
+    j["time_ms_interval"] = intervals;
+}
+
+/// "A/B": per repetition, A's mean total time per frame over B's (the two ran interleaved, under
+/// the same load), then the median of those ratios and its 95 % bootstrap interval.
+Json totalTimeRatios(const Json& algs) {
+    Json ratios = Json::object();
+    for (const auto& [a, ja] : algs.items())
+        for (const auto& [b, jb] : algs.items()) {
+            if (a == b || !ja.contains("repetitions") || !jb.contains("repetitions")) continue;
+            const auto ta = ja["repetitions"]["time_ms"]["total"].get<std::vector<double>>();
+            const auto tb = jb["repetitions"]["time_ms"]["total"].get<std::vector<double>>();
+            std::vector<double> r;
+            for (size_t k = 0; k < std::min(ta.size(), tb.size()); ++k)
+                if (tb[k] > 0) r.push_back(ta[k] / tb[k]);
+            const Interval ci = bootstrapMedian(r);
+            ratios[a + "/" + b] = {{"median", ci.median}, {"low", ci.valid ? Json(ci.low) : Json()}, {"high", ci.valid ? Json(ci.high) : Json()}};
+        }
+    return ratios;
+}
+} // namespace
+
 Json ExperimentResults::summary() const {
     Json out = meta;
     Json algs = Json::object();
@@ -169,9 +212,12 @@ Json ExperimentResults::summary() const {
         j["params"] = a.params;
         j["preprocess_ms"] = a.preprocessMs;
         // Times, accuracy and overflow come from the timed pass, in which no statistics are gathered.
-        auto [time, cpuTime] = stageTimes(a.frames, gpuTimes);
+        std::vector<FrameRecord> timed = a.frames;  // every repetition's frames
+        for (const auto& rep : a.repetitions) timed.insert(timed.end(), rep.begin(), rep.end());
+        auto [time, cpuTime] = stageTimes(timed, gpuTimes);
         j["time_ms"] = time;
         j["cpu_time_ms"] = cpuTime;
+        if (!a.repetitions.empty()) addRepetitions(j, a, gpuTimes);
         if (!mismatch.empty()) {
             Stats m = computeStats(mismatch);
             j["accuracy"] = {{"mismatch_ratio", m.mean},
@@ -212,6 +258,7 @@ Json ExperimentResults::summary() const {
         algs[a.id] = j;
     }
     out["algorithms"] = algs;
+    if (!algorithms.empty() && algorithms.front().repetitions.size() >= 2) out["time_ratios"] = totalTimeRatios(algs);
     out["complete"] = true;
     return out;
 }
@@ -271,6 +318,26 @@ void writeExpectationsSection(std::ostream& os, const Json& records) {
 }
 } // namespace
 
+namespace {
+/// With repetitions: each id's total time per frame, the median over repetitions and its interval,
+/// and how far the repetitions spread (what a change must exceed to be more than noise here).
+void writeRepetitionsSection(std::ostream& os, const Json& s) {
+    const Json& algs = s["algorithms"];
+    if (algs.empty() || !algs.begin()->contains("repetitions")) return;
+    const size_t count = (*algs.begin())["repetitions"]["count"].get<size_t>();
+    os << "\n## Total time per frame over " << count << " repetitions (ms; the algorithms' order rotated each time)\n\n"
+       << "| id | median | 95 % interval | spread of the repetitions |\n|---|---:|---|---:|\n";
+    for (const auto& [id, j] : algs.items()) {
+        const std::vector<double> t = j["repetitions"]["time_ms"]["total"].get<std::vector<double>>();
+        const auto [lo, hi] = std::minmax_element(t.begin(), t.end());
+        const double median = medianOf(t);
+        os << "| " << markdownLiteral(id) << " | " << std::setprecision(3) << median << " | ";
+        if (j.contains("time_ms_interval")) os << j["time_ms_interval"]["total"]["low"].get<double>() << " – " << j["time_ms_interval"]["total"]["high"].get<double>();
+        os << " | " << std::setprecision(1) << (median > 0 ? 100.0 * (*hi - *lo) / median : 0.0) << " % |\n";
+    }
+}
+} // namespace
+
 void ExperimentResults::writeReport(const std::string& path, const Json& s) const {
     std::ostringstream os;
     os << std::fixed;
@@ -322,6 +389,7 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
                << st["max"].get<double>() << " | " << st["median"].get<double>() << " |\n";
         }
     }
+    writeRepetitionsSection(os, s);
     os << "\n## Accuracy against the reference (over lit pixels, N·L > 0)\n\n";
     os << "| id | mismatch (mean) | mismatch (worst frame) | false lit | false shadowed | RMSE |\n|---|---:|---:|---:|---:|---:|\n";
     for (const auto& a : algorithms) {

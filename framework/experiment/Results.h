@@ -29,6 +29,10 @@ struct AlgorithmResults {
     size_t memoryBytes = 0;
     size_t residentBytes = 0; ///< everything it held (ShadowAlgorithm::residentBytes), largest over frames
     std::vector<FrameRecord> frames;      ///< the timed pass: statistics compiled out, every frame
+    /// The timed pass's repetitions after the first (ExperimentConfig::repeats): times and overflow
+    /// only; the first's images and accuracy stand for all (a repetition whose image differs is warned of).
+    std::vector<std::vector<FrameRecord>> repetitions;
+    std::vector<int> repetitionDiffers;   ///< frames whose image differed in some repetition
     /// The untimed statistics pass (instrumented shaders) over ExperimentConfig::statisticsFrames():
     /// its counters are the ones reported; its times only show what instrumentation costs.
     std::vector<FrameRecord> statistics;

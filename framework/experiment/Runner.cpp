@@ -35,6 +35,7 @@ struct Instance {
     std::unique_ptr<AlgorithmHost> host;
     AlgorithmResults results;
     std::map<int, uint64_t> timedVisibility; ///< frame → visibilityHash, on the statistics frames
+    std::vector<uint64_t> firstImages;       ///< visibilityHash of each frame of the first timed pass, with repeats
 };
 
 /// A host for `entry` on the scene: instrumented for the statistics pass, else with statistics
@@ -139,7 +140,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         } catch (const SceneRefusal& refusal) {
             throw sceneRefusalError(cfg, *e, refusal.what());
         }
-        Instance inst{e, std::move(host), {}, {}};
+        Instance inst{e, std::move(host), {}, {}, {}};
         inst.results.id = e->id;
         inst.results.algorithm = e->info->name;
         inst.results.params = e->params.toJson();
@@ -179,7 +180,8 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"reference", cfg.reference}};
 
     std::vector<int> framesWithoutLit;  // accuracy is measured over lit pixels: none, nothing to measure
-    Progress progress(opt.progress, size_t(cfg.frames + statFrames.size() + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
+    Progress progress(opt.progress,
+                      size_t(cfg.frames * cfg.repeats + int(statFrames.size()) + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
     std::optional<CpuGBuffer> cpuG;
     auto renderFrame = [&](const Camera& cam) {
         gbuffer.render(sceneGpu, cam);
@@ -236,6 +238,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                 rec.accuracy = compareVisibility(vis, reference, lit);
             }
             if (isStatFrame(frame)) inst.timedVisibility[frame] = visibilityHash(vis);
+            if (cfg.repeats > 1) inst.firstImages.push_back(visibilityHash(vis));
             if (saveImages) {
                 shading.run(gbuffer, inst.host->visibility(), light);
                 writeFrameImages(dir, inst.entry->id, frame, res, shading, vis, cfg.reference && !isReference ? &reference : nullptr,
@@ -246,6 +249,32 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     }
 
     // What each algorithm's device-dependent choices came to, as the timed pass ran them.
+    // Repetitions of the timed pass: the same frames, the algorithms in a rotated order each time,
+    // times and overflow recorded; each image is hashed against the first pass's (they must agree).
+    for (int rep = 1; rep < cfg.repeats; ++rep) {
+        for (auto& inst : instances) inst.results.repetitions.emplace_back();
+        for (int frame = 0; frame < cfg.frames; ++frame) {
+            Camera cam = cfg.cameraAt(frame);
+            Light light = cfg.lightAt(frame);
+            const TimedWork sceneUpdate = sceneGpu.setTime(cfg.sceneTimeAt(frame), timer);
+            renderFrame(cam);
+            glFinish();
+            for (size_t k = 0; k < instances.size(); ++k) {
+                Instance& inst = instances[(k + size_t(rep)) % instances.size()];
+                throwIfInterrupted();
+                progress.step(inst.entry->id + " repetition " + std::to_string(rep + 1) + ", frame " + std::to_string(frame + 1));
+                FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
+                m.stages.insert(m.stages.begin(), sceneUpdate.stages.begin(), sceneUpdate.stages.end());
+                m.wallMs += sceneUpdate.wallMs;
+                inst.results.repetitions.back().push_back(recordOf(m, frame));
+                if (visibilityHash(inst.host->readVisibility()) != inst.firstImages[size_t(frame)] &&
+                    std::find(inst.results.repetitionDiffers.begin(), inst.results.repetitionDiffers.end(), frame) ==
+                        inst.results.repetitionDiffers.end())
+                    inst.results.repetitionDiffers.push_back(frame);
+            }
+        }
+    }
+
     for (auto& inst : instances) inst.results.resolvedParams = inst.host->algorithm().resolvedParams();
 
     // The statistics pass: the same frames again with instrumented shaders, untimed as far as any
@@ -292,6 +321,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
              "is not measured on them" +
              (int(framesWithoutLit.size()) == cfg.frames ? ", so it is not measured at all" : ""));
     for (const auto& a : results.algorithms) {
+        if (!a.repetitionDiffers.empty())
+            warn(a.id + ": a repetition of the timed pass gave another image than the first on " + std::to_string(a.repetitionDiffers.size()) +
+                 " of " + std::to_string(cfg.frames) + " frames (the algorithm is not deterministic; the first pass's images and accuracy are reported)");
         if (!a.visibilityDiffers.empty())
             warn(a.id + ": the statistics pass's visibility differs from the timed pass's on " + std::to_string(a.visibilityDiffers.size()) +
                  " of " + std::to_string(statFrames.size()) +
