@@ -8,6 +8,7 @@
 #include "framework/experiment/DeviceReport.h"
 #include "framework/experiment/Runner.h"
 #include "framework/gl/DeviceInfo.h"
+#include "framework/experiment/CompareCli.h"
 #include "framework/gl/GlContext.h"
 #include "framework/scene/SceneConfig.h"
 #include "framework/sweep/SweepCli.h"
@@ -61,7 +62,7 @@ const char* kInfoUsage = R"(  shadowlab info [--json]
 
 std::string fullUsage() {
     return std::string("shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.\n\nUsage:\n") +
-           kRunUsage + kValidateUsage + kPlanUsage + kListUsage + kInfoUsage + kSweepUsage + "  shadowlab --help | --version\n\n" +
+           kRunUsage + kValidateUsage + kPlanUsage + kListUsage + kInfoUsage + kSweepUsage + kCompareUsage + "  shadowlab --help | --version\n\n" +
            "Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure,\n"
            "3 a run's expectations not met (every result written), 128 + N stopped by signal N.\n";
 }
@@ -406,6 +407,7 @@ static int dispatch(std::vector<std::string> args) {
         if (args[0] == "run") return run(args);
         if (args[0] == "info") return info(args);
         if (args[0] == "sweep") return sweepCommand(args);
+        if (args[0] == "compare") return compareCommand(args);
         usageError("unknown command " + args[0]);
     } catch (const InputError& e) {
         std::fprintf(stderr, "shadowlab: error: %s\n", shortText(e.what(), 1000).c_str());

@@ -218,6 +218,12 @@ Json ExperimentResults::summary() const {
         j["time_ms"] = time;
         j["cpu_time_ms"] = cpuTime;
         if (!a.repetitions.empty()) addRepetitions(j, a, gpuTimes);
+        // Each frame's total of the first pass: `compare` pairs two runs' frames (the same views).
+        Json perFrame = Json::array();
+        for (const auto& f : a.frames)
+            for (const auto& st : f.stages)
+                if (st.name == "total") perFrame.push_back(st.cpuMs);
+        j["total_ms_per_frame"] = perFrame;
         if (!mismatch.empty()) {
             Stats m = computeStats(mismatch);
             j["accuracy"] = {{"mismatch_ratio", m.mean},

@@ -1,0 +1,352 @@
+#include "framework/experiment/Compare.h"
+
+#include "framework/core/Error.h"
+#include "framework/core/FileIO.h"
+#include "framework/core/Text.h"
+#include "framework/metrics/Noise.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include <stb_image.h>
+#include <stb_image_write.h>
+
+namespace shadowlab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+Json readSummary(const std::string& dir) {
+    const std::string file = dir + "/summary.json";
+    if (!fs::is_directory(dir)) throw InputError(shortText(dir, 300), "", "is not a run's output folder (it should hold summary.json)");
+    const Json s = JsonNode::parseFile(file);
+    if (!s.is_object() || s.value("complete", false) != true || !s.contains("algorithms") || !s["algorithms"].is_object())
+        throw InputError(shortText(file, 300), "", "is not a complete run's summary (no \"complete\": true and \"algorithms\")");
+    return s;
+}
+
+std::string number(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
+std::vector<double> numbers(const Json& j) {
+    std::vector<double> v;
+    if (j.is_array())
+        for (const Json& x : j)
+            if (x.is_number()) v.push_back(x.get<double>());
+    return v;
+}
+
+size_t repetitionCount(const Json& a) { return a.contains("repetitions") ? a["repetitions"].value("count", size_t(1)) : 1; }
+
+/// One stage's time, BASE → NEW: the ratio of the medians with its interval, from the passes'
+/// means when both ran 3 or more (independent samples, U test too), else from the first pass's
+/// frames paired one to one (the same views), else the ratio of the means without an interval.
+Json compareStage(const Json& a, const Json& b, const std::string& stage, double threshold) {
+    Json r = {{"stage", stage}};
+    Interval ci;
+    std::string method;
+    if (repetitionCount(a) >= 3 && repetitionCount(b) >= 3) {
+        const auto x = numbers(a["repetitions"]["time_ms"].value(stage, Json())), y = numbers(b["repetitions"]["time_ms"].value(stage, Json()));
+        ci = bootstrapRatioOfMedians(x, y);
+        r["base"] = medianOf(x);
+        r["new"] = medianOf(y);
+        r["p"] = mannWhitneyP(x, y);
+        method = "repetitions";
+    } else if (stage == "total" && a.contains("total_ms_per_frame") && b.contains("total_ms_per_frame") &&
+               a["total_ms_per_frame"].size() == b["total_ms_per_frame"].size() && a["total_ms_per_frame"].size() >= 3) {
+        const auto x = numbers(a["total_ms_per_frame"]), y = numbers(b["total_ms_per_frame"]);
+        std::vector<double> ratios;
+        for (size_t k = 0; k < x.size(); ++k)
+            if (x[k] > 0) ratios.push_back(y[k] / x[k]);
+        ci = bootstrapMedian(ratios);
+        r["base"] = medianOf(x);
+        r["new"] = medianOf(y);
+        method = "frames paired";
+    } else {
+        const double x = a["time_ms"].contains(stage) ? a["time_ms"][stage].value("mean", 0.0) : 0.0;
+        const double y = b["time_ms"].contains(stage) ? b["time_ms"][stage].value("mean", 0.0) : 0.0;
+        r["base"] = x;
+        r["new"] = y;
+        ci.median = x > 0 ? y / x : 0;
+        method = "means only";
+    }
+    r["ratio"] = ci.median;
+    r["low"] = ci.valid ? Json(ci.low) : Json();
+    r["high"] = ci.valid ? Json(ci.high) : Json();
+    r["method"] = method;
+    // A change counts when it exceeds the threshold, its whole interval lies on one side of 1 and,
+    // from repetitions, the U test finds the two samples different (p < 0.05: 5 or more each).
+    const bool significant = !r.contains("p") || r["p"].get<double>() < 0.05;
+    std::string verdict = "within noise";
+    if (!ci.valid) verdict = "no interval";
+    else if (significant && ci.low > 1.0 && ci.median > 1.0 + threshold) verdict = "slower";
+    else if (significant && ci.high < 1.0 && ci.median < 1.0 - threshold) verdict = "faster";
+    r["verdict"] = verdict;
+    return r;
+}
+
+/// The first pass's stage names of `a`, "total" last (as summary.json's object sorts them).
+std::vector<std::string> stagesOf(const Json& a, const Json& b) {
+    std::vector<std::string> out;
+    for (const auto& [stage, v] : a["time_ms"].items())
+        if (stage != "total" && b["time_ms"].contains(stage)) out.push_back(stage);
+    out.push_back("total");
+    return out;
+}
+
+struct Picture {
+    int width = 0, height = 0;
+    std::vector<unsigned char> rgba;
+};
+
+bool readPng(const std::string& path, Picture& p) {
+    std::vector<unsigned char> bytes;
+    try {
+        bytes = readInputFileBytes(path, size_t(256) << 20);
+    } catch (const InputError&) {
+        return false;
+    }
+    int n = 0;
+    unsigned char* data = stbi_load_from_memory(bytes.data(), int(bytes.size()), &p.width, &p.height, &n, 4);
+    if (!data) return false;
+    p.rgba.assign(data, data + size_t(p.width) * size_t(p.height) * 4);
+    stbi_image_free(data);
+    return true;
+}
+
+/// The saved visibility images of `id` in both runs, frame by frame: pixels that differ, and a
+/// picture of them (changed pixels red over the new image in grey) in `imagesDir`.
+Json compareImages(const std::string& baseDir, const std::string& newDir, const std::string& id, const std::string& imagesDir) {
+    Json out = Json::array();
+    const std::string prefix = id + "_f", suffix = "_visibility.png";
+    std::error_code ec;
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(newDir + "/images", ec)) {
+        const std::string n = e.path().filename().string();
+        if (n.starts_with(prefix) && n.ends_with(suffix) && n.size() == prefix.size() + 4 + suffix.size()) names.push_back(n);
+    }
+    std::sort(names.begin(), names.end());
+    for (const std::string& n : names) {
+        Picture a, b;
+        if (!readPng(baseDir + "/images/" + n, a) || !readPng(newDir + "/images/" + n, b)) continue;
+        const int frame = std::stoi(n.substr(prefix.size(), 4));
+        if (a.width != b.width || a.height != b.height) {
+            out.push_back({{"frame", frame}, {"changed_pixels", Json()}, {"note", "the images differ in size"}});
+            continue;
+        }
+        size_t changed = 0;
+        std::vector<unsigned char> picture(b.rgba.size());
+        for (size_t i = 0; i < b.rgba.size(); i += 4) {
+            const bool differs = !std::equal(a.rgba.begin() + long(i), a.rgba.begin() + long(i) + 3, b.rgba.begin() + long(i));
+            changed += differs ? 1 : 0;
+            const unsigned char grey = static_cast<unsigned char>(b.rgba[i] / 3 + 60);
+            picture[i] = differs ? 255 : grey;
+            picture[i + 1] = differs ? 0 : grey;
+            picture[i + 2] = differs ? 0 : grey;
+            picture[i + 3] = 255;
+        }
+        Json rec = {{"frame", frame}, {"changed_pixels", changed}, {"pixels", size_t(b.width) * size_t(b.height)}};
+        if (changed > 0 && !imagesDir.empty()) {
+            const std::string file = id + "_f" + n.substr(prefix.size(), 4) + "_changed.png";
+            if (stbi_write_png((imagesDir + "/" + file).c_str(), b.width, b.height, 4, picture.data(), b.width * 4)) rec["picture"] = "images/" + file;
+        }
+        out.push_back(rec);
+    }
+    return out;
+}
+
+/// The resolved configs' differences, as the top-level keys that differ (output.dir left out).
+std::vector<std::string> configDifferences(const std::string& baseDir, const std::string& newDir) {
+    std::vector<std::string> keys;
+    try {
+        Json a = JsonNode::parseFile(baseDir + "/config.resolved.json"), b = JsonNode::parseFile(newDir + "/config.resolved.json");
+        for (Json* j : {&a, &b})
+            if (j->contains("output") && (*j)["output"].is_object()) (*j)["output"].erase("dir");
+        std::set<std::string> all;
+        for (const auto& [k, v] : a.items()) all.insert(k);
+        for (const auto& [k, v] : b.items()) all.insert(k);
+        for (const auto& k : all)
+            if (a.value(k, Json()) != b.value(k, Json())) keys.push_back(k);
+    } catch (const InputError&) {
+        keys.push_back("(a config.resolved.json cannot be read)");
+    }
+    return keys;
+}
+
+} // namespace
+
+Comparison compareRuns(const std::string& baseDir, const std::string& newDir, const CompareOptions& opt) {
+    const Json base = readSummary(baseDir), next = readSummary(newDir);
+    Comparison c;
+    if (const auto keys = configDifferences(baseDir, newDir); !keys.empty()) {
+        std::string list;
+        for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+        c.notes.push_back("the two runs' configs differ in: " + shortText(list, 300) + " (a change may be the config's, not the code's)");
+    }
+    if (base.value("renderer", std::string()) != next.value("renderer", std::string()))
+        c.notes.push_back("the runs ran on different renderers: " + shortText(base.value("renderer", std::string()), 100) + " and " +
+                          shortText(next.value("renderer", std::string()), 100));
+    std::set<std::string> ids;
+    for (const auto& [id, v] : base["algorithms"].items()) ids.insert(id);
+    for (const auto& [id, v] : next["algorithms"].items()) ids.insert(id);
+    for (const std::string& id : ids) {
+        Json r = {{"id", id}};
+        const bool inBase = base["algorithms"].contains(id), inNew = next["algorithms"].contains(id);
+        r["present"] = inBase && inNew ? "both" : inBase ? "base only" : "new only";
+        r["regressions"] = Json::array();
+        if (!(inBase && inNew)) {
+            c.records.push_back(r);
+            continue;
+        }
+        const Json& a = base["algorithms"][id];
+        const Json& b = next["algorithms"][id];
+        Json time = Json::array();
+        for (const std::string& stage : stagesOf(a, b)) time.push_back(compareStage(a, b, stage, opt.threshold));
+        r["time"] = time;
+        if (time.back()["verdict"] == "slower")
+            r["regressions"].push_back("total time " + number(time.back()["ratio"].get<double>()) + "× (95 % interval " +
+                                       number(time.back()["low"].get<double>()) + " – " + number(time.back()["high"].get<double>()) + ")");
+        const Json accA = a.value("accuracy", Json()), accB = b.value("accuracy", Json());
+        if (accA.is_object() && accB.is_object()) {
+            const double x = accA.value("mismatch_ratio_max", 0.0), y = accB.value("mismatch_ratio_max", 0.0);
+            // Accuracy is deterministic on one renderer: any growth past the threshold is the code's.
+            const std::string verdict = y > x * (1 + opt.threshold) + 1e-12 ? "worse" : y < x * (1 - opt.threshold) - 1e-12 ? "better" : "same";
+            r["accuracy"] = {{"base", x}, {"new", y}, {"verdict", verdict}};
+            if (verdict == "worse") r["regressions"].push_back("worst-frame mismatch " + number(100 * x) + " % → " + number(100 * y) + " %");
+        }
+        const uint64_t ova = a.value("overflow", uint64_t(0)), ovb = b.value("overflow", uint64_t(0));
+        r["overflow"] = {{"base", ova}, {"new", ovb}};
+        if (ovb > ova) r["regressions"].push_back("overflow " + std::to_string(ova) + " → " + std::to_string(ovb));
+        const double ma = a.value("memory_bytes", 0.0), mb = b.value("memory_bytes", 0.0);
+        r["memory_bytes"] = {{"base", ma}, {"new", mb}, {"ratio", ma > 0 ? Json(mb / ma) : Json()}};
+        Json counters = Json::object();
+        if (a.contains("counters") && b.contains("counters"))
+            for (const auto& [name, v] : a["counters"].items()) {
+                if (!b["counters"].contains(name)) continue;
+                const double x = v.value("mean", 0.0), y = b["counters"][name].value("mean", 0.0);
+                if (std::fabs(y - x) > opt.threshold * std::max(std::fabs(x), 1e-12)) counters[name] = {{"base", x}, {"new", y}};
+            }
+        r["counters_changed"] = counters;
+        r["images"] = compareImages(baseDir, newDir, id, opt.imagesDir);
+        c.regressions += r["regressions"].size();
+        c.records.push_back(r);
+    }
+    size_t fewest = SIZE_MAX;
+    for (const auto& [id, v] : next["algorithms"].items()) fewest = std::min(fewest, repetitionCount(v));
+    for (const auto& [id, v] : base["algorithms"].items()) fewest = std::min(fewest, repetitionCount(v));
+    if (fewest < 3)
+        c.notes.push_back("a run has fewer than 3 repetitions (config \"repeats\"): total times are compared frame by frame, the other "
+                          "stages without an interval");
+    else if (fewest < 5)
+        c.notes.push_back("a run has fewer than 5 repetitions: the U test cannot find a difference (p < 0.05) in so few, so no time is "
+                          "called slower or faster; use \"repeats\": 5 or more (9 is safer on a shared machine)");
+    return c;
+}
+
+std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, const std::string& newDir, const CompareOptions& opt) {
+    std::ostringstream os;
+    os << "# Comparison\n\n- base: " << markdownLiteral(baseDir) << "\n- new: " << markdownLiteral(newDir) << "\n- threshold: "
+       << number(100 * opt.threshold) << " % (a time counts as slower or faster only past it, with its whole 95 % interval on one side of 1)\n";
+    for (const auto& n : c.notes) os << "- **note**: " << markdownLiteral(n) << "\n";
+    os << "\n## " << (c.regressions ? std::to_string(c.regressions) + " regressions" : std::string("No regression")) << "\n\n";
+    for (const Json& r : c.records)
+        for (const Json& g : r["regressions"]) os << "- " << markdownLiteral(r["id"].get<std::string>()) << ": " << markdownLiteral(g.get<std::string>()) << "\n";
+    os << "\n## Time per frame (ms), new over base\n\n| id | stage | base | new | ratio | 95 % interval | p (U test) | from | verdict |\n"
+          "|---|---|---:|---:|---:|---|---:|---|---|\n";
+    for (const Json& r : c.records) {
+        if (r["present"] != "both") {
+            os << "| " << markdownLiteral(r["id"].get<std::string>()) << " | | | | | | | | " << r["present"].get<std::string>() << " |\n";
+            continue;
+        }
+        for (const Json& t : r["time"]) {
+            os << "| " << markdownLiteral(r["id"].get<std::string>()) << " | " << markdownLiteral(t["stage"].get<std::string>()) << " | "
+               << number(t["base"].get<double>()) << " | " << number(t["new"].get<double>()) << " | " << number(t["ratio"].get<double>()) << " | "
+               << (t["low"].is_null() ? std::string() : number(t["low"].get<double>()) + " – " + number(t["high"].get<double>())) << " | "
+               << (t.contains("p") ? number(t["p"].get<double>()) : std::string()) << " | " << t["method"].get<std::string>() << " | "
+               << (t["verdict"] == "slower" ? "**slower**" : t["verdict"].get<std::string>()) << " |\n";
+        }
+    }
+    os << "\n## Accuracy, overflow, memory\n\n| id | worst-frame mismatch base → new | verdict | overflow | memory (MiB) |\n|---|---|---|---|---|\n";
+    for (const Json& r : c.records) {
+        if (r["present"] != "both") continue;
+        os << "| " << markdownLiteral(r["id"].get<std::string>()) << " | ";
+        if (r.contains("accuracy"))
+            os << number(100 * r["accuracy"]["base"].get<double>()) << " % → " << number(100 * r["accuracy"]["new"].get<double>()) << " % | "
+               << (r["accuracy"]["verdict"] == "worse" ? "**worse**" : r["accuracy"]["verdict"].get<std::string>());
+        else
+            os << "not measured | ";
+        os << " | " << r["overflow"]["base"] << " → " << r["overflow"]["new"] << " | " << number(r["memory_bytes"]["base"].get<double>() / 1048576.0)
+           << " → " << number(r["memory_bytes"]["new"].get<double>() / 1048576.0) << " |\n";
+    }
+    os << "\n## Changed counters (mean past the threshold) and images\n\n";
+    for (const Json& r : c.records) {
+        if (r["present"] != "both") continue;
+        for (const auto& [name, v] : r["counters_changed"].items())
+            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " " << markdownLiteral(name) << ": " << number(v["base"].get<double>())
+               << " → " << number(v["new"].get<double>()) << "\n";
+        for (const Json& im : r["images"]) {
+            if (im["changed_pixels"].is_null() || im["changed_pixels"].get<size_t>() == 0) continue;
+            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << ": " << im["changed_pixels"] << " of "
+               << im["pixels"] << " pixels changed";
+            if (im.contains("picture")) os << "\n\n  ![changed pixels](" << im["picture"].get<std::string>() << ")";
+            os << "\n";
+        }
+    }
+    return os.str();
+}
+
+namespace {
+std::string xml(const std::string& text) {
+    std::string out;
+    for (char ch : validUtf8(text)) {
+        const unsigned char u = static_cast<unsigned char>(ch);
+        if (ch == '&') out += "&amp;";
+        else if (ch == '<') out += "&lt;";
+        else if (ch == '>') out += "&gt;";
+        else if (ch == '"') out += "&quot;";
+        else if (u < 0x20 && ch != '\t' && ch != '\n') out += '?';
+        else out += ch;
+    }
+    return out;
+}
+} // namespace
+
+std::string comparisonJUnit(const Comparison& c) {
+    std::ostringstream cases;
+    size_t tests = 0, failures = 0;
+    for (const Json& r : c.records) {
+        if (r["present"] != "both") continue;
+        const std::string id = r["id"].get<std::string>();
+        auto testCase = [&](const std::string& name, const std::string& failure) {
+            ++tests;
+            cases << "    <testcase classname=\"" << xml(id) << "\" name=\"" << xml(name) << "\" time=\"0\"";
+            if (failure.empty()) {
+                cases << "/>\n";
+                return;
+            }
+            ++failures;
+            cases << ">\n      <failure message=\"" << xml(failure) << "\">" << xml(failure) << "</failure>\n    </testcase>\n";
+        };
+        auto regression = [&](const std::string& start) {
+            for (const Json& g : r["regressions"])
+                if (g.get<std::string>().starts_with(start)) return g.get<std::string>();
+            return std::string();
+        };
+        testCase("total time not slower", regression("total time"));
+        if (r.contains("accuracy")) testCase("accuracy not worse", regression("worst-frame mismatch"));
+        testCase("overflow not more", regression("overflow"));
+    }
+    return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites tests=\"" + std::to_string(tests) + "\" failures=\"" +
+           std::to_string(failures) + "\">\n  <testsuite name=\"shadowlab compare\" tests=\"" + std::to_string(tests) + "\" failures=\"" +
+           std::to_string(failures) + "\" errors=\"0\">\n" + cases.str() + "  </testsuite>\n</testsuites>\n";
+}
+
+} // namespace shadowlab

@@ -1,0 +1,78 @@
+// `compare` on runs written in-process: a run against itself changes nothing; planted regressions
+// (a psv that writes a few pixels lit, a psv whose traverse is done many times over) are named,
+// and bvh_raytrace, untouched, is not.
+#include "framework/experiment/Compare.h"
+#include "framework/experiment/Config.h"
+#include "framework/experiment/Runner.h"
+#include "tests/TestSupport.h"
+
+namespace shadowlab {
+namespace {
+
+using test::GLTest;
+
+Json comparedConfig() {
+    return {{"name", "compared"},
+            {"resolution", {64, 64}},
+            {"frames", 3},
+            {"warmup_frames", 1},
+            {"repeats", 5},
+            {"scene", {{"objects", Json::array({{{"procedural", "plane"}, {"size", {8, 8}}},
+                                                {{"procedural", "sphere"}, {"radius", 0.8}, {"transform", {{"translate", {0, 1.0, 0}}}}}})}}},
+            {"camera", {{"position", {0.5, 5, 4}}, {"target", {0, 0, 0}}}},
+            {"light", {{"type", "point"}, {"position", {0.7, 5, 0.4}}}},
+            {"algorithms", Json::array({{{"algorithm", "psv"}}, {{"algorithm", "bvh_raytrace"}}})},
+            {"statistics", "none"},
+            {"output", {{"plots", false}, {"images_at_frames", {2}}}}};
+}
+
+void runInto(const std::string& dir) {
+    ExperimentConfig cfg = parseConfig(comparedConfig(), dir + ".json");
+    RunOptions opt;
+    opt.progress = false;
+    opt.outputDir = dir;
+    runExperiment(cfg, opt, "osmesa");
+}
+
+const Json& record(const Comparison& c, const std::string& id) {
+    for (const Json& r : c.records)
+        if (r["id"] == id) return r;
+    static const Json none;
+    return none;
+}
+
+class CompareGLTest : public GLTest {};
+
+TEST_F(CompareGLTest, PlantedRegressionsAreNamedAndARunAgainstItselfChangesNothing) {
+    const std::string dir = test::makeTempDir("compare");
+    runInto(dir + "/base");
+    {
+        test::ScopedShaderFaults fault(ShaderDefines{{"SHADOWLAB_FAULT_PLANTED_LIT", "1"}, {"SHADOWLAB_FAULT_SLOW_TRAVERSE", "30"}});
+        runInto(dir + "/planted");
+    }
+    const Comparison same = compareRuns(dir + "/base", dir + "/base", {});
+    EXPECT_EQ(same.regressions, 0u);
+    EXPECT_DOUBLE_EQ(record(same, "psv")["time"].back()["ratio"].get<double>(), 1.0);
+
+    CompareOptions opt;
+    opt.imagesDir = dir;
+    const Comparison c = compareRuns(dir + "/base", dir + "/planted", opt);
+    const Json& psv = record(c, "psv");
+    ASSERT_TRUE(psv.is_object());
+    EXPECT_EQ(psv["time"].back()["stage"], "total");
+    EXPECT_EQ(psv["time"].back()["verdict"], "slower") << psv["time"].dump(2);
+    EXPECT_EQ(psv["accuracy"]["verdict"], "worse") << psv["accuracy"].dump();
+    ASSERT_EQ(psv["images"].size(), 1u);
+    EXPECT_GT(psv["images"][0]["changed_pixels"].get<size_t>(), 0u);
+    EXPECT_TRUE(psv["images"][0].contains("picture"));
+    EXPECT_EQ(psv["regressions"].size(), 2u) << psv["regressions"].dump();
+    const Json& bvh = record(c, "bvh_raytrace");
+    EXPECT_EQ(bvh["regressions"].size(), 0u) << bvh.dump(2);
+    EXPECT_EQ(bvh["images"][0]["changed_pixels"], 0u);
+    EXPECT_EQ(c.regressions, 2u);
+    const std::string junit = comparisonJUnit(c);
+    EXPECT_NE(junit.find("failures=\"2\""), std::string::npos) << junit;
+}
+
+} // namespace
+} // namespace shadowlab
