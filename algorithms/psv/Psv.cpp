@@ -150,6 +150,9 @@ public:
         f.timer.begin("traverse");
         if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
         else runPixelPass(f, query_, {});
+        // Test fault: a GL error in the frame (what a failed allocation raises), which must stop
+        // the run before it saves anything.
+        if (shaderFaultActive("SHADOWLAB_FAULT_GL_ERROR")) glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0xFFFFFFF0u);
         // Test fault: the traverse stage done N more times (the same image), a planted slowdown
         // for the checks that must catch one (expectations, compare).
         for (int extra = shaderFaultCount("SHADOWLAB_FAULT_SLOW_TRAVERSE"); extra > 0; --extra) runPixelPass(f, query_, {});

@@ -180,12 +180,14 @@ private:
 
 } // namespace
 
-/// Its maps at the configured resolution: 8 bytes a texel (distance and depth), on the six faces of
-/// a cube map and one 2D map (the plan does not know the light: the most any light asks for).
+/// Its maps at the configured resolution, on the six faces of a cube map and one 2D map (the plan
+/// does not know the light: the most any light asks for): 14 bytes a texel of each, distance and
+/// depth and what llvmpipe holds beside them (84-92 bytes per r² measured for a point light's cube
+/// at 2048 and 4096, results/reference/memory_bounds_llvmpipe.md).
 Footprint shadowMapFootprint(const FootprintQuery& q) {
     const size_t r = size_t(std::get<int>(q.params->get("resolution")));
     Footprint f;
-    f.bytes = saturatingMul(saturatingMul(r, r), 8 * 7);
+    f.bytes = saturatingMul(saturatingMul(r, r), 7 * 14);
     return f;
 }
 

@@ -1,7 +1,10 @@
 #include "framework/core/SystemMemory.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <string>
+#include <sys/resource.h>
 
 namespace shadowlab {
 namespace {
@@ -25,7 +28,46 @@ size_t procKilobytes(const char* file, const char* key) {
 
 } // namespace
 
-SystemMemory systemMemory() { return {procKilobytes("/proc/meminfo", "MemTotal"), procKilobytes("/proc/meminfo", "MemAvailable")}; }
+namespace {
+/// The headroom of this process's cgroup (v2) under its memory.max, bytes; SIZE_MAX when unlimited or unknown.
+size_t cgroupHeadroom() {
+    std::FILE* f = std::fopen("/proc/self/cgroup", "r");
+    if (!f) return SIZE_MAX;
+    char line[4096];
+    std::string path;
+    while (std::fgets(line, sizeof line, f))
+        if (std::strncmp(line, "0::", 3) == 0) {
+            path = line + 3;
+            while (!path.empty() && (path.back() == '\n' || path.back() == '\r')) path.pop_back();
+        }
+    std::fclose(f);
+    if (path.empty() || path.find("..") != std::string::npos) return SIZE_MAX;
+    auto readNumber = [&](const char* name) -> size_t {
+        std::FILE* g = std::fopen(("/sys/fs/cgroup" + path + "/" + name).c_str(), "r");
+        if (!g) return SIZE_MAX;
+        unsigned long long v = 0;
+        const bool ok = std::fscanf(g, "%llu", &v) == 1;  // "max" reads as no number: unlimited
+        std::fclose(g);
+        return ok ? size_t(v) : SIZE_MAX;
+    };
+    const size_t max = readNumber("memory.max"), current = readNumber("memory.current");
+    if (max == SIZE_MAX) return SIZE_MAX;
+    return current == SIZE_MAX || current >= max ? 0 : max - current;
+}
+} // namespace
+
+SystemMemory systemMemory() {
+    SystemMemory m{procKilobytes("/proc/meminfo", "MemTotal"), procKilobytes("/proc/meminfo", "MemAvailable"), ""};
+    struct rlimit limit {};
+    if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+        const size_t used = procKilobytes("/proc/self/status", "VmSize");
+        const size_t headroom = size_t(limit.rlim_cur) > used ? size_t(limit.rlim_cur) - used : 0;
+        if (m.available == 0 || headroom < m.available) m = {m.total, headroom, "ulimit -v"};
+    }
+    if (const size_t headroom = cgroupHeadroom(); headroom != SIZE_MAX && (m.available == 0 || headroom < m.available))
+        m = {m.total, headroom, "cgroup memory.max"};
+    return m;
+}
 
 size_t peakResidentBytes() { return procKilobytes("/proc/self/status", "VmHWM"); }
 

@@ -194,6 +194,9 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
 
     plan.held.emplace_back("scene", predictedSceneBytes(scene));
     plan.held.emplace_back("scene_gpu", predictedSceneGpuBytes(scene));
+    // The framework's per-pixel buffers: G-buffer, its host copy, lit and covered masks, shading,
+    // the visibility read back per algorithm and the images written (results/reference/memory_bounds_llvmpipe.md).
+    plan.held.emplace_back("frame buffers", saturatingMul(size_t(cfg.resolution.x) * size_t(cfg.resolution.y), kFrameBytesPerPixel));
     // The largest object (a grid's copies) is made whole and then appended to the scene.
     plan.loadPeak = saturatingMul(2, plan.held[0].second);
     refuseOverflow(cfg, "/scene", "the scene", plan.loadPeak, triangles);
@@ -203,7 +206,7 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
 
     // Algorithms set up one after the other (the reference first): each one's transient sits on
     // top of the scene and of what it and the ones before it hold, not of what comes after.
-    size_t held = saturatingSum({plan.held[0].second, plan.held[1].second}), setupPeak = 0;
+    size_t held = saturatingSum({plan.held[0].second, plan.held[1].second, plan.held[2].second}), setupPeak = 0;
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         if (!e->info->footprint) continue;
         const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
@@ -216,12 +219,30 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
         setupPeak = std::max(setupPeak, saturatingSum({held, f.peakBytes}));
         refuseOverflow(cfg, where, e->info->name + "'s estimate with what is held before it", setupPeak, triangles);
     }
+    // The statistics pass makes every algorithm again (instrumented) while the driver still holds
+    // the timed pass's structures: llvmpipe frees them only at the end of the run (an izb of 512 MiB
+    // of jobs peaked at 1.09 GiB with the pass, 0.59 without; results/reference/memory_bounds_llvmpipe.md).
+    if (!cfg.statisticsFrames().empty()) {
+        size_t again = 0, setup = 0;
+        for (const AlgorithmEntry* e : planEntries(cfg)) {
+            if (!e->info->footprint) continue;
+            const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
+            again = saturatingSum({again, f.bytes});
+            setup = std::max(setup, f.peakBytes);
+        }
+        plan.held.emplace_back("statistics pass", again);
+        held = saturatingSum({held, again});
+        setupPeak = std::max(setupPeak, saturatingSum({held, setup}));
+        refuseOverflow(cfg, "/statistics", "the statistics pass's structures with the timed pass's", setupPeak, triangles);
+    }
     plan.peak = std::max({plan.loadPeak, gpuUploadPeak, held, setupPeak});
     if (plan.available > 0 && plan.peak > plan.available)
         throw InputError(cfg.file, "/scene",
                          "the run would need about " + plan.summary() + " for up to " + std::to_string(triangles) +
-                             " triangles; this machine has " + formatGiB(plan.machine) +
-                             " in all: use fewer triangles or algorithms");
+                             " triangles; " +
+                             (*machine.limitedBy ? "this process may take " + formatGiB(plan.available) + " more (" + machine.limitedBy + ")"
+                                                 : "this machine has " + formatGiB(plan.machine) + " in all") +
+                             ": use fewer triangles or algorithms");
     return plan;
 }
 

@@ -15,6 +15,11 @@
 
 namespace shadowlab {
 
+/// The framework's bytes per image pixel (G-buffer and its host copy, masks, shading, each
+/// algorithm's visibility read back, the images written): 58 measured on llvmpipe from 2048² to
+/// 4096², reference only (results/reference/memory_bounds_llvmpipe.md).
+constexpr size_t kFrameBytesPerPixel = 64;
+
 /// The device's limits an algorithm's estimate depends on (read from the current GL context).
 struct DeviceLimits {
     size_t storageBlockBytes = 0; ///< what one storage block addresses, measured (see MemoryPlan.cpp)
@@ -27,7 +32,7 @@ DeviceLimits currentDeviceLimits(size_t triangles);
 struct MemoryPlan {
     size_t triangles = 0;
     bool moving = false;
-    std::vector<std::pair<std::string, size_t>> held; ///< what stays for the run, by part: "scene", "scene_gpu", then ids
+    std::vector<std::pair<std::string, size_t>> held; ///< what stays for the run, by part: "scene", "scene_gpu", "frame buffers", then ids
     size_t loadPeak = 0;   ///< bytes while the scene is made (a grid's copies and the scene they go into)
     size_t peak = 0;       ///< the estimated peak: the load's, or the held parts' with each setScene() transient on
                            ///< top of what is held when it runs (entries are set up in order)

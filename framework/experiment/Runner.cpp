@@ -4,6 +4,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
 #include "framework/core/SystemMemory.h"
+#include "framework/core/Text.h"
 #include "framework/experiment/OutputPlace.h"
 #include "framework/experiment/Progress.h"
 #include "framework/gl/DeviceInfo.h"
@@ -116,6 +117,21 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     }
     const std::string dir = place ? place->partialDir() : std::string();
     const std::string finalDir = place ? place->finalDir() : std::string();
+    // A GL error (an allocation that failed, a framebuffer left incomplete) means the images and
+    // times that follow are not the algorithms': the run stops there and saves nothing (the
+    // previous results kept), instead of committing a "complete" output a sweep would then merge.
+    const int glErrorsAtStart = glErrorCount();
+    const size_t glMessagesAtStart = glLastErrors().size();
+    const auto stopIfBroken = [&] {
+        throwIfInterrupted();
+        if (glErrorCount() > glErrorsAtStart) {
+            std::string first = glLastErrors();
+            first = first.size() > glMessagesAtStart ? first.substr(glMessagesAtStart) : std::string("see the GL errors above");
+            first = first.substr(0, first.find('\n'));
+            throw RuntimeError(std::to_string(glErrorCount() - glErrorsAtStart) + " OpenGL error(s) during the run (" + shortText(first, 200) +
+                               "): its results cannot be trusted, so none were saved");
+        }
+    };
 
     const glm::ivec2 res = cfg.resolution;
     SceneGpu sceneGpu(*cfg.scene);
@@ -198,7 +214,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         Light light = cfg.lightAt(0);
         renderFrame(cam);
         for (auto& inst : instances) {
-            throwIfInterrupted();
+            stopIfBroken();
             progress.step("warm-up " + inst.entry->id);
             for (int w = 0; w < cfg.warmupFrames; ++w) inst.host->computeFrame({gbuffer, getCpuG, cam, light, 0}, timer);
         }
@@ -221,7 +237,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         if (!std::any_of(lit.begin(), lit.end(), [](uint8_t v) { return v != 0; })) framesWithoutLit.push_back(frame);
 
         for (auto& inst : instances) {
-            throwIfInterrupted();
+            stopIfBroken();
             progress.step(inst.entry->id + " frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
             FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
             m.stages.insert(m.stages.begin(), sceneUpdate.stages.begin(), sceneUpdate.stages.end());
@@ -261,7 +277,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             glFinish();
             for (size_t k = 0; k < instances.size(); ++k) {
                 Instance& inst = instances[(k + size_t(rep)) % instances.size()];
-                throwIfInterrupted();
+                stopIfBroken();
                 progress.step(inst.entry->id + " repetition " + std::to_string(rep + 1) + ", frame " + std::to_string(frame + 1));
                 FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
                 m.stages.insert(m.stages.begin(), sceneUpdate.stages.begin(), sceneUpdate.stages.end());
@@ -296,7 +312,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                 for (int w = 0; w < cfg.warmupFrames; ++w) inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
         const bool saveImages = isImageFrame(frame);
         for (auto& inst : instances) {
-            throwIfInterrupted();
+            stopIfBroken();
             progress.step(inst.entry->id + " statistics, frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
             FrameRecord rec = recordOf(inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer), frame);
             if (visibilityHash(inst.host->readVisibility()) != inst.timedVisibility[frame]) inst.results.visibilityDiffers.push_back(frame);
@@ -341,7 +357,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     // JUnit file say the same; a failed one changes nothing else (the caller sets the exit code).
     if (!cfg.expectations.empty()) results.meta["expectations"] = checkExpectations(cfg.expectations, cfg.expectationIds(), results.summary());
     if (!opt.writeOutputs) return results;
-    throwIfInterrupted();
+    stopIfBroken();
 
     // Order matters: the resolved config and tables first, plots next, summary.json last; the
     // rename that follows makes the whole directory appear at once.
@@ -354,7 +370,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         writeFileAtomic(dir + "/expectations.junit.xml",
                         expectationsJUnit(cfg.name, summary["expectations"], results.meta["wall_time_s"].get<double>()));
     if (cfg.plots) runPlots(dir, finalDir, results.meta["stage_time_source"].get<std::string>());
-    throwIfInterrupted();
+    stopIfBroken();
     writeFileAtomic(dir + "/summary.json", summary.dump(2) + "\n");
     place->commit();
     return results;
