@@ -131,6 +131,43 @@ TEST(RunSafetyTest, SighupStopsTheRunUnlessItWasIgnoredAtTheStart) {
     f.expectPreviousKept();
 }
 
+// Sixth probe: the output removed mid-run and a folder of the user's made in its place got the
+// same inode number, and the commit replaced it (mine.txt lost, exit 0). Emptied and refilled in
+// place, the same. Both are kept now, the run's results beside them in DIR.kept-PID, exit 1.
+TEST(RunSafetyTest, AFolderPutInPlaceOfTheOutputMidRunIsKept) {
+    for (bool sameDirectory : {false, true}) {
+        SCOPED_TRACE(sameDirectory ? "emptied and refilled" : "removed and made again");
+        Fixture f(sameDirectory ? "swap-refill" : "swap-remake", 40);
+        pid_t pid = startRun(f.config, f.out, f.base + "/log", {"--force"});
+        ASSERT_TRUE(waitFor([&] { return hasPartial(f.base); })) << slurp(f.base + "/log");
+        if (sameDirectory) {
+            for (const auto& e : fs::directory_iterator(f.out)) fs::remove_all(e.path());
+        } else {
+            fs::remove_all(f.out);
+            fs::create_directory(f.out);
+        }
+        std::ofstream(f.out + "/mine.txt") << "user data\n";
+        EXPECT_EQ(waitExit(pid, 120s), 1) << slurp(f.base + "/log");
+        EXPECT_EQ(slurp(f.out + "/mine.txt"), "user data\n");
+        bool kept = false;
+        for (const auto& e : fs::directory_iterator(f.base)) kept = kept || e.path().filename().string().starts_with("out.kept-");
+        EXPECT_TRUE(kept) << slurp(f.base + "/log");
+    }
+}
+
+// Sixth probe: a config kept inside the output it names, run with --force, was deleted with the
+// old results (its glTF too). Refused now, exit 2, everything kept.
+TEST(RunSafetyTest, ForceNeverReplacesAFolderTheRunReadsItsInputsFrom) {
+    Fixture f("inputs-inside", 1);
+    const std::string config = f.out + "/my.json";
+    std::ofstream(config) << test::configWith({{"output", R"({"dir": ".", "plots": false})"}});
+    std::string log;
+    EXPECT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + config + " --force --no-progress", log), 2) << log;
+    EXPECT_NE(log.find("this run reads"), std::string::npos) << log;
+    EXPECT_TRUE(fs::exists(config));
+    f.expectPreviousKept();
+}
+
 TEST(RunSafetyTest, SigtermWhilePlottingStopsThePlotterAndKeepsThePreviousResults) {
     Fixture f("interrupt-plot", 2, true);
     // A plotter that announces itself and then takes far longer than any real plot.

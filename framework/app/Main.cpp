@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -162,6 +163,43 @@ int reportExpectations(const Json& meta) {
     return kExpectationsFailedExit;
 }
 
+/// Every "gltf" path of the resolved scene (objects, a grid's object, nested).
+void collectGltfPaths(const Json& j, std::vector<std::string>& out) {
+    if (j.is_object()) {
+        for (const auto& [k, v] : j.items()) {
+            if (k == "gltf" && v.is_string()) out.push_back(v.get<std::string>());
+            else collectGltfPaths(v, out);
+        }
+    } else if (j.is_array()) {
+        for (const auto& v : j) collectGltfPaths(v, out);
+    }
+}
+
+/// --force replaces DIR with everything in it: a run whose own config or scene files lie inside
+/// it would delete them (sixth probe: config.resolved.json then named a glTF file that was gone).
+void refuseInputsInsideReplacedOutput(const std::string& config, const std::vector<std::string>& overrides, const std::string& dir) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::is_directory(fs::symlink_status(dir, ec))) return;
+    const fs::path root = fs::weakly_canonical(fs::absolute(dir), ec);
+    auto inside = [&](const std::string& file) {
+        const fs::path p = fs::weakly_canonical(fs::absolute(file), ec);
+        const auto [a, b] = std::mismatch(root.begin(), root.end(), p.begin(), p.end());
+        return a == root.end();
+    };
+    Json j = JsonNode::parseFile(config);
+    for (const auto& o : overrides) applyOverride(j, o);
+    std::vector<std::string> gltf;
+    collectGltfPaths(j.value("scene", Json()), gltf);
+    std::vector<std::string> inputs = {config};
+    const fs::path folder = fs::absolute(config).parent_path();
+    for (const std::string& g : gltf) inputs.push_back(fs::path(g).is_absolute() ? g : (folder / g).string());
+    for (const std::string& file : inputs)
+        if (inside(file))
+            throw InputError(shortText(dir, 300), "", "--force would replace the folder with everything in it, and this run reads " +
+                                                          shortText(file, 200) + " from inside it: move that file out, or choose another --out");
+}
+
 int run(const std::vector<std::string>& args) {
     std::string config;
     std::vector<std::string> overrides;
@@ -199,6 +237,7 @@ int run(const std::vector<std::string>& args) {
     // The output place is checked and locked before the scene is loaded and anything rendered, so a
     // run that could not save its results fails at once instead of after the work.
     ExperimentConfig cfg = loadConfig(config, false, overrides);
+    if (opt.force) refuseInputsInsideReplacedOutput(config, overrides, opt.outputDir.empty() ? cfg.outputDir : opt.outputDir);
     std::vector<std::string> notes;
     // A place from the config is named as validate names it: the config and /output/dir.
     OutputPlace place = [&] {

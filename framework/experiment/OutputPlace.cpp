@@ -449,8 +449,10 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
         if (!output)
             throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no " + std::string(kOutputMark) +
                                       " mark, nor a summary.json of a run); --force replaces only outputs");
+        place.oldFd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
         struct stat st {};
-        if (::lstat(dir.c_str(), &st) == 0) place.existed_ = true, place.dev_ = uint64_t(st.st_dev), place.ino_ = uint64_t(st.st_ino);
+        if (place.oldFd_ >= 0 && ::fstat(place.oldFd_, &st) == 0)
+            place.existed_ = true, place.dev_ = uint64_t(st.st_dev), place.ino_ = uint64_t(st.st_ino);
     }
     place.partial_ = dir + ".partial-" + pidSuffix();
     fs::create_directories(place.partial_ + "/images", ec);
@@ -463,8 +465,9 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
 OutputPlace::OutputPlace(OutputPlace&& o) noexcept
     : final_(std::move(o.final_)), partial_(std::move(o.partial_)), lockPath_(std::move(o.lockPath_)),
       madeParents_(std::move(o.madeParents_)), lockFd_(o.lockFd_), committed_(o.committed_), kept_(o.kept_),
-      existed_(o.existed_), dev_(o.dev_), ino_(o.ino_) {
+      existed_(o.existed_), dev_(o.dev_), ino_(o.ino_), oldFd_(o.oldFd_) {
     o.lockFd_ = -1;
+    o.oldFd_ = -1;
     o.partial_.clear();
     o.madeParents_.clear();
 }
@@ -478,6 +481,8 @@ OutputPlace::~OutputPlace() {
 
 
 void OutputPlace::release() {
+    if (oldFd_ >= 0) ::close(oldFd_);
+    oldFd_ = -1;
     if (lockFd_ < 0) return;
     ::unlink(lockPath_.c_str());  // while still holding it: see acquireLock
     ::close(lockFd_);
@@ -509,6 +514,9 @@ void OutputPlace::commit() {
     if (exists && !existed_) refuseCommit("it appeared while this run was working and was not created by it");
     if (exists && (uint64_t(st.st_dev) != dev_ || uint64_t(st.st_ino) != ino_))
         refuseCommit("it was replaced by another directory while this run was working");
+    // The same directory, emptied and refilled by someone, is not the output open() checked either.
+    if (exists && !isShadowlabOutput(fs::path(final_)))
+        refuseCommit("it no longer carries the mark of a shadowlab output (its content was replaced while this run was working)");
     if (exists)
         if (const std::string inside = nestedInside(final_); !inside.empty())
             refuseCommit("it now holds " + inside);

@@ -68,6 +68,10 @@ private:
     /// DIR as open() found it (the directory --force may replace).
     bool existed_ = false;
     uint64_t dev_ = 0, ino_ = 0;
+    /// DIR held open from open() to commit(): while it is open its inode number cannot be given to
+    /// a directory made in its place (a folder of the user's, made after DIR was removed, once
+    /// got the same number and was replaced as if it were the checked output).
+    int oldFd_ = -1;
 };
 
 } // namespace shadowlab
