@@ -139,6 +139,23 @@ std::vector<BadCase> badCases() {
          test::animatedTriangleGltf({{"translation", "LINEAR", {0, 1}, {0, 0, 0, 3e38f, 0, 0}}}),
          {"m.gltf", "/nodes/0", "beyond ±1e15", "frame 1"}, R"(, "animation": 0)"},
         // What the glTF reader refuses in its own words, named by JSON path (checked before it).
+        // Sixth probe: an absolute buffer path was "not found" without a JSON path; "%zz" was called a NUL.
+        {"GltfBufferAbsolutePath", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "/etc/hostname"}])"}}),
+         {"m.gltf", "/buffers/0/uri", "an absolute path"}},
+        {"GltfBufferUriWithAScheme", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "file:m.bin"}])"}}),
+         {"m.gltf", "/buffers/0/uri", "a URI with a scheme"}},
+        {"GltfBufferBadPercentEscape", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "t%zzt.bin"}])"}}),
+         {"m.gltf", "/buffers/0/uri", "not followed by two hexadecimal digits"}},
+        // Sixth probe: a skinned mesh was drawn in its bind pose, morph targets with weights were dropped.
+        {"GltfSkinnedMesh", "m.gltf", test::triangleGltf({{"nodes", R"([{"mesh": 0, "skin": 0}])"}, {"skins", R"([{"joints": [0]}])"}}),
+         {"m.gltf", "/nodes/0/skin", "skinned meshes are not supported"}},
+        {"GltfMorphWeightsOnTheMesh", "m.gltf",
+         test::triangleGltf({{"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": 0}]}], "weights": [0.5]}])"}}),
+         {"m.gltf", "/meshes/0/weights", "non-zero weight"}},
+        {"GltfMorphWeightsOnTheNode", "m.gltf",
+         test::triangleGltf({{"nodes", R"([{"mesh": 0, "weights": [1]}])"},
+                             {"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": 0}]}], "weights": [0]}])"}}),
+         {"m.gltf", "/nodes/0/weights", "non-zero weight"}},
         // Fifth probe: a glTF 1.0 file failed on the first 2.0 field it lacks; "1.0" on a 2.0 layout loaded.
         {"GltfVersionOne", "m.gltf", test::triangleGltf({{"asset", R"({"version": "1.0"})"}}), {"m.gltf", "/asset/version", "glTF 2.x only"}},
         {"GltfVersionNotMajorMinor", "m.gltf", test::triangleGltf({{"asset", R"({"version": "2"})"}}), {"m.gltf", "/asset/version"}},

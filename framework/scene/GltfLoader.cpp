@@ -276,6 +276,9 @@ std::string percentDecoded(const std::string& uri) {
     return out;
 }
 
+/// The largest buffer file read (what readInputFileBytes is given below: a glTF byteLength is a uint32 in practice).
+constexpr size_t kMaxBufferFileBytes = 0xFFFFFFF0u;
+
 /// The data URIs the reader decodes (others it would take for file names).
 constexpr const char* kDataUriPrefixes[] = {"data:application/octet-stream;base64,", "data:application/gltf-buffer;base64,"};
 
@@ -301,6 +304,40 @@ size_t dataUriLength(const std::string& uri, std::string& problem) {
     problem = "a data URI of a buffer must begin with data:application/octet-stream;base64, or "
               "data:application/gltf-buffer;base64,";
     return 0;
+}
+
+/// What the file describes that rigid triangles cannot show, refused by its JSON path rather than
+/// drawn otherwise than the file means: a skinned mesh (it would be drawn in its bind pose) and
+/// morph targets with a non-zero weight on the mesh or its node (the mesh would be drawn without them).
+void checkDeformations(const Json& doc, const std::string& file) {
+    auto nonZero = [](const Json& weights) {
+        return weights.is_array() && std::any_of(weights.begin(), weights.end(), [](const Json& w) { return w.is_number() && w.get<double>() != 0.0; });
+    };
+    auto hasTargets = [&](size_t mesh) {
+        if (!doc.contains("meshes") || mesh >= doc["meshes"].size()) return false;
+        for (const Json& p : doc["meshes"][mesh].value("primitives", Json::array()))
+            if (p.is_object() && p.contains("targets") && !p["targets"].empty()) return true;
+        return false;
+    };
+    if (doc.contains("meshes"))
+        for (size_t m = 0; m < doc["meshes"].size(); ++m)
+            if (hasTargets(m) && nonZero(doc["meshes"][m].value("weights", Json())))
+                throw InputError(file, "/meshes/" + std::to_string(m) + "/weights",
+                                 "morph targets with a non-zero weight deform the mesh, which is not supported here (only rigid "
+                                 "parts): bake the weights into the positions, or set them to 0");
+    if (doc.contains("nodes"))
+        for (size_t n = 0; n < doc["nodes"].size(); ++n) {
+            const Json& node = doc["nodes"][n];
+            if (!node.is_object() || !node.contains("mesh")) continue;
+            if (node.contains("skin"))
+                throw InputError(file, "/nodes/" + std::to_string(n) + "/skin",
+                                 "skinned meshes are not supported (the mesh would be drawn in its bind pose, not as the skin "
+                                 "places it): bake the skin into the positions");
+            if (nonZero(node.value("weights", Json())) && node["mesh"].is_number_unsigned() && hasTargets(node["mesh"].get<size_t>()))
+                throw InputError(file, "/nodes/" + std::to_string(n) + "/weights",
+                                 "morph targets with a non-zero weight deform the mesh, which is not supported here (only rigid "
+                                 "parts): bake the weights into the positions, or set them to 0");
+        }
 }
 
 /// What the glTF reader (tinygltf) refuses without saying where (or saying it by echoing the
@@ -344,6 +381,17 @@ void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool bi
                 have = dataUriLength(uri, problem);
                 if (!problem.empty()) throw InputError(file, where + "/uri", problem);
             } else {
+                // A uri is a relative reference (RFC 3986) to a file beside the glTF file: a path from
+                // the root or another scheme is not read as one (the reader called it "not found").
+                if (uri.starts_with("/") || uri.find(':') < uri.find('/'))
+                    throw InputError(file, where + "/uri", "\"" + shortText(uri, 80) + "\" is " +
+                                                               (uri.starts_with("/") ? "an absolute path" : "a URI with a scheme") +
+                                                               ": a buffer's uri is a file name relative to the glTF file, or a data: URI");
+                for (size_t k = 0; k < uri.size(); ++k)
+                    if (uri[k] == '%' && (k + 2 >= uri.size() || !std::isxdigit(static_cast<unsigned char>(uri[k + 1])) ||
+                                          !std::isxdigit(static_cast<unsigned char>(uri[k + 2]))))
+                        throw InputError(file, where + "/uri", "the uri holds a '%' that is not followed by two hexadecimal digits "
+                                                               "(a percent-encoded byte, such as %20 for a space)");
                 // The reader decodes percent-encoded names (%20); so does this check. A decoded NUL
                 // would end the name there, and another file be read.
                 const std::string decoded = percentDecoded(uri);
@@ -357,6 +405,10 @@ void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool bi
                     throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " is " +
                                                                nonRegularKind(path, true) + ", not a regular file");
                 have = size_t(st.st_size);
+                if (have > kMaxBufferFileBytes)
+                    throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " holds " + std::to_string(have >> 20) +
+                                                               " MiB, more than the " + std::to_string(kMaxBufferFileBytes >> 20) +
+                                                               " MiB a buffer may hold here");
             }
             if (have != length)
                 throw InputError(file, where + "/byteLength", std::to_string(length) + " bytes declared, the buffer holds " +
@@ -625,9 +677,6 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         fail("/animations", "no animation \"" + animation_.substr(0, 40) + "\" (the file has " +
                                 (m_.animations.empty() ? std::string("none") : std::to_string(m_.animations.size()) + ": " + names) + ")");
     }
-    for (size_t i = 0; i < m_.nodes.size(); ++i)
-        if (m_.nodes[i].skin != -1 && m_.nodes[i].mesh != -1)
-            fail(at("nodes", i) + "/skin", "skinned meshes are not supported: only node (rigid) animation is played");
     auto anim = std::make_shared<NodeAnimation>();
     anim->file = file_;
     anim->extra.resize(m_.nodes.size());
@@ -1079,6 +1128,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
     if (!doc.is_object()) throw InputError(file, "", "not a glTF file (the JSON document is not an object)");
     checkVersion(doc, file);
     TypeChecker(file).checkObject(doc, kRoot, "");
+    checkDeformations(doc, file);
     checkWhatTheReaderRefuses(doc, file, binary, binary ? glbBinLength(bytes) : 0);
 
     tinygltf::TinyGLTF loader;
@@ -1096,7 +1146,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
     fs.WriteWholeFile = tinygltf::WriteWholeFile;
     fs.ReadWholeFile = [](std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
         try {
-            *out = readInputFileBytes(path, 0xFFFFFFF0u);
+            *out = readInputFileBytes(path, kMaxBufferFileBytes);
             return true;
         } catch (const InputError& e) {
             if (err) *err += e.cause() + "\n";
