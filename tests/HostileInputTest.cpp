@@ -139,6 +139,15 @@ std::vector<BadCase> badCases() {
          test::animatedTriangleGltf({{"translation", "LINEAR", {0, 1}, {0, 0, 0, 3e38f, 0, 0}}}),
          {"m.gltf", "/nodes/0", "beyond ±1e15", "frame 1"}, R"(, "animation": 0)"},
         // What the glTF reader refuses in its own words, named by JSON path (checked before it).
+        // Sixth probe: objects changed by float rounding ran as "valid": a fence whose outer posts at
+        // ±1e15 lost their triangles, a unit sphere at 1e7 drawn as a disc.
+        {"FenceWhosePostsCollapseInFloat", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "plane"}, {"procedural": "fence", "posts": 3, "spacing": 1e15,
+                                    "triangles_per_cylinder": 12, "rails": 1}]})"}}),
+         {"/scene/objects/1", "triangles have no area left in float", "spacing is"}},
+        {"SphereFarFromTheOrigin", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "sphere", "radius": 0.5, "transform": {"translate": [1e7, 0, 0]}}]})"}}),
+         {"/scene/objects/0", "would be drawn distorted", "at most 1 %"}},
         // Sixth probe: an absolute buffer path was "not found" without a JSON path; "%zz" was called a NUL.
         {"GltfBufferAbsolutePath", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "/etc/hostname"}])"}}),
          {"m.gltf", "/buffers/0/uri", "an absolute path"}},

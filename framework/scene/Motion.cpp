@@ -2,6 +2,7 @@
 
 #include "framework/core/JsonParse.h"
 #include "framework/core/Spline.h"
+#include "framework/scene/TriangleNormal.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -160,9 +161,7 @@ void MovingPart::setLocal(std::vector<glm::vec3> vertices) {
 void poseTriangle(const glm::mat4& m, const glm::vec3* local, glm::vec3* out, glm::vec3& normal) {
     for (int k = 0; k < 3; ++k) out[k] = glm::vec3(m * glm::vec4(local[k], 1.0f));
     if (glm::determinant(glm::mat3(m)) < 0.0f) std::swap(out[1], out[2]);
-    glm::vec3 n = glm::cross(out[1] - out[0], out[2] - out[0]);
-    float len = glm::length(n);
-    normal = len > 0.0f && std::isfinite(len) ? n / len : glm::vec3(0, 1, 0);
+    if (!unitNormal(out[0], out[1], out[2], normal)) normal = glm::vec3(0, 1, 0);
 }
 
 } // namespace shadowlab

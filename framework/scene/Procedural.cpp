@@ -27,11 +27,10 @@ public:
         s_.materialIds.reserve(expectedTriangles);
     }
     void add(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
-        glm::vec3 n = glm::cross(b - a, c - a);
-        float len = glm::length(n);
-        if (!(len > 0.0f) || !std::isfinite(len)) return;
+        glm::vec3 n;
+        if (!unitNormal(a, b, c, n)) return;
         s_.positions.insert(s_.positions.end(), {a, b, c});
-        s_.normals.push_back(n / len);
+        s_.normals.push_back(n);
         s_.materialIds.push_back(0);
         s_.bounds.extend(a);
         s_.bounds.extend(b);

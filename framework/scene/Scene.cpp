@@ -12,11 +12,10 @@ void Scene::addTriangles(const std::vector<glm::vec3>& tri, const Material& mate
     uint32_t mat = static_cast<uint32_t>(materials.size());
     bool used = false;
     for (size_t i = 0; i + 2 < tri.size(); i += 3) {
-        glm::vec3 n = glm::cross(tri[i + 1] - tri[i], tri[i + 2] - tri[i]);
-        float len = glm::length(n);
-        if (!(len > 0.0f) || !std::isfinite(len)) continue;
+        glm::vec3 n;
+        if (!unitNormal(tri[i], tri[i + 1], tri[i + 2], n)) continue;
         positions.insert(positions.end(), {tri[i], tri[i + 1], tri[i + 2]});
-        normals.push_back(n / len);
+        normals.push_back(n);
         materialIds.push_back(mat);
         for (int k = 0; k < 3; ++k) bounds.extend(tri[i + k]);
         used = true;
@@ -48,13 +47,13 @@ void Scene::append(const Scene& other, const glm::mat4& m) {
         glm::vec3 v[3];
         for (int k = 0; k < 3; ++k) v[k] = glm::vec3(m * glm::vec4(other.positions[3 * t + k], 1.0f));
         if (mirrored) std::swap(v[1], v[2]);
-        glm::vec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
-        float len = glm::length(n);
+        glm::vec3 n;
+        const bool hasArea = unitNormal(v[0], v[1], v[2], n);
         const bool moves = partOf[t] >= 0;
-        if (!moves && (!(len > 0.0f) || !std::isfinite(len))) continue;
+        if (!moves && !hasArea) continue;
         if (moves && other.moving[size_t(partOf[t])].firstTriangle == t) partStart[size_t(partOf[t])] = triangleCount();
         positions.insert(positions.end(), {v[0], v[1], v[2]});
-        normals.push_back(len > 0.0f ? n / len : glm::vec3(0, 1, 0));
+        normals.push_back(hasArea ? n : glm::vec3(0, 1, 0));
         materialIds.push_back(matBase + other.materialIds[t]);
         for (auto& p : v) {
             bounds.extend(p);

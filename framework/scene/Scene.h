@@ -4,9 +4,11 @@
 // Some triangle ranges may move rigidly (MovingPart); their positions here are the rest pose, the
 // pose at time 0, and SceneGpu poses them per frame.
 #include "framework/scene/Motion.h"
+#include "framework/scene/TriangleNormal.h"
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
