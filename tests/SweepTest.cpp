@@ -1,6 +1,7 @@
 // Sweeps through the command line: validation errors (exit code 2, one line naming the axis and
 // the JSON path), stable run ids, running, failing, resuming after a kill, and merging.
 #include "framework/core/JsonNode.h"
+#include "tests/HostileInputs.h"
 #include "tests/SweepTestData.h"
 #include "tests/TestSupport.h"
 
@@ -344,6 +345,28 @@ TEST(SweepTest, RunsWithUnmetExpectationsAreCompleteAndTheSweepExitsThree) {
     EXPECT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 3) << log;
     EXPECT_EQ(countOf(log, "] skip"), 2u) << log;
     EXPECT_EQ(test::runCommand(bin() + " sweep merge " + out + " --no-plots", log), 0) << log;
+}
+
+// Sixth probe: a model edited between two `sweep run`s kept its runs' ids, and the results of the
+// old geometry were skipped as complete and merged. Its content is part of the id: they run again.
+TEST(SweepTest, EditingAGltfFileGivesItsRunsNewIds) {
+    const std::string dir = test::makeTempDir("sweep-gltf-edit");
+    std::ofstream(dir + "/m.gltf") << test::triangleGltf({});
+    Json sweep = test::smallSweep();
+    sweep["base"]["frames"] = 1;
+    sweep["base"]["scene"]["objects"][1] = Json::parse(R"({"gltf": "m.gltf"})");
+    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
+    sweep.erase("merge");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    const Json before = plan(file);
+    std::ofstream(dir + "/m.gltf") << test::triangleGltf({{"nodes", R"([{"mesh": 0, "translation": [0, 0.5, 0]}])"}});
+    const Json after = plan(file);
+    for (size_t k = 0; k < 2; ++k) EXPECT_NE(before["runs"][k]["id"], after["runs"][k]["id"]) << k;
+    ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
+    EXPECT_EQ(countOf(log, "] done"), 2u) << log;
+    EXPECT_EQ(countOf(log, "] skip"), 0u) << log;
 }
 
 TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {

@@ -259,7 +259,8 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
 /// infinities (then dropped as degenerate) or puts it beyond float range; both are bad input, not
 /// an object that silently vanishes.
 /// And it must be the object the config describes (sixth probe: a fence with posts at ±1e15 lost
-/// 15 of its 50 triangles and a sphere moved to 1e7 was drawn as a disc, both runs "valid"): a
+/// 15 of its 50 triangles, a sphere of radius 4e10 64 % of its own, and a sphere moved to 1e7 was
+/// drawn as a disc, all runs "valid"): a
 /// generated object that lost triangles to float rounding (`exactCount`: what its generator
 /// makes, 0 when not known exactly, as for a glTF file's own degenerate triangles), or that lies
 /// where a float's spacing exceeds 1 % of its size, is refused, naming the precision there.
@@ -282,8 +283,9 @@ void checkBuilt(const Scene& s, JsonNode& node, size_t exactCount) {
     };
     if (exactCount > 0 && s.triangleCount() < exactCount && s.moving.empty())
         node.failHere(std::to_string(exactCount - s.triangleCount()) + " of its " + std::to_string(exactCount) +
-                      " triangles have no area left in float (" + precision() +
-                      "): make the object larger or move the scene nearer the origin");
+                      " triangles have no normal in float (" + precision() +
+                      "; a triangle needs an area the coordinates' precision can show, and edges below about 1e9 units): "
+                      "move the scene nearer the origin, or change the object's size");
     if (size > 0.0f && spacing > 0.01f * size) {
         char share[96];
         std::snprintf(share, sizeof share, "%.3g units across, would be drawn distorted: ", double(size));

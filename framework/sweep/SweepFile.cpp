@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <fstream>
 #include <set>
 
 namespace shadowlab {
@@ -259,12 +260,73 @@ void checkMergeIds(const Sweep& s, const std::set<std::string>& ids) {
 
 std::string toString(AxisScale scale) { return kScales[size_t(scale)]; }
 
+namespace {
+constexpr uint64_t kFnvBasis = 1469598103934665603ull, kFnvPrime = 1099511628211ull;
+
+/// FNV-1a of a file's bytes, read in blocks; "missing" when it cannot be read (the run then fails
+/// on it, with its own error). Cached by path, size and modification time: a sweep of many runs
+/// over one model reads it once.
+std::string fileFingerprint(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    if (ec) return "missing";
+    const auto time = fs::last_write_time(path, ec).time_since_epoch().count();
+    static std::map<std::string, std::pair<std::pair<uintmax_t, long long>, std::string>> cache;
+    const auto key = std::pair<uintmax_t, long long>{size, (long long)time};
+    if (auto it = cache.find(path); it != cache.end() && it->second.first == key) return it->second.second;
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return "missing";
+    uint64_t h = kFnvBasis;
+    std::vector<char> block(1 << 20);
+    while (in.read(block.data(), std::streamsize(block.size())) || in.gcount() > 0)
+        for (std::streamsize i = 0; i < in.gcount(); ++i) h = (h ^ static_cast<unsigned char>(block[size_t(i)])) * kFnvPrime;
+    char text[24];
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+    cache[path] = {key, text};
+    return text;
+}
+
+/// The files a glTF file's geometry comes from: itself and, for a .gltf, the buffer files its
+/// buffers name (relative, not data: URIs). A file that cannot be read names no buffers.
+std::vector<std::string> gltfFiles(const std::string& gltf) {
+    std::vector<std::string> files = {gltf};
+    try {
+        if (gltf.size() < 5 || gltf.compare(gltf.size() - 5, 5, ".gltf") != 0) return files;
+        const Json doc = JsonNode::parseFile(gltf);
+        if (doc.is_object() && doc.contains("buffers") && doc["buffers"].is_array())
+            for (const Json& b : doc["buffers"])
+                if (b.is_object() && b.contains("uri") && b["uri"].is_string() && !b["uri"].get<std::string>().starts_with("data:"))
+                    files.push_back(resolvePath(parentDir(gltf), b["uri"].get<std::string>()));
+    } catch (const InputError&) {
+    }
+    return files;
+}
+
+void collectGltf(const Json& j, std::vector<std::string>& out) {
+    if (j.is_object()) {
+        for (const auto& [k, v] : j.items())
+            if (k == "gltf" && v.is_string()) out.push_back(v.get<std::string>());
+            else collectGltf(v, out);
+    } else if (j.is_array()) {
+        for (const Json& v : j) collectGltf(v, out);
+    }
+}
+} // namespace
+
 std::string runId(const Json& resolvedConfig) {
     Json j = resolvedConfig;
     if (j.contains("output") && j["output"].is_object()) j["output"].erase("dir");
     // FNV-1a over the canonical dump (nlohmann sorts object keys): stable across runs and machines.
-    uint64_t h = 1469598103934665603ull;
-    for (unsigned char c : j.dump()) h = (h ^ c) * 1099511628211ull;
+    uint64_t h = kFnvBasis;
+    for (unsigned char c : j.dump()) h = (h ^ c) * kFnvPrime;
+    // And over the content of every glTF file the scene reads (sixth probe: a model edited between
+    // two `sweep run`s kept its runs' ids, and the old geometry's results were skipped as complete).
+    std::vector<std::string> gltf;
+    collectGltf(j.value("scene", Json()), gltf);
+    for (const std::string& file : gltf)
+        for (const std::string& part : gltfFiles(file))
+            for (unsigned char c : part + "=" + fileFingerprint(part) + "\n") h = (h ^ c) * kFnvPrime;
     char buf[17];
     std::snprintf(buf, sizeof buf, "%012llx", static_cast<unsigned long long>(h >> 16));
     return buf;
