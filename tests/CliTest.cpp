@@ -216,6 +216,7 @@ TEST(CliTest, AnOptionTwiceOrWithoutItsValueIsBadInput) {
         {"run " + config + " --out --force", "not the option --force"},
         {"run " + config + " --out " + dir + "/a --out " + dir + "/b", "--out is given twice"},
         {"plan " + config + " --triangles 10 --triangles 20", "--triangles is given twice"},
+        {"validate " + config + " --set frames=2 --set frames=3", "--set frames is given twice"},
         {"sweep run " + sweep + " --out " + dir + "/a --out " + dir + "/b", "is given twice"},
         {"sweep run " + sweep + " --out --jobs 2", "not the option --jobs"},
         {"sweep slurm " + sweep + " --out " + dir + "/sw --partition ''", "must not be empty"},

@@ -62,6 +62,7 @@ struct BadCase {
 };
 
 const BadCase kBad[] = {
+    {"images_frame_twice", R"({"frames": 3, "output": {"images_at_frames": [1, 0, 1]}})", "/output/images_at_frames", "listed twice"},
     // Expectations (docs/config.md, `expect`): each entry's problem at its own path.
     {"expect_not_a_list", R"({"expect": {"id": "shadow_map"}})", "/expect", "expected a list"},
     {"expect_unknown_id", R"({"expect": [{"id": "psb", "measure": "overflow", "max": 0}]})", "/expect/0/id", "not an algorithm id"},

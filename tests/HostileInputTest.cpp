@@ -160,6 +160,12 @@ std::vector<BadCase> badCases() {
          {"m.gltf", "/buffers/0/uri", "a URI with a scheme"}},
         {"GltfBufferBadPercentEscape", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "t%zzt.bin"}])"}}),
          {"m.gltf", "/buffers/0/uri", "not followed by two hexadecimal digits"}},
+        // Sixth probe: a node's matrix beside TRS, or a projective matrix, were taken silently.
+        {"GltfMatrixAndTranslation", "m.gltf",
+         test::triangleGltf({{"nodes", R"([{"mesh": 0, "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "translation": [1, 0, 0]}])"}}),
+         {"m.gltf", "/nodes/0/matrix", "not both"}},
+        {"GltfProjectiveMatrix", "m.gltf", test::triangleGltf({{"nodes", R"([{"mesh": 0, "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,2]}])"}}),
+         {"m.gltf", "/nodes/0/matrix", "not an affine transform"}},
         // Sixth probe: a skinned mesh was drawn in its bind pose, morph targets with weights were dropped.
         {"GltfSkinnedMesh", "m.gltf", test::triangleGltf({{"nodes", R"([{"mesh": 0, "skin": 0}])"}, {"skins", R"([{"joints": [0]}])"}}),
          {"m.gltf", "/nodes/0/skin", "skinned meshes are not supported"}},

@@ -168,6 +168,22 @@ TEST(RunSafetyTest, ForceNeverReplacesAFolderTheRunReadsItsInputsFrom) {
     f.expectPreviousKept();
 }
 
+// Sixth probe: validate accepted an output.dir run could not make (/proc/x); a plotter that exits
+// 0 without writing anything (SHADOWLAB_PYTHON=/bin/true) left a run without report.html, unsaid.
+TEST(RunSafetyTest, ValidateTriesTheOutputPlaceAndASilentPlotterIsNamed) {
+    const std::string base = test::makeTempDir("place-and-plotter");
+    std::ofstream(base + "/c.json") << test::configWith({{"output", R"({"dir": "/proc/shadowlab-x", "plots": true})"}});
+    std::string log;
+    EXPECT_EQ(test::runCommand("(" + std::string(SHADOWLAB_BINARY) + " validate " + base + "/c.json >/dev/null)", log), 2) << log;
+    EXPECT_NE(log.find("at /output/dir: cannot create folders in /proc"), std::string::npos) << log;
+    EXPECT_EQ(test::runCommand("(SHADOWLAB_PYTHON=/bin/true " + std::string(SHADOWLAB_BINARY) + " run " + base + "/c.json --no-progress --out " +
+                                   base + "/out --set output.dir=out >/dev/null)",
+                               log),
+              0)
+        << log;
+    EXPECT_NE(log.find("wrote no report.html"), std::string::npos) << log;
+}
+
 TEST(RunSafetyTest, SigtermWhilePlottingStopsThePlotterAndKeepsThePreviousResults) {
     Fixture f("interrupt-plot", 2, true);
     // A plotter that announces itself and then takes far longer than any real plot.

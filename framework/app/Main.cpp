@@ -132,6 +132,16 @@ void checkOverride(const std::string& assignment) {
         usageError("--set " + shortText(path, 80) + ": the path " + why);
 }
 
+/// Adds a checked --set; the same path twice is a usage error, as a key twice in a config file is
+/// (which value was meant?), never the last one silently.
+void addOverride(std::vector<std::string>& overrides, const std::string& assignment) {
+    checkOverride(assignment);
+    const std::string path = assignment.substr(0, assignment.find('='));
+    for (const std::string& o : overrides)
+        if (o.substr(0, o.find('=')) == path) usageError("--set " + shortText(path, 80) + " is given twice");
+    overrides.push_back(assignment);
+}
+
 /// What run and validate check before the first frame, in this order (GL context current): the
 /// memory plan of the predicted scene, before it is made; the scene, made into `cfg` (loaded without
 /// it); each algorithm's fit on it. What validate accepts, run runs.
@@ -222,8 +232,7 @@ int run(const std::vector<std::string>& args) {
             opt.progress = false;
         } else if (a == "--set") {
             if (++i >= args.size()) usageError("--set needs PATH=VALUE");
-            checkOverride(args[i]);
-            overrides.push_back(args[i]);
+            addOverride(overrides, args[i]);
         } else if (!a.empty() && a[0] == '-') {
             usageError("unknown option " + a);
         } else if (config.empty()) {
@@ -287,8 +296,7 @@ int plan(const std::vector<std::string>& args) {
         if (isHelp(args[i])) return commandUsage(kPlanUsage);
         if (args[i] == "--set") {
             if (++i >= args.size()) usageError("--set needs PATH=VALUE");
-            checkOverride(args[i]);
-            overrides.push_back(args[i]);
+            addOverride(overrides, args[i]);
         } else if (args[i] == "--triangles") {
             if (++i >= args.size()) usageError("--triangles needs a count");
             if (triangles > 0) usageError("--triangles is given twice");
@@ -431,8 +439,7 @@ static int dispatch(std::vector<std::string> args) {
                 if (isHelp(args[i])) return commandUsage(kValidateUsage);
                 if (args[i] == "--set") {
                     if (++i >= args.size()) usageError("--set needs PATH=VALUE");
-                    checkOverride(args[i]);
-                    overrides.push_back(args[i]);
+                    addOverride(overrides, args[i]);
                 } else if (config.empty() && !args[i].empty() && args[i][0] != '-') {
                     config = args[i];
                 } else {

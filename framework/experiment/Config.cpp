@@ -307,9 +307,13 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     c.outputDir = out.getPath("dir", "results/" + c.name);
     if (const std::string why = pathTextProblem(c.outputDir); !why.empty()) out.fail("dir", "the folder's name " + why);
     c.imagesAtFrames = out.getIntList("images_at_frames", {0});
-    for (int f : c.imagesAtFrames)
+    for (size_t k = 0; k < c.imagesAtFrames.size(); ++k) {
+        const int f = c.imagesAtFrames[k];
         if (f < 0 || f >= c.frames)
             out.fail("images_at_frames", "frame " + std::to_string(f) + " is outside [0, " + std::to_string(c.frames - 1) + "]");
+        if (std::find(c.imagesAtFrames.begin(), c.imagesAtFrames.begin() + long(k), f) != c.imagesAtFrames.begin() + long(k))
+            out.fail("images_at_frames", "frame " + std::to_string(f) + " is listed twice");
+    }
     c.plots = out.getBool("plots", true);
     out.finish();
     root.finish();

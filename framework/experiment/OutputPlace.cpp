@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <set>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -332,15 +333,26 @@ bool isSweepMade(const fs::path& entry) {
 bool isFormerSweep(const fs::path& dir) {
     std::error_code ec;
     if (!fs::is_directory(fs::symlink_status(dir / "runs", ec)) || !isRegularFile(dir / "plan.json")) return false;
+    std::set<std::string> ids;
     try {
         const Json plan = JsonNode::parseFile((dir / "plan.json").string());
-        if (!plan.is_object() || !plan.contains("axes") || !plan.contains("runs")) return false;
+        if (!plan.is_object() || !plan.contains("axes") || !plan.contains("runs") || !plan["runs"].is_array()) return false;
+        for (const Json& r : plan["runs"])
+            if (r.is_object() && r.contains("id") && r["id"].is_string()) ids.insert(r["id"].get<std::string>());
     } catch (const InputError&) {
         return false;
     }
     for (const auto& e : fs::directory_iterator(dir, ec))
         if (!isSweepMade(e.path())) return false;
-    return !ec;
+    // And runs/ holds that plan's runs, nothing else (a plan.json copied beside a folder of the
+    // user's does not make it a sweep's): each entry an ID or ID.config.json, ID.log, ...
+    size_t slots = 0;
+    for (const auto& e : fs::directory_iterator(dir / "runs", ec)) {
+        const std::string n = e.path().filename().string();
+        if (!ids.count(n.substr(0, n.find('.')))) return false;
+        ++slots;
+    }
+    return !ec && slots > 0;
 }
 } // namespace
 
@@ -364,7 +376,17 @@ void OutputPlace::checkSweepPlace(const std::string& given) {
 }
 
 void OutputPlace::check(const std::string& given, const std::string& runConfig) {
-    checkPlace(normalize(given), runConfig, "results/run1");
+    const std::string dir = normalize(given);
+    checkPlace(dir, runConfig, "results/run1");
+    // What run will do first, tried: make a folder beside DIR, in the nearest folder that exists
+    // (sixth probe: validate accepted output.dir=/proc/x, which run then could not make).
+    std::error_code ec;
+    fs::path parent = fs::absolute(fs::path(dir), ec).parent_path();
+    while (!parent.empty() && !fs::exists(fs::symlink_status(parent, ec)) && parent != parent.parent_path()) parent = parent.parent_path();
+    std::string probe = (parent / ".shadowlab-probe-XXXXXX").string();
+    if (!::mkdtemp(probe.data()))
+        throw InputError(shortPath(dir), "", "cannot create folders in " + shortPath(parent.string()) + ": " + std::strerror(errno));
+    ::rmdir(probe.c_str());
 }
 
 namespace {

@@ -77,6 +77,10 @@ void runPlots(const std::string& dir, const std::string& finalDir, const std::st
     std::string log = dir + "/plots.log";
     if (runChildProcess({python && *python ? python : SHADOWLAB_PLOT_PYTHON, script, dir, timeSource}, log) != 0)
         std::fprintf(stderr, "warning: plotting failed (see %s/plots.log); tables and images are complete\n", finalDir.c_str());
+    else if (!std::filesystem::exists(dir + "/report.html"))
+        // An interpreter that exits 0 without doing the work (a wrong SHADOWLAB_PYTHON) is said too.
+        std::fprintf(stderr, "warning: the plotter exited 0 but wrote no report.html (see %s/plots.log); tables and images are complete\n",
+                     finalDir.c_str());
     else
         std::filesystem::remove(log);
 }

@@ -340,6 +340,26 @@ void checkDeformations(const Json& doc, const std::string& file) {
         }
 }
 
+/// A node's local transform as glTF 2.0 allows it: a matrix or translation/rotation/scale, not
+/// both (the reader took the matrix silently), and a matrix that is affine (last row 0 0 0 1: a
+/// projective part would be dropped silently).
+void checkNodeTransforms(const Json& doc, const std::string& file) {
+    if (!doc.contains("nodes")) return;
+    for (size_t n = 0; n < doc["nodes"].size(); ++n) {
+        const Json& node = doc["nodes"][n];
+        if (!node.is_object() || !node.contains("matrix")) continue;
+        const std::string where = "/nodes/" + std::to_string(n) + "/matrix";
+        for (const char* trs : {"translation", "rotation", "scale"})
+            if (node.contains(trs))
+                throw InputError(file, where, std::string("a node has a matrix or translation/rotation/scale, not both (this one also has \"") +
+                                                  trs + "\")");
+        const Json& m = node["matrix"];
+        if (!m.is_array() || m.size() != 16) continue;  // the schema says what is wrong with it
+        if (!(m[3] == 0 && m[7] == 0 && m[11] == 0 && m[15] == 1))
+            throw InputError(file, where, "not an affine transform: its last row (elements 3, 7, 11 and 15, column-major) must be 0 0 0 1");
+    }
+}
+
 /// What the glTF reader (tinygltf) refuses without saying where (or saying it by echoing the
 /// file's text), checked first so that the error names its JSON path: a byteStride outside 4..252
 /// or not a multiple of 4; a buffer without a uri outside a GLB's first; a data URI the reader
@@ -1129,6 +1149,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
     checkVersion(doc, file);
     TypeChecker(file).checkObject(doc, kRoot, "");
     checkDeformations(doc, file);
+    checkNodeTransforms(doc, file);
     checkWhatTheReaderRefuses(doc, file, binary, binary ? glbBinLength(bytes) : 0);
 
     tinygltf::TinyGLTF loader;

@@ -102,7 +102,10 @@ bool RunPaths::complete(std::string* why) const {
         return false;
     };
     if (!fs::is_directory(slot)) return fail("runs/" + id + " is not a folder of its own (a link or a file)");
-    if (!fs::exists(fs::symlink_status(summary, ec))) return fail("the run's folder has no summary.json");
+    const fs::file_status summaryStatus = fs::symlink_status(summary, ec);
+    if (!fs::exists(summaryStatus)) return fail("the run's folder has no summary.json");
+    // A run writes its summary itself: a link there is another file's, not this run's result.
+    if (fs::is_symlink(summaryStatus)) return fail("summary.json is a symbolic link, not the run's own file");
     try {
         const Json s = JsonNode::parseFile(summary);
         if (!(s.is_object() && s.contains("complete") && s["complete"] == true)) return fail("summary.json does not say \"complete\": true");
