@@ -4,6 +4,7 @@
 #include "framework/experiment/Compare.h"
 #include "framework/experiment/Config.h"
 #include "framework/experiment/Runner.h"
+#include "tests/SmallExperiment.h"
 #include "tests/TestSupport.h"
 
 namespace shadowlab {
@@ -12,18 +13,10 @@ namespace {
 using test::GLTest;
 
 Json comparedConfig() {
-    return {{"name", "compared"},
-            {"resolution", {64, 64}},
-            {"frames", 3},
-            {"warmup_frames", 1},
-            {"repeats", 5},
-            {"scene", {{"objects", Json::array({{{"procedural", "plane"}, {"size", {8, 8}}},
-                                                {{"procedural", "sphere"}, {"radius", 0.8}, {"transform", {{"translate", {0, 1.0, 0}}}}}})}}},
-            {"camera", {{"position", {0.5, 5, 4}}, {"target", {0, 0, 0}}}},
-            {"light", {{"type", "point"}, {"position", {0.7, 5, 0.4}}}},
-            {"algorithms", Json::array({{{"algorithm", "psv"}}, {{"algorithm", "bvh_raytrace"}}})},
-            {"statistics", "none"},
-            {"output", {{"plots", false}, {"images_at_frames", {2}}}}};
+    Json c = test::sphereOverPlane("compared");
+    c["repeats"] = 5;
+    c["output"]["images_at_frames"] = {2};
+    return c;
 }
 
 void runInto(const std::string& dir) {

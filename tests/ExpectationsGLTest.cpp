@@ -3,6 +3,7 @@
 // slower). The clean build meets the same expectations.
 #include "framework/experiment/Config.h"
 #include "framework/experiment/Runner.h"
+#include "tests/SmallExperiment.h"
 #include "tests/TestSupport.h"
 
 namespace shadowlab {
@@ -11,18 +12,9 @@ namespace {
 using test::GLTest;
 
 Json plantedConfig(const Json& expect) {
-    return {{"name", "planted"},
-            {"resolution", {64, 64}},
-            {"frames", 3},
-            {"warmup_frames", 1},
-            {"scene", {{"objects", Json::array({{{"procedural", "plane"}, {"size", {8, 8}}},
-                                                {{"procedural", "sphere"}, {"radius", 0.8}, {"transform", {{"translate", {0, 1.0, 0}}}}}})}}},
-            {"camera", {{"position", {0.5, 5, 4}}, {"target", {0, 0, 0}}}},
-            {"light", {{"type", "point"}, {"position", {0.7, 5, 0.4}}}},
-            {"algorithms", Json::array({{{"algorithm", "psv"}}, {{"algorithm", "bvh_raytrace"}}})},
-            {"statistics", "none"},
-            {"expect", expect},
-            {"output", {{"plots", false}}}};
+    Json c = test::sphereOverPlane("planted");
+    c["expect"] = expect;
+    return c;
 }
 
 Json records(const Json& config) {

@@ -5,6 +5,7 @@
 #include "framework/experiment/Config.h"
 #include "framework/experiment/Runner.h"
 #include "framework/gl/GlContext.h"
+#include "tests/SmallExperiment.h"
 #include "tests/TestSupport.h"
 
 #include <filesystem>
@@ -15,16 +16,13 @@ namespace {
 using test::GLTest;
 
 Json smallConfig() {
-    return {{"name", "integrity"},
-            {"resolution", {32, 32}},
-            {"frames", 2},
-            {"warmup_frames", 0},
-            {"scene", {{"objects", Json::array({{{"procedural", "plane"}, {"size", {8, 8}}},
-                                                {{"procedural", "sphere"}, {"radius", 0.8}, {"transform", {{"translate", {0, 1.0, 0}}}}}})}}},
-            {"camera", {{"position", {0.5, 5, 4}}, {"target", {0, 0, 0}}}},
-            {"light", {{"type", "point"}, {"position", {0.7, 5, 0.4}}}},
-            {"algorithms", Json::array({{{"algorithm", "psv"}}})},
-            {"output", {{"plots", false}}}};
+    Json c = test::sphereOverPlane("integrity");
+    c["resolution"] = {32, 32};
+    c["frames"] = 2;
+    c["warmup_frames"] = 0;
+    c["algorithms"] = Json::array({{{"algorithm", "psv"}}});
+    c["statistics"] = "images";
+    return c;
 }
 
 class RunIntegrityGLTest : public GLTest {};

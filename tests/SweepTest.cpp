@@ -254,10 +254,7 @@ TEST(SweepTest, KilledMidwayThenRestartedRunsOnlyTheMissingRuns) {
 // is this run's config.
 TEST(SweepTest, AnotherRunsResultsInASlotAreNotThisRun) {
     const std::string dir = test::makeTempDir("sweep-foreign-slot");
-    Json sweep = test::smallSweep();
-    sweep["base"]["frames"] = 1;
-    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
-    sweep.erase("merge");
+    Json sweep = test::twoRunSweep();
     const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
     std::string log;
     ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
@@ -283,10 +280,8 @@ TEST(SweepTest, AnotherRunsResultsInASlotAreNotThisRun) {
 // folder without sweep.json is taken (its runs with equal ids kept); with a file of the user's in it, not.
 TEST(SweepTest, AMergedSweepsFolderWithoutItsSnapshotGoesToANewSweep) {
     const std::string dir = test::makeTempDir("sweep-handover");
-    Json sweep = test::smallSweep();
-    sweep["base"]["frames"] = 1;
-    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0]}}])");
-    sweep.erase("merge");
+    Json sweep = test::twoRunSweep();
+    sweep["axes"][0]["values"]["algorithms.0.params.pcf"] = Json::array({0});  // one run, then two
     const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
     std::string log;
     ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
@@ -312,10 +307,7 @@ TEST(SweepTest, AMergedSweepsFolderWithoutItsSnapshotGoesToANewSweep) {
 // place (the snapshot's output.dir). The snapshot's own folder is the sweep's: it resumes there.
 TEST(SweepTest, AMovedSweepResumesFromItsSnapshotInPlace) {
     const std::string dir = test::makeTempDir("sweep-moved");
-    Json sweep = test::smallSweep();
-    sweep["base"]["frames"] = 1;
-    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
-    sweep.erase("merge");
+    Json sweep = test::twoRunSweep();
     const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out", moved = dir + "/moved";
     std::string log;
     ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;
@@ -331,11 +323,8 @@ TEST(SweepTest, AMovedSweepResumesFromItsSnapshotInPlace) {
 // says so on its line, and exits 3 itself, also when it resumes.
 TEST(SweepTest, RunsWithUnmetExpectationsAreCompleteAndTheSweepExitsThree) {
     const std::string dir = test::makeTempDir("sweep-expect");
-    Json sweep = test::smallSweep();
-    sweep["base"]["frames"] = 1;
+    Json sweep = test::twoRunSweep();
     sweep["base"]["expect"] = Json::parse(R"([{"id": "shadow_map", "measure": "memory_bytes", "max": 1}])");
-    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
-    sweep.erase("merge");
     const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
     std::string log;
     EXPECT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 3) << log;
@@ -352,11 +341,8 @@ TEST(SweepTest, RunsWithUnmetExpectationsAreCompleteAndTheSweepExitsThree) {
 TEST(SweepTest, EditingAGltfFileGivesItsRunsNewIds) {
     const std::string dir = test::makeTempDir("sweep-gltf-edit");
     std::ofstream(dir + "/m.gltf") << test::triangleGltf({});
-    Json sweep = test::smallSweep();
-    sweep["base"]["frames"] = 1;
+    Json sweep = test::twoRunSweep();
     sweep["base"]["scene"]["objects"][1] = Json::parse(R"({"gltf": "m.gltf"})");
-    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
-    sweep.erase("merge");
     const std::string file = test::writeJson(dir + "/s.sweep.json", sweep), out = dir + "/out";
     std::string log;
     ASSERT_EQ(test::runCommand(bin() + " sweep run " + file + " --out " + out, log), 0) << log;

@@ -41,6 +41,16 @@ inline Json smallSweep() {
 })");
 }
 
+/// smallSweep() cut to two runs of one frame (an axis of pcf 0 and 1), no merge section: for the
+/// tests about a sweep's folder and slots rather than its tables.
+inline Json twoRunSweep() {
+    Json sweep = smallSweep();
+    sweep["base"]["frames"] = 1;
+    sweep["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}}])");
+    sweep.erase("merge");
+    return sweep;
+}
+
 inline std::string writeJson(const std::string& path, const Json& j) {
     std::ofstream(path) << j.dump(2);
     return path;

@@ -173,4 +173,19 @@ std::string markdownLiteral(const std::string& text) {
     return out;
 }
 
+std::string xmlText(const std::string& text) {
+    std::string out;
+    for (char c : validUtf8(text)) {
+        const unsigned char u = static_cast<unsigned char>(c);
+        if (c == '&') out += "&amp;";
+        else if (c == '<') out += "&lt;";
+        else if (c == '>') out += "&gt;";
+        else if (c == '"') out += "&quot;";
+        else if (c == '\'') out += "&apos;";
+        else if (u < 0x20 && c != '\t' && c != '\n') out += '?';
+        else out += c;
+    }
+    return out;
+}
+
 } // namespace shadowlab

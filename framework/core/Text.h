@@ -49,6 +49,10 @@ bool isFileName(const std::string& name);
 /// a paragraph or a table cell (scripts/report_html.py's literal() is the same rule).
 std::string markdownLiteral(const std::string& text);
 
+/// `text` as XML character data or an attribute value (JUnit files): & < > " ' escaped, bytes that
+/// are not well-formed UTF-8 and C0 controls but tab and newline (which XML 1.0 cannot hold) as '?'.
+std::string xmlText(const std::string& text);
+
 /// `text` for one line of output: control characters and invalid bytes shown as '?', cut to
 /// `maxChars` with "..." after it.
 std::string shortText(const std::string& text, size_t maxChars = kMaxEchoChars);

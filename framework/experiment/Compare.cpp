@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/Text.h"
+#include "framework/experiment/JUnit.h"
 #include "framework/metrics/Noise.h"
 
 #include <algorithm>
@@ -303,50 +304,22 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
     return os.str();
 }
 
-namespace {
-std::string xml(const std::string& text) {
-    std::string out;
-    for (char ch : validUtf8(text)) {
-        const unsigned char u = static_cast<unsigned char>(ch);
-        if (ch == '&') out += "&amp;";
-        else if (ch == '<') out += "&lt;";
-        else if (ch == '>') out += "&gt;";
-        else if (ch == '"') out += "&quot;";
-        else if (u < 0x20 && ch != '\t' && ch != '\n') out += '?';
-        else out += ch;
-    }
-    return out;
-}
-} // namespace
 
 std::string comparisonJUnit(const Comparison& c) {
-    std::ostringstream cases;
-    size_t tests = 0, failures = 0;
+    std::vector<JUnitCase> cases;
     for (const Json& r : c.records) {
         if (r["present"] != "both") continue;
         const std::string id = r["id"].get<std::string>();
-        auto testCase = [&](const std::string& name, const std::string& failure) {
-            ++tests;
-            cases << "    <testcase classname=\"" << xml(id) << "\" name=\"" << xml(name) << "\" time=\"0\"";
-            if (failure.empty()) {
-                cases << "/>\n";
-                return;
-            }
-            ++failures;
-            cases << ">\n      <failure message=\"" << xml(failure) << "\">" << xml(failure) << "</failure>\n    </testcase>\n";
-        };
         auto regression = [&](const std::string& start) {
             for (const Json& g : r["regressions"])
                 if (g.get<std::string>().starts_with(start)) return g.get<std::string>();
             return std::string();
         };
-        testCase("total time not slower", regression("total time"));
-        if (r.contains("accuracy")) testCase("accuracy not worse", regression("worst-frame mismatch"));
-        testCase("overflow not more", regression("overflow"));
+        cases.push_back({id, "total time not slower", regression("total time")});
+        if (r.contains("accuracy")) cases.push_back({id, "accuracy not worse", regression("worst-frame mismatch")});
+        cases.push_back({id, "overflow not more", regression("overflow")});
     }
-    return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites tests=\"" + std::to_string(tests) + "\" failures=\"" +
-           std::to_string(failures) + "\">\n  <testsuite name=\"shadowlab compare\" tests=\"" + std::to_string(tests) + "\" failures=\"" +
-           std::to_string(failures) + "\" errors=\"0\">\n" + cases.str() + "  </testsuite>\n</testsuites>\n";
+    return junitXml("shadowlab compare", cases, 0.0);
 }
 
 } // namespace shadowlab

@@ -2,6 +2,7 @@
 
 #include "framework/core/Error.h"
 #include "framework/core/Text.h"
+#include "framework/experiment/JUnit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -190,45 +191,15 @@ std::string expectationLine(const Json& r) {
            bound + "; " + where + ")";
 }
 
-namespace {
-/// `text` as XML character data or attribute value: markup characters escaped, characters XML 1.0
-/// cannot hold (C0 controls but tab and newline, invalid UTF-8) as '?'.
-std::string xmlText(const std::string& text) {
-    std::string out;
-    for (char c : validUtf8(text)) {
-        const unsigned char u = static_cast<unsigned char>(c);
-        if (c == '&') out += "&amp;";
-        else if (c == '<') out += "&lt;";
-        else if (c == '>') out += "&gt;";
-        else if (c == '"') out += "&quot;";
-        else if (c == '\'') out += "&apos;";
-        else if (u < 0x20 && c != '\t' && c != '\n') out += '?';
-        else out += c;
-    }
-    return out;
-}
-} // namespace
 
 std::string expectationsJUnit(const std::string& experiment, const Json& records, double wallSeconds) {
-    size_t failures = 0;
-    for (const Json& r : records) failures += r.value("passed", false) ? 0 : 1;
-    std::string x = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    x += "<testsuites tests=\"" + std::to_string(records.size()) + "\" failures=\"" + std::to_string(failures) + "\">\n";
-    x += "  <testsuite name=\"shadowlab expectations: " + xmlText(experiment) + "\" tests=\"" + std::to_string(records.size()) +
-         "\" failures=\"" + std::to_string(failures) + "\" errors=\"0\" time=\"" + number(wallSeconds) + "\">\n";
+    std::vector<JUnitCase> cases;
     for (const Json& r : records) {
         const std::string rel = r["relative_to"].is_null() ? "" : " / " + r["relative_to"].get<std::string>();
-        x += "    <testcase classname=\"" + xmlText(r["id"].get<std::string>()) + "\" name=\"" +
-             xmlText(r["measure"].get<std::string>() + rel + " " + r["where"].get<std::string>()) + "\" time=\"0\"";
-        if (r.value("passed", false)) {
-            x += "/>\n";
-        } else {
-            const std::string why = r.value("why", std::string());
-            x += ">\n      <failure message=\"" + xmlText(why) + "\">" + xmlText(why) + "</failure>\n    </testcase>\n";
-        }
+        cases.push_back({r["id"].get<std::string>(), r["measure"].get<std::string>() + rel + " " + r["where"].get<std::string>(),
+                         r.value("passed", false) ? std::string() : r.value("why", std::string())});
     }
-    x += "  </testsuite>\n</testsuites>\n";
-    return x;
+    return junitXml("shadowlab expectations: " + experiment, cases, wallSeconds);
 }
 
 } // namespace shadowlab
