@@ -47,15 +47,31 @@ std::vector<double> numbers(const Json& j) {
 
 size_t repetitionCount(const Json& a) { return a.contains("repetitions") ? a["repetitions"].value("count", size_t(1)) : 1; }
 
+/// `x` divided element by element by `by` (the yardstick's samples of the same passes or frames);
+/// empty when they do not pair up.
+std::vector<double> over(const std::vector<double>& x, const std::vector<double>& by) {
+    if (by.empty()) return x;
+    std::vector<double> out;
+    if (x.size() != by.size()) return out;
+    for (size_t k = 0; k < x.size(); ++k)
+        if (by[k] > 0) out.push_back(x[k] / by[k]);
+    return out;
+}
+
 /// One stage's time, BASE → NEW: the ratio of the medians with its interval, from the passes'
 /// means when both ran 3 or more (independent samples, U test too), else from the first pass's
 /// frames paired one to one (the same views), else the ratio of the means without an interval.
-Json compareStage(const Json& a, const Json& b, const std::string& stage, double threshold) {
+/// With a yardstick (`--relative-to`), each pass's (or frame's) time is first divided by the
+/// yardstick's total of the same pass in the same run: a machine that got slower between the
+/// two runs slows both, and the quotient keeps only what changed in the algorithm.
+Json compareStage(const Json& a, const Json& b, const std::string& stage, double threshold, const Json* ya, const Json* yb) {
     Json r = {{"stage", stage}};
     Interval ci;
     std::string method;
+    auto passes = [&](const Json& e, const std::string& s) { return numbers(e["repetitions"]["time_ms"].value(s, Json())); };
     if (repetitionCount(a) >= 3 && repetitionCount(b) >= 3) {
-        const auto x = numbers(a["repetitions"]["time_ms"].value(stage, Json())), y = numbers(b["repetitions"]["time_ms"].value(stage, Json()));
+        const auto x = over(passes(a, stage), ya ? passes(*ya, "total") : std::vector<double>{});
+        const auto y = over(passes(b, stage), yb ? passes(*yb, "total") : std::vector<double>{});
         ci = bootstrapRatioOfMedians(x, y);
         r["base"] = medianOf(x);
         r["new"] = medianOf(y);
@@ -63,22 +79,25 @@ Json compareStage(const Json& a, const Json& b, const std::string& stage, double
         method = "repetitions";
     } else if (stage == "total" && a.contains("total_ms_per_frame") && b.contains("total_ms_per_frame") &&
                a["total_ms_per_frame"].size() == b["total_ms_per_frame"].size() && a["total_ms_per_frame"].size() >= 3) {
-        const auto x = numbers(a["total_ms_per_frame"]), y = numbers(b["total_ms_per_frame"]);
+        const auto x = over(numbers(a["total_ms_per_frame"]), ya ? numbers((*ya)["total_ms_per_frame"]) : std::vector<double>{});
+        const auto y = over(numbers(b["total_ms_per_frame"]), yb ? numbers((*yb)["total_ms_per_frame"]) : std::vector<double>{});
         std::vector<double> ratios;
-        for (size_t k = 0; k < x.size(); ++k)
+        for (size_t k = 0; k < std::min(x.size(), y.size()); ++k)
             if (x[k] > 0) ratios.push_back(y[k] / x[k]);
         ci = bootstrapMedian(ratios);
         r["base"] = medianOf(x);
         r["new"] = medianOf(y);
         method = "frames paired";
     } else {
-        const double x = a["time_ms"].contains(stage) ? a["time_ms"][stage].value("mean", 0.0) : 0.0;
-        const double y = b["time_ms"].contains(stage) ? b["time_ms"][stage].value("mean", 0.0) : 0.0;
+        auto mean = [&](const Json& e, const std::string& s) { return e["time_ms"].contains(s) ? e["time_ms"][s].value("mean", 0.0) : 0.0; };
+        const double x = mean(a, stage) / (ya ? std::max(mean(*ya, "total"), 1e-300) : 1.0);
+        const double y = mean(b, stage) / (yb ? std::max(mean(*yb, "total"), 1e-300) : 1.0);
         r["base"] = x;
         r["new"] = y;
         ci.median = x > 0 ? y / x : 0;
         method = "means only";
     }
+    if (ya) method += ", over the yardstick";
     r["ratio"] = ci.median;
     r["low"] = ci.valid ? Json(ci.low) : Json();
     r["high"] = ci.valid ? Json(ci.high) : Json();
@@ -182,11 +201,47 @@ std::vector<std::string> configDifferences(const std::string& baseDir, const std
     return keys;
 }
 
+/// The yardstick of `--relative-to`: an id's entry, or for "*" one made of the geometric mean of
+/// every id's total time, pass by pass and frame by frame (the machine's speed in that pass, as
+/// all the algorithms saw it; one algorithm's change moves it by a share only).
+Json yardstickOf(const Json& summary, const std::string& id) {
+    if (id != "*") return summary["algorithms"][id];
+    std::vector<std::vector<double>> passes, frames;
+    std::vector<double> means;
+    for (const auto& [name, e] : summary["algorithms"].items()) {
+        passes.push_back(numbers(e.contains("repetitions") ? e["repetitions"]["time_ms"].value("total", Json()) : Json()));
+        frames.push_back(numbers(e.value("total_ms_per_frame", Json())));
+        means.push_back(e["time_ms"].contains("total") ? e["time_ms"]["total"].value("mean", 0.0) : 0.0);
+    }
+    auto geomean = [](const std::vector<std::vector<double>>& rows) {
+        std::vector<double> out;
+        if (rows.empty()) return out;
+        for (size_t k = 0; k < rows.front().size(); ++k) {
+            double logSum = 0;
+            for (const auto& row : rows) logSum += k < row.size() && row[k] > 0 ? std::log(row[k]) : 0.0;
+            out.push_back(std::exp(logSum / double(rows.size())));
+        }
+        return out;
+    };
+    Json y;
+    y["repetitions"] = {{"count", passes.empty() ? 1 : passes.front().size()}, {"time_ms", {{"total", geomean(passes)}}}};
+    y["total_ms_per_frame"] = geomean(frames);
+    double logSum = 0;
+    for (double m : means) logSum += m > 0 ? std::log(m) : 0.0;
+    y["time_ms"] = {{"total", {{"mean", means.empty() ? 0.0 : std::exp(logSum / double(means.size()))}}}};
+    return y;
+}
+
 } // namespace
 
 Comparison compareRuns(const std::string& baseDir, const std::string& newDir, const CompareOptions& opt) {
     const Json base = readSummary(baseDir), next = readSummary(newDir);
     Comparison c;
+    if (!opt.relativeTo.empty() && opt.relativeTo != "*" &&
+        !(base["algorithms"].contains(opt.relativeTo) && next["algorithms"].contains(opt.relativeTo)))
+        throw InputError("--relative-to", "", "\"" + shortText(opt.relativeTo, 60) + "\" is not an algorithm id of both runs (or \"*\")");
+    const Json baseYardstick = opt.relativeTo.empty() ? Json() : yardstickOf(base, opt.relativeTo);
+    const Json newYardstick = opt.relativeTo.empty() ? Json() : yardstickOf(next, opt.relativeTo);
     if (const auto keys = configDifferences(baseDir, newDir); !keys.empty()) {
         std::string list;
         for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
@@ -210,7 +265,11 @@ Comparison compareRuns(const std::string& baseDir, const std::string& newDir, co
         const Json& a = base["algorithms"][id];
         const Json& b = next["algorithms"][id];
         Json time = Json::array();
-        for (const std::string& stage : stagesOf(a, b)) time.push_back(compareStage(a, b, stage, opt.threshold));
+        const Json* ya = opt.relativeTo.empty() || id == opt.relativeTo ? nullptr : &baseYardstick;
+        const Json* yb = opt.relativeTo.empty() || id == opt.relativeTo ? nullptr : &newYardstick;
+        for (const std::string& stage : stagesOf(a, b)) time.push_back(compareStage(a, b, stage, opt.threshold, ya, yb));
+        // The yardstick itself is compared as it is, but it measures the machine: never a regression.
+        if (!opt.relativeTo.empty() && id == opt.relativeTo) time.back()["verdict"] = "the yardstick";
         r["time"] = time;
         if (time.back()["verdict"] == "slower")
             r["regressions"].push_back("total time " + number(time.back()["ratio"].get<double>()) + "× (95 % interval " +
@@ -256,6 +315,9 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
     std::ostringstream os;
     os << "# Comparison\n\n- base: " << markdownLiteral(baseDir) << "\n- new: " << markdownLiteral(newDir) << "\n- threshold: "
        << number(100 * opt.threshold) << " % (a time counts as slower or faster only past it, with its whole 95 % interval on one side of 1)\n";
+    if (!opt.relativeTo.empty())
+        os << "- times relative to " << markdownLiteral(opt.relativeTo)
+           << "'s total of the same pass (base and new columns are quotients, not milliseconds)\n";
     for (const auto& n : c.notes) os << "- **note**: " << markdownLiteral(n) << "\n";
     os << "\n## " << (c.regressions ? std::to_string(c.regressions) + " regressions" : std::string("No regression")) << "\n\n";
     for (const Json& r : c.records)

@@ -14,12 +14,15 @@
 
 namespace shadowlab {
 
-const char* kCompareUsage = R"(  shadowlab compare BASE NEW [--threshold PCT] [--out DIR] [--force]
+const char* kCompareUsage = R"(  shadowlab compare BASE NEW [--threshold PCT] [--relative-to ID] [--out DIR] [--force]
       What changed from run folder BASE to run folder NEW, per algorithm id: each stage's time
       (ratio, 95 % interval, faster / slower / within noise), accuracy, overflow, memory, counters
-      and the saved images' changed pixels. A regression: total time slower past PCT (default 5) %
+      and the saved images' changed pixels. A regression: total time slower past PCT (default 10) %
       with its whole interval above 1, accuracy worse past PCT %, or more overflow. Markdown on
       standard output, or with --out: DIR/compare.md, compare.html, compare.junit.xml and images/.
+      --relative-to ID divides every time by ID's total of the same pass first ("*": by the
+      geometric mean of every id's): on a shared machine whose load changed between the runs,
+      only what changed relative to it remains.
       Exit code 0 without regression, 3 with one.
 )";
 
@@ -68,6 +71,9 @@ int compareCommand(const std::vector<std::string>& args) {
             if (thresholdGiven) throw InputError(a, "", "is given twice");
             opt.threshold = parseThreshold(value("a percentage"));
             thresholdGiven = true;
+        } else if (a == "--relative-to") {
+            if (!opt.relativeTo.empty()) throw InputError(a, "", "is given twice");
+            opt.relativeTo = value("an algorithm id");
         } else if (a == "--out") {
             if (!out.empty()) throw InputError(a, "", "is given twice");
             out = value("a folder");
