@@ -256,6 +256,33 @@ TEST(CliTest, UnmetExpectationsExitThreeWithEveryResultWritten) {
     EXPECT_NE(log.find("expectations: all 2 met"), std::string::npos) << log;
 }
 
+// compare on the command line: two run folders give a report and exit 0 for one build against
+// itself; bad arguments are one line and exit 2; --out writes the report, JUnit and json.
+TEST(CliTest, CompareTwoRunsAndRefuseBadArguments) {
+    const std::string dir = test::makeTempDir("cli-compare");
+    std::ofstream(dir + "/c.json") << test::configWith({});
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin() + " run " + dir + "/c.json --out " + dir + "/a --no-progress", log), 0) << log;
+    EXPECT_EQ(test::runCommand("(" + bin() + " compare " + dir + "/a " + dir + "/a >" + dir + "/same.md)", log), 0) << log;
+    std::ifstream same(dir + "/same.md");
+    const std::string md((std::istreambuf_iterator<char>(same)), {});
+    EXPECT_NE(md.find("## No regression"), std::string::npos) << md;
+    EXPECT_EQ(test::runCommand(bin() + " compare " + dir + "/a " + dir + "/a --relative-to '*' --out " + dir + "/cmp", log), 0) << log;
+    for (const char* f : {"compare.md", "compare.html", "compare.junit.xml", "compare.json"})
+        EXPECT_TRUE(std::filesystem::exists(dir + "/cmp/" + f)) << f;
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {"compare " + dir + "/a", "expects two run folders"},
+        {"compare " + dir + "/a " + dir + "/a --threshold x", "expected a percentage"},
+        {"compare " + dir + "/a " + dir + "/a --relative-to nope", "not an algorithm id of both runs"},
+        {"compare " + dir + "/a " + dir, "is not a run's output folder"},
+    };
+    for (const auto& [args, cause] : bad) {
+        EXPECT_EQ(test::runCommand("(" + bin() + " " + args + " >/dev/null)", log), 2) << args << ": " << log;
+        EXPECT_NE(log.find(cause), std::string::npos) << args << ": " << log;
+        EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << log;
+    }
+}
+
 TEST(CliTest, UnknownCommandIsBadInput) {
     std::string out;
     EXPECT_EQ(test::runCommand(bin() + " frobnicate", out), 2);

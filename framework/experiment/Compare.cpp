@@ -24,7 +24,9 @@ namespace {
 
 Json readSummary(const std::string& dir) {
     const std::string file = dir + "/summary.json";
-    if (!fs::is_directory(dir)) throw InputError(shortText(dir, 300), "", "is not a run's output folder (it should hold summary.json)");
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec) || !fs::exists(file, ec))
+        throw InputError(shortText(dir, 300), "", "is not a run's output folder (it holds no summary.json)");
     const Json s = JsonNode::parseFile(file);
     if (!s.is_object() || s.value("complete", false) != true || !s.contains("algorithms") || !s["algorithms"].is_object())
         throw InputError(shortText(file, 300), "", "is not a complete run's summary (no \"complete\": true and \"algorithms\")");
