@@ -188,6 +188,7 @@ Footprint shadowMapFootprint(const FootprintQuery& q) {
     const size_t r = size_t(std::get<int>(q.params->get("resolution")));
     Footprint f;
     f.bytes = saturatingMul(saturatingMul(r, r), 7 * 14);
+    f.textureBytes = f.bytes;
     return f;
 }
 

@@ -94,6 +94,9 @@ struct Footprint {
     size_t bytes = 0;     ///< held for the run: its structures, copies of the scene, per-pixel images (host + GPU:
                           ///< a software renderer keeps GPU buffers in host memory)
     size_t peakBytes = 0; ///< held only while setScene() runs, on top of `bytes` (e.g. a clustering's working set)
+    /// Of `bytes`, what lies in textures: freed by the driver as soon as the algorithm is destroyed
+    /// (llvmpipe keeps a destroyed algorithm's buffers, not its textures, until the run ends).
+    size_t textureBytes = 0;
     std::string refusal;  ///< not empty: this algorithm cannot run the scene on this device, and why
 };
 
