@@ -182,8 +182,7 @@ private:
 
 /// Its maps at the configured resolution, on the six faces of a cube map and one 2D map (the plan
 /// does not know the light: the most any light asks for): 14 bytes a texel of each, distance and
-/// depth and what llvmpipe holds beside them (84-92 bytes per r² measured for a point light's cube
-/// at 2048 and 4096, results/reference/memory_bounds_llvmpipe.md).
+/// depth and what llvmpipe holds beside them (results/reference/memory_bounds_llvmpipe.md).
 Footprint shadowMapFootprint(const FootprintQuery& q) {
     const size_t r = size_t(std::get<int>(q.params->get("resolution")));
     Footprint f;

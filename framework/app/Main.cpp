@@ -173,18 +173,6 @@ int reportExpectations(const Json& meta) {
     return kExpectationsFailedExit;
 }
 
-/// Every "gltf" path of the resolved scene (objects, a grid's object, nested).
-void collectGltfPaths(const Json& j, std::vector<std::string>& out) {
-    if (j.is_object()) {
-        for (const auto& [k, v] : j.items()) {
-            if (k == "gltf" && v.is_string()) out.push_back(v.get<std::string>());
-            else collectGltfPaths(v, out);
-        }
-    } else if (j.is_array()) {
-        for (const auto& v : j) collectGltfPaths(v, out);
-    }
-}
-
 /// --force replaces DIR with everything in it: a run whose own config or scene files lie inside
 /// it would delete them (sixth probe: config.resolved.json then named a glTF file that was gone).
 void refuseInputsInsideReplacedOutput(const std::string& config, const std::vector<std::string>& overrides, const std::string& dir) {
@@ -199,8 +187,7 @@ void refuseInputsInsideReplacedOutput(const std::string& config, const std::vect
     };
     Json j = JsonNode::parseFile(config);
     for (const auto& o : overrides) applyOverride(j, o);
-    std::vector<std::string> gltf;
-    collectGltfPaths(j.value("scene", Json()), gltf);
+    const std::vector<std::string> gltf = gltfPathsOf(j.value("scene", Json()));
     std::vector<std::string> inputs = {config};
     const fs::path folder = fs::absolute(config).parent_path();
     for (const std::string& g : gltf) inputs.push_back(fs::path(g).is_absolute() ? g : (folder / g).string());

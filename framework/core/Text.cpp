@@ -173,6 +173,12 @@ std::string markdownLiteral(const std::string& text) {
     return out;
 }
 
+std::string shortNumber(double v, int digits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return buf;
+}
+
 std::string xmlText(const std::string& text) {
     std::string out;
     for (char c : validUtf8(text)) {

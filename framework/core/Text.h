@@ -49,6 +49,9 @@ bool isFileName(const std::string& name);
 /// a paragraph or a table cell (scripts/report_html.py's literal() is the same rule).
 std::string markdownLiteral(const std::string& text);
 
+/// `v` in at most `digits` significant digits (printf's %g): numbers in lines, tables and reports.
+std::string shortNumber(double v, int digits = 6);
+
 /// `text` as XML character data or an attribute value (JUnit files): & < > " ' escaped, bytes that
 /// are not well-formed UTF-8 and C0 controls but tab and newline (which XML 1.0 cannot hold) as '?'.
 std::string xmlText(const std::string& text);

@@ -33,12 +33,6 @@ Json readSummary(const std::string& dir) {
     return s;
 }
 
-std::string number(double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.4g", v);
-    return buf;
-}
-
 std::vector<double> numbers(const Json& j) {
     std::vector<double> v;
     if (j.is_array())
@@ -274,15 +268,15 @@ Comparison compareRuns(const std::string& baseDir, const std::string& newDir, co
         if (!opt.relativeTo.empty() && id == opt.relativeTo) time.back()["verdict"] = "the yardstick";
         r["time"] = time;
         if (time.back()["verdict"] == "slower")
-            r["regressions"].push_back("total time " + number(time.back()["ratio"].get<double>()) + "× (95 % interval " +
-                                       number(time.back()["low"].get<double>()) + " – " + number(time.back()["high"].get<double>()) + ")");
+            r["regressions"].push_back("total time " + shortNumber(time.back()["ratio"].get<double>(), 4) + "× (95 % interval " +
+                                       shortNumber(time.back()["low"].get<double>(), 4) + " – " + shortNumber(time.back()["high"].get<double>(), 4) + ")");
         const Json accA = a.value("accuracy", Json()), accB = b.value("accuracy", Json());
         if (accA.is_object() && accB.is_object()) {
             const double x = accA.value("mismatch_ratio_max", 0.0), y = accB.value("mismatch_ratio_max", 0.0);
             // Accuracy is deterministic on one renderer: any growth past the threshold is the code's.
             const std::string verdict = y > x * (1 + opt.threshold) + 1e-12 ? "worse" : y < x * (1 - opt.threshold) - 1e-12 ? "better" : "same";
             r["accuracy"] = {{"base", x}, {"new", y}, {"verdict", verdict}};
-            if (verdict == "worse") r["regressions"].push_back("worst-frame mismatch " + number(100 * x) + " % → " + number(100 * y) + " %");
+            if (verdict == "worse") r["regressions"].push_back("worst-frame mismatch " + shortNumber(100 * x, 4) + " % → " + shortNumber(100 * y, 4) + " %");
         }
         const uint64_t ova = a.value("overflow", uint64_t(0)), ovb = b.value("overflow", uint64_t(0));
         r["overflow"] = {{"base", ova}, {"new", ovb}};
@@ -316,7 +310,7 @@ Comparison compareRuns(const std::string& baseDir, const std::string& newDir, co
 std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, const std::string& newDir, const CompareOptions& opt) {
     std::ostringstream os;
     os << "# Comparison\n\n- base: " << markdownLiteral(baseDir) << "\n- new: " << markdownLiteral(newDir) << "\n- threshold: "
-       << number(100 * opt.threshold) << " % (a time counts as slower or faster only past it, with its whole 95 % interval on one side of 1)\n";
+       << shortNumber(100 * opt.threshold, 4) << " % (a time counts as slower or faster only past it, with its whole 95 % interval on one side of 1)\n";
     if (!opt.relativeTo.empty())
         os << "- times relative to " << markdownLiteral(opt.relativeTo)
            << "'s total of the same pass (base and new columns are quotients, not milliseconds)\n";
@@ -333,9 +327,9 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
         }
         for (const Json& t : r["time"]) {
             os << "| " << markdownLiteral(r["id"].get<std::string>()) << " | " << markdownLiteral(t["stage"].get<std::string>()) << " | "
-               << number(t["base"].get<double>()) << " | " << number(t["new"].get<double>()) << " | " << number(t["ratio"].get<double>()) << " | "
-               << (t["low"].is_null() ? std::string() : number(t["low"].get<double>()) + " – " + number(t["high"].get<double>())) << " | "
-               << (t.contains("p") ? number(t["p"].get<double>()) : std::string()) << " | " << t["method"].get<std::string>() << " | "
+               << shortNumber(t["base"].get<double>(), 4) << " | " << shortNumber(t["new"].get<double>(), 4) << " | " << shortNumber(t["ratio"].get<double>(), 4) << " | "
+               << (t["low"].is_null() ? std::string() : shortNumber(t["low"].get<double>(), 4) + " – " + shortNumber(t["high"].get<double>(), 4)) << " | "
+               << (t.contains("p") ? shortNumber(t["p"].get<double>(), 4) : std::string()) << " | " << t["method"].get<std::string>() << " | "
                << (t["verdict"] == "slower" ? "**slower**" : t["verdict"].get<std::string>()) << " |\n";
         }
     }
@@ -344,19 +338,19 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
         if (r["present"] != "both") continue;
         os << "| " << markdownLiteral(r["id"].get<std::string>()) << " | ";
         if (r.contains("accuracy"))
-            os << number(100 * r["accuracy"]["base"].get<double>()) << " % → " << number(100 * r["accuracy"]["new"].get<double>()) << " % | "
+            os << shortNumber(100 * r["accuracy"]["base"].get<double>(), 4) << " % → " << shortNumber(100 * r["accuracy"]["new"].get<double>(), 4) << " % | "
                << (r["accuracy"]["verdict"] == "worse" ? "**worse**" : r["accuracy"]["verdict"].get<std::string>());
         else
             os << "not measured | ";
-        os << " | " << r["overflow"]["base"] << " → " << r["overflow"]["new"] << " | " << number(r["memory_bytes"]["base"].get<double>() / 1048576.0)
-           << " → " << number(r["memory_bytes"]["new"].get<double>() / 1048576.0) << " |\n";
+        os << " | " << r["overflow"]["base"] << " → " << r["overflow"]["new"] << " | " << shortNumber(r["memory_bytes"]["base"].get<double>() / 1048576.0, 4)
+           << " → " << shortNumber(r["memory_bytes"]["new"].get<double>() / 1048576.0, 4) << " |\n";
     }
     os << "\n## Changed counters (mean past the threshold) and images\n\n";
     for (const Json& r : c.records) {
         if (r["present"] != "both") continue;
         for (const auto& [name, v] : r["counters_changed"].items())
-            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " " << markdownLiteral(name) << ": " << number(v["base"].get<double>())
-               << " → " << number(v["new"].get<double>()) << "\n";
+            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " " << markdownLiteral(name) << ": " << shortNumber(v["base"].get<double>(), 4)
+               << " → " << shortNumber(v["new"].get<double>(), 4) << "\n";
         for (const Json& im : r["images"]) {
             if (im["changed_pixels"].is_null() || im["changed_pixels"].get<size_t>() == 0) continue;
             os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << ": " << im["changed_pixels"] << " of "

@@ -44,12 +44,6 @@ std::string measureProblem(const std::string& m) {
            "(STAT: mean, median, min or max)";
 }
 
-std::string number(double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
-}
-
 /// The ids an expectation's id stands for.
 std::vector<std::string> idsOf(const Expectation& e, const ExpectationIds& ids) {
     if (e.id == "*") return ids.all;
@@ -153,18 +147,18 @@ Json checkExpectations(const std::vector<Expectation>& expectations, const Expec
             if (has && !e.relativeTo.empty()) {
                 const std::optional<double> base = measured(summary, e.relativeTo, e.measure, why);
                 has = base.has_value() && *base > 0;
-                if (base && !(*base > 0)) why = e.relativeTo + "'s " + e.measure + " is " + number(*base) + ": no ratio to it";
+                if (base && !(*base > 0)) why = e.relativeTo + "'s " + e.measure + " is " + shortNumber(*base) + ": no ratio to it";
                 if (has) value /= *base;
             }
             const std::string what = id + ": " + e.measure + (e.relativeTo.empty() ? "" : " / " + e.relativeTo + "'s");
             if (has) {
                 r["value"] = value;
                 if (e.max && !(value <= *e.max))
-                    why = what + " = " + number(value) + ", above max " + number(*e.max) +
-                          (*e.max != 0 ? " (" + number(value / *e.max) + "×)" : "");
+                    why = what + " = " + shortNumber(value) + ", above max " + shortNumber(*e.max) +
+                          (*e.max != 0 ? " (" + shortNumber(value / *e.max) + "×)" : "");
                 else if (e.min && !(value >= *e.min))
-                    why = what + " = " + number(value) + ", below min " + number(*e.min) +
-                          (*e.min != 0 ? " (" + number(value / *e.min) + "×)" : "");
+                    why = what + " = " + shortNumber(value) + ", below min " + shortNumber(*e.min) +
+                          (*e.min != 0 ? " (" + shortNumber(value / *e.min) + "×)" : "");
             } else {
                 why = "not measured: " + why;
             }
@@ -184,10 +178,10 @@ std::string expectationLine(const Json& r) {
     const std::string where = r.value("where", std::string());
     if (!r.value("passed", false)) return r.value("why", std::string()) + " (" + where + ")";
     std::string bound;
-    if (!r["min"].is_null()) bound += "min " + number(r["min"].get<double>());
-    if (!r["max"].is_null()) bound += std::string(bound.empty() ? "" : ", ") + "max " + number(r["max"].get<double>());
+    if (!r["min"].is_null()) bound += "min " + shortNumber(r["min"].get<double>());
+    if (!r["max"].is_null()) bound += std::string(bound.empty() ? "" : ", ") + "max " + shortNumber(r["max"].get<double>());
     const std::string rel = r["relative_to"].is_null() ? "" : " / " + r["relative_to"].get<std::string>() + "'s";
-    return r["id"].get<std::string>() + ": " + r["measure"].get<std::string>() + rel + " = " + number(r["value"].get<double>()) + " (" +
+    return r["id"].get<std::string>() + ": " + r["measure"].get<std::string>() + rel + " = " + shortNumber(r["value"].get<double>()) + " (" +
            bound + "; " + where + ")";
 }
 

@@ -207,6 +207,7 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
     // Algorithms set up one after the other (the reference first): each one's transient sits on
     // top of the scene and of what it and the ones before it hold, not of what comes after.
     size_t held = saturatingSum({plan.held[0].second, plan.held[1].second, plan.held[2].second}), setupPeak = 0;
+    size_t buffersAgain = 0, largestSetup = 0;  // for the statistics pass, below
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         if (!e->info->footprint) continue;
         const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
@@ -215,26 +216,19 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
             throw InputError(cfg.file, where, e->info->name + " cannot run this scene (up to " + std::to_string(triangles) +
                                                   " triangles) on this device: " + f.refusal);
         plan.held.emplace_back(e->id, f.bytes);
+        buffersAgain = saturatingSum({buffersAgain, f.bytes - std::min(f.bytes, f.textureBytes)});
+        largestSetup = std::max(largestSetup, f.peakBytes);
         held = saturatingSum({held, f.bytes});
         setupPeak = std::max(setupPeak, saturatingSum({held, f.peakBytes}));
         refuseOverflow(cfg, where, e->info->name + "'s estimate with what is held before it", setupPeak, triangles);
     }
     // The statistics pass makes every algorithm again (instrumented) while the driver still holds
-    // the timed pass's buffers: llvmpipe frees them only at the end of the run (an izb of 512 MiB
-    // of jobs peaked at 1.09 GiB with the pass, 0.59 without), its textures at once (a shadow map
-    // of 8192 peaked at 6.14 GiB with the pass, as planned without it;
-    // results/reference/memory_bounds_llvmpipe.md).
+    // the timed pass's buffers: llvmpipe frees them only at the end of the run, its textures at
+    // once (results/reference/memory_bounds_llvmpipe.md).
     if (!cfg.statisticsFrames().empty()) {
-        size_t again = 0, setup = 0;
-        for (const AlgorithmEntry* e : planEntries(cfg)) {
-            if (!e->info->footprint) continue;
-            const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
-            again = saturatingSum({again, f.bytes - std::min(f.bytes, f.textureBytes)});
-            setup = std::max(setup, f.peakBytes);
-        }
-        plan.held.emplace_back("statistics pass", again);
-        held = saturatingSum({held, again});
-        setupPeak = std::max(setupPeak, saturatingSum({held, setup}));
+        plan.held.emplace_back("statistics pass", buffersAgain);
+        held = saturatingSum({held, buffersAgain});
+        setupPeak = std::max(setupPeak, saturatingSum({held, largestSetup}));
         refuseOverflow(cfg, "/statistics", "the statistics pass's structures with the timed pass's", setupPeak, triangles);
     }
     plan.peak = std::max({plan.loadPeak, gpuUploadPeak, held, setupPeak});

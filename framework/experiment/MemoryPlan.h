@@ -16,8 +16,8 @@
 namespace shadowlab {
 
 /// The framework's bytes per image pixel (G-buffer and its host copy, masks, shading, each
-/// algorithm's visibility read back, the images written): 58 measured on llvmpipe from 2048² to
-/// 4096², reference only (results/reference/memory_bounds_llvmpipe.md).
+/// algorithm's visibility read back, the images written), a bound of what was measured on llvmpipe
+/// (results/reference/memory_bounds_llvmpipe.md).
 constexpr size_t kFrameBytesPerPixel = 64;
 
 /// The device's limits an algorithm's estimate depends on (read from the current GL context).

@@ -296,12 +296,6 @@ void writeMemorySection(std::ostream& os, const Json& s) {
 } // namespace
 
 namespace {
-std::string formatNumber(double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
-}
-
 /// The config's expectations first in the report: what a CI job checks, and what failed.
 void writeExpectationsSection(std::ostream& os, const Json& records) {
     size_t failed = 0;
@@ -309,7 +303,7 @@ void writeExpectationsSection(std::ostream& os, const Json& records) {
     os << "## Expectations: " << (failed ? std::to_string(failed) + " of " + std::to_string(records.size()) + " failed"
                                          : "all " + std::to_string(records.size()) + " met")
        << "\n\n| result | id | measure | bound | value | where | note |\n|---|---|---|---|---:|---|---|\n";
-    auto num = [](const Json& v) { return v.is_null() ? std::string() : markdownLiteral(formatNumber(v.get<double>())); };
+    auto num = [](const Json& v) { return v.is_null() ? std::string() : markdownLiteral(shortNumber(v.get<double>())); };
     for (const Json& r : records) {
         std::string bound;
         if (!r["min"].is_null()) bound += "≥ " + num(r["min"]);

@@ -212,6 +212,15 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         return *cpuG;
     };
 
+    // One timed frame of one algorithm; posing the moving parts is shared work, done once per
+    // frame, and its cost is reported in every algorithm's frame.
+    auto timedFrame = [&](Instance& inst, const Camera& cam, const Light& light, int frame, const TimedWork& sceneUpdate) {
+        FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
+        m.stages.insert(m.stages.begin(), sceneUpdate.stages.begin(), sceneUpdate.stages.end());
+        m.wallMs += sceneUpdate.wallMs;
+        return m;
+    };
+
     // Warm-up: shader compilation, first-touch allocations and caches are kept out of the timings.
     if (cfg.warmupFrames > 0) {
         Camera cam = cfg.cameraAt(0);
@@ -243,9 +252,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         for (auto& inst : instances) {
             stopIfBroken();
             progress.step(inst.entry->id + " frame " + std::to_string(frame + 1) + "/" + std::to_string(cfg.frames));
-            FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
-            m.stages.insert(m.stages.begin(), sceneUpdate.stages.begin(), sceneUpdate.stages.end());
-            m.wallMs += sceneUpdate.wallMs;
+            const FrameMeasurement m = timedFrame(inst, cam, light, frame, sceneUpdate);
             FrameRecord rec = recordOf(m, frame);
             inst.results.memoryBytes = std::max(inst.results.memoryBytes, m.memoryBytes);
             inst.results.residentBytes = std::max(inst.results.residentBytes, m.residentBytes);
@@ -268,7 +275,6 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         }
     }
 
-    // What each algorithm's device-dependent choices came to, as the timed pass ran them.
     // Repetitions of the timed pass: the same frames, the algorithms in a rotated order each time,
     // times and overflow recorded; each image is hashed against the first pass's (they must agree).
     for (int rep = 1; rep < cfg.repeats; ++rep) {
@@ -283,10 +289,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                 Instance& inst = instances[(k + size_t(rep)) % instances.size()];
                 stopIfBroken();
                 progress.step(inst.entry->id + " repetition " + std::to_string(rep + 1) + ", frame " + std::to_string(frame + 1));
-                FrameMeasurement m = inst.host->computeFrame({gbuffer, getCpuG, cam, light, frame}, timer);
-                m.stages.insert(m.stages.begin(), sceneUpdate.stages.begin(), sceneUpdate.stages.end());
-                m.wallMs += sceneUpdate.wallMs;
-                inst.results.repetitions.back().push_back(recordOf(m, frame));
+                inst.results.repetitions.back().push_back(recordOf(timedFrame(inst, cam, light, frame, sceneUpdate), frame));
                 if (visibilityHash(inst.host->readVisibility()) != inst.firstImages[size_t(frame)] &&
                     std::find(inst.results.repetitionDiffers.begin(), inst.results.repetitionDiffers.end(), frame) ==
                         inst.results.repetitionDiffers.end())
@@ -295,6 +298,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         }
     }
 
+    // What each algorithm's device-dependent choices came to, as the timed pass ran them.
     for (auto& inst : instances) inst.results.resolvedParams = inst.host->algorithm().resolvedParams();
 
     // The statistics pass: the same frames again with instrumented shaders, untimed as far as any

@@ -521,4 +521,19 @@ Scene buildScene(JsonNode sceneNode) {
     return scene;
 }
 
+std::vector<std::string> gltfPathsOf(const Json& scene) {
+    std::vector<std::string> out;
+    const std::function<void(const Json&)> walk = [&](const Json& j) {
+        if (j.is_object()) {
+            for (const auto& [k, v] : j.items())
+                if (k == "gltf" && v.is_string()) out.push_back(v.get<std::string>());
+                else walk(v);
+        } else if (j.is_array()) {
+            for (const Json& v : j) walk(v);
+        }
+    };
+    walk(scene);
+    return out;
+}
+
 } // namespace shadowlab

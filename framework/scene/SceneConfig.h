@@ -12,6 +12,10 @@ constexpr size_t kMaxSceneTriangles = 200'000'000;
 /// Reads {"objects": [...]} (schema: docs/scene.md) and returns the world-space triangle soup.
 /// Every error (unknown keys, bad values, unreadable or malformed glTF) is an InputError.
 Scene buildScene(JsonNode sceneNode);
+
+/// Every "gltf" path of a scene's JSON (its objects, a grid's object, nested), as written there:
+/// the files a run reads besides its config.
+std::vector<std::string> gltfPathsOf(const Json& scene);
 /// The same checks as buildScene (keys, values, glTF files present, triangle limits) without
 /// generating or loading anything, so thousands of scenes can be checked in a moment. A malformed
 /// glTF file is found only when it is loaded.

@@ -303,15 +303,6 @@ std::vector<std::string> gltfFiles(const std::string& gltf) {
     return files;
 }
 
-void collectGltf(const Json& j, std::vector<std::string>& out) {
-    if (j.is_object()) {
-        for (const auto& [k, v] : j.items())
-            if (k == "gltf" && v.is_string()) out.push_back(v.get<std::string>());
-            else collectGltf(v, out);
-    } else if (j.is_array()) {
-        for (const Json& v : j) collectGltf(v, out);
-    }
-}
 } // namespace
 
 std::string runId(const Json& resolvedConfig) {
@@ -322,9 +313,7 @@ std::string runId(const Json& resolvedConfig) {
     for (unsigned char c : j.dump()) h = (h ^ c) * kFnvPrime;
     // And over the content of every glTF file the scene reads (sixth probe: a model edited between
     // two `sweep run`s kept its runs' ids, and the old geometry's results were skipped as complete).
-    std::vector<std::string> gltf;
-    collectGltf(j.value("scene", Json()), gltf);
-    for (const std::string& file : gltf)
+    for (const std::string& file : gltfPathsOf(j.value("scene", Json())))
         for (const std::string& part : gltfFiles(file))
             for (unsigned char c : part + "=" + fileFingerprint(part) + "\n") h = (h ^ c) * kFnvPrime;
     char buf[17];
