@@ -63,7 +63,7 @@ const char* kInfoUsage = R"(  shadowlab info [--json]
 
 std::string fullUsage() {
     return std::string("shadowlab: real-time shadow algorithms side by side, checked against a ray-traced reference.\n\nUsage:\n") +
-           kRunUsage + kValidateUsage + kPlanUsage + kListUsage + kInfoUsage + kSweepUsage + kCompareUsage + "  shadowlab --help | --version\n\n" +
+           kRunUsage + kValidateUsage + kPlanUsage + kListUsage + kInfoUsage + kSweepUsage + kCompareUsage + kHistoryUsage + "  shadowlab --help | --version\n\n" +
            "Exit codes: 0 success, 2 bad input (config, scene file, parameter), 1 runtime failure,\n"
            "3 a run's expectations not met (every result written), 128 + N stopped by signal N.\n";
 }
@@ -441,6 +441,7 @@ static int dispatch(std::vector<std::string> args) {
         if (args[0] == "info") return info(args);
         if (args[0] == "sweep") return sweepCommand(args);
         if (args[0] == "compare") return compareCommand(args);
+        if (args[0] == "history") return historyCommand(args);
         usageError("unknown command " + args[0]);
     } catch (const InputError& e) {
         std::fprintf(stderr, "shadowlab: error: %s\n", shortText(e.what(), 1000).c_str());

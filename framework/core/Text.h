@@ -52,6 +52,9 @@ std::string markdownLiteral(const std::string& text);
 /// `v` in at most `digits` significant digits (printf's %g): numbers in lines, tables and reports.
 std::string shortNumber(double v, int digits = 6);
 
+/// The current time in UTC as ISO 8601 to the second ("2026-12-06T16:05:54Z"): sorts as it reads.
+std::string utcTimestamp();
+
 /// `text` as XML character data or an attribute value (JUnit files): & < > " ' escaped, bytes that
 /// are not well-formed UTF-8 and C0 controls but tab and newline (which XML 1.0 cannot hold) as '?'.
 std::string xmlText(const std::string& text);

@@ -20,9 +20,7 @@ namespace shadowlab {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-Json readSummary(const std::string& dir) {
+Json readRunSummary(const std::string& dir) {
     const std::string file = dir + "/summary.json";
     std::error_code ec;
     if (!fs::is_directory(dir, ec) || !fs::exists(file, ec))
@@ -32,6 +30,8 @@ Json readSummary(const std::string& dir) {
         throw InputError(shortText(file, 300), "", "is not a complete run's summary (no \"complete\": true and \"algorithms\")");
     return s;
 }
+
+namespace {
 
 std::vector<double> numbers(const Json& j) {
     std::vector<double> v;
@@ -98,14 +98,7 @@ Json compareStage(const Json& a, const Json& b, const std::string& stage, double
     r["low"] = ci.valid ? Json(ci.low) : Json();
     r["high"] = ci.valid ? Json(ci.high) : Json();
     r["method"] = method;
-    // A change counts when it exceeds the threshold, its whole interval lies on one side of 1 and,
-    // from repetitions, the U test finds the two samples different (p < 0.05: 5 or more each).
-    const bool significant = !r.contains("p") || r["p"].get<double>() < 0.05;
-    std::string verdict = "within noise";
-    if (!ci.valid) verdict = "no interval";
-    else if (significant && ci.low > 1.0 && ci.median > 1.0 + threshold) verdict = "slower";
-    else if (significant && ci.high < 1.0 && ci.median < 1.0 - threshold) verdict = "faster";
-    r["verdict"] = verdict;
+    r["verdict"] = timeVerdict(ci, r.contains("p") ? r["p"].get<double>() : -1.0, threshold);
     return r;
 }
 
@@ -197,6 +190,25 @@ std::vector<std::string> configDifferences(const std::string& baseDir, const std
     return keys;
 }
 
+} // namespace
+
+std::string timeVerdict(const Interval& ci, double p, double threshold) {
+    // A change counts when it exceeds the threshold, its whole interval lies on one side of 1 and,
+    // from repetitions, the U test finds the two samples different (p < 0.05: 5 or more each).
+    const bool significant = p < 0 || p < 0.05;
+    if (!ci.valid) return "no interval";
+    if (significant && ci.low > 1.0 && ci.median > 1.0 + threshold) return "slower";
+    if (significant && ci.high < 1.0 && ci.median < 1.0 - threshold) return "faster";
+    return "within noise";
+}
+
+std::vector<double> totalTimeSamples(const Json& entry, const Json* yardstick) {
+    if (repetitionCount(entry) >= 3)
+        return over(numbers(entry["repetitions"]["time_ms"].value("total", Json())),
+                    yardstick ? numbers((*yardstick)["repetitions"]["time_ms"].value("total", Json())) : std::vector<double>{});
+    return over(numbers(entry.value("total_ms_per_frame", Json())), yardstick ? numbers((*yardstick)["total_ms_per_frame"]) : std::vector<double>{});
+}
+
 /// The yardstick of `--relative-to`: an id's entry, or for "*" one made of the geometric mean of
 /// every id's total time, pass by pass and frame by frame (the machine's speed in that pass, as
 /// all the algorithms saw it; one algorithm's change moves it by a share only).
@@ -228,10 +240,8 @@ Json yardstickOf(const Json& summary, const std::string& id) {
     return y;
 }
 
-} // namespace
-
 Comparison compareRuns(const std::string& baseDir, const std::string& newDir, const CompareOptions& opt) {
-    const Json base = readSummary(baseDir), next = readSummary(newDir);
+    const Json base = readRunSummary(baseDir), next = readRunSummary(newDir);
     Comparison c;
     if (!opt.relativeTo.empty() && opt.relativeTo != "*" &&
         !(base["algorithms"].contains(opt.relativeTo) && next["algorithms"].contains(opt.relativeTo)))

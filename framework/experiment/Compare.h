@@ -6,6 +6,7 @@
 // total time is slower beyond the threshold and outside the noise, accuracy worse, or overflow
 // more; the exit code says whether there was one (kRegressionExit).
 #include "framework/core/JsonNode.h"
+#include "framework/metrics/Noise.h"
 
 #include <string>
 
@@ -28,6 +29,22 @@ struct Comparison {
     std::vector<std::string> notes; ///< what makes the comparison weaker (configs differ, few samples)
     size_t regressions = 0;
 };
+
+/// DIR/summary.json, which must be a complete run's (InputError naming the file otherwise).
+Json readRunSummary(const std::string& dir);
+
+/// What `--relative-to ID` divides by in `summary`: ID's entry, or for "*" an entry made of the
+/// geometric mean of every id's total time, pass by pass and frame by frame.
+Json yardstickOf(const Json& summary, const std::string& id);
+
+/// One id's total time as samples: the passes' means when it ran 3 or more (`repeats`), else its
+/// frames' totals; each divided by the yardstick's of the same pass or frame when one is given.
+std::vector<double> totalTimeSamples(const Json& entry, const Json* yardstick);
+
+/// "slower" or "faster" when the ratio's interval lies wholly on one side of 1, its median is past
+/// `threshold` and the U test's `p` (negative: none) is below 0.05; else "within noise", or "no
+/// interval" when `ci` is not valid.
+std::string timeVerdict(const Interval& ci, double p, double threshold);
 
 /// Reads BASE/summary.json and NEW/summary.json (InputError naming the file when either is not a
 /// complete run's) and compares them.

@@ -5,9 +5,12 @@
 #include "framework/core/Interrupt.h"
 #include "framework/core/Text.h"
 #include "framework/experiment/Compare.h"
+#include "framework/experiment/History.h"
+#include "framework/experiment/JUnit.h"
 #include "framework/experiment/OutputPlace.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -26,6 +29,17 @@ const char* kCompareUsage = R"(  shadowlab compare BASE NEW [--threshold PCT] [-
       Exit code 0 without regression, 3 with one.
 )";
 
+const char* kHistoryUsage = R"(  shadowlab history DIR [--threshold PCT] [--relative-to ID] [--window N] [--by-name] [--out OUT] [--force]
+      The runs of one experiment kept across commits, one run folder each directly in DIR, oldest
+      first (by summary.json's started_utc; --by-name: by folder name): each id's total time and
+      worst-frame mismatch run by run, and the runs where a step happened, named by commit. A time
+      step: the N (default 3) runs after a boundary against the N before, past PCT (default 10) %
+      with the whole 95 % interval on one side of 1 (compare's rule); --relative-to as compare's.
+      Markdown on standard output, or with --out: OUT/history.md, history.html, history.json,
+      history.junit.xml and the plots history_time.png, history_accuracy.png.
+      Exit code 0, or 3 when the newest run starts a step for the worse (slower, less accurate).
+)";
+
 namespace {
 
 double parseThreshold(const std::string& text) {
@@ -38,15 +52,55 @@ double parseThreshold(const std::string& text) {
     return v / 100.0;
 }
 
-/// compare.html from compare.md, as the run's report (scripts/report_html.py, argv only).
-void writeHtml(const std::string& dir) {
-    const std::string script = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/report_html.py";
-    if (runChildProcess({SHADOWLAB_PLOT_PYTHON, script, dir + "/compare.md", dir + "/compare.html"}, dir + "/compare_html.log") == 0) {
+/// One of scripts/ with `args` (argv only), its output in DIR/LOG, removed when it succeeded; a
+/// warning naming what was not written otherwise.
+void runScript(const std::string& command, const std::string& script, std::vector<std::string> args, const std::string& dir,
+               const std::string& log, const std::string& what) {
+    const char* python = std::getenv("SHADOWLAB_PYTHON");
+    args.insert(args.begin(), {python && *python ? python : SHADOWLAB_PLOT_PYTHON, std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/" + script});
+    if (runChildProcess(args, dir + "/" + log) == 0) {
         std::error_code ec;
-        std::filesystem::remove(dir + "/compare_html.log", ec);
+        std::filesystem::remove(dir + "/" + log, ec);
     } else {
-        std::fprintf(stderr, "shadowlab compare: compare.html was not written (see compare_html.log)\n");
+        std::fprintf(stderr, "shadowlab %s: %s not written (see %s)\n", command.c_str(), what.c_str(), log.c_str());
     }
+}
+
+/// An option's value: the next argument, which must be there and not be another option.
+std::string optionValue(const std::vector<std::string>& args, size_t& i, const char* what) {
+    const std::string& a = args[i];
+    if (++i >= args.size()) throw InputError(a, "", std::string("needs ") + what);
+    if (args[i].empty() || args[i].starts_with("--")) throw InputError(a, "", std::string("needs ") + what + ", not \"" + shortText(args[i], 40) + "\"");
+    return args[i];
+}
+
+/// The options compare and history share; false when `args[i]` is none of them.
+bool sharedOption(const std::vector<std::string>& args, size_t& i, double& threshold, bool& thresholdGiven, std::string& relativeTo,
+                  std::string& out, bool& force) {
+    const std::string& a = args[i];
+    if (a == "--threshold") {
+        if (thresholdGiven) throw InputError(a, "", "is given twice");
+        threshold = parseThreshold(optionValue(args, i, "a percentage"));
+        thresholdGiven = true;
+    } else if (a == "--relative-to") {
+        if (!relativeTo.empty()) throw InputError(a, "", "is given twice");
+        relativeTo = optionValue(args, i, "an algorithm id");
+    } else if (a == "--out") {
+        if (!out.empty()) throw InputError(a, "", "is given twice");
+        out = optionValue(args, i, "a folder");
+        if (const std::string why = pathTextProblem(out); !why.empty()) throw InputError("--out", "", "the folder's name " + why);
+    } else if (a == "--force") {
+        force = true;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+void writeStandardOutput(const std::string& text) {
+    std::cout << text;
+    std::cout.flush();
+    if (!std::cout) throw InputError("standard output", "", "cannot be written (a full disk or a closed stream)");
 }
 
 } // namespace
@@ -62,24 +116,7 @@ int compareCommand(const std::vector<std::string>& args) {
             std::fputs((std::string("Usage:\n") + kCompareUsage).c_str(), stdout);
             return 0;
         }
-        auto value = [&](const char* what) {
-            if (++i >= args.size()) throw InputError(a, "", std::string("needs ") + what);
-            if (args[i].empty() || args[i].starts_with("--")) throw InputError(a, "", std::string("needs ") + what + ", not \"" + shortText(args[i], 40) + "\"");
-            return args[i];
-        };
-        if (a == "--threshold") {
-            if (thresholdGiven) throw InputError(a, "", "is given twice");
-            opt.threshold = parseThreshold(value("a percentage"));
-            thresholdGiven = true;
-        } else if (a == "--relative-to") {
-            if (!opt.relativeTo.empty()) throw InputError(a, "", "is given twice");
-            opt.relativeTo = value("an algorithm id");
-        } else if (a == "--out") {
-            if (!out.empty()) throw InputError(a, "", "is given twice");
-            out = value("a folder");
-            if (const std::string why = pathTextProblem(out); !why.empty()) throw InputError("--out", "", "the folder's name " + why);
-        } else if (a == "--force") {
-            force = true;
+        if (sharedOption(args, i, opt.threshold, thresholdGiven, opt.relativeTo, out, force)) {
         } else if (!a.empty() && a[0] == '-') {
             throw InputError(shortText(a, 60), "", "unknown option of `compare` (see shadowlab compare --help)");
         } else {
@@ -89,9 +126,7 @@ int compareCommand(const std::vector<std::string>& args) {
     if (runs.size() != 2) throw InputError("compare", "", "expects two run folders, BASE and NEW (see shadowlab compare --help)");
     if (out.empty()) {
         const Comparison c = compareRuns(runs[0], runs[1], opt);
-        std::cout << comparisonMarkdown(c, runs[0], runs[1], opt);
-        std::cout.flush();
-        if (!std::cout) throw InputError("standard output", "", "cannot be written (a full disk or a closed stream)");
+        writeStandardOutput(comparisonMarkdown(c, runs[0], runs[1], opt));
         std::fprintf(stderr, "shadowlab compare: %zu regressions\n", c.regressions);
         return c.regressions ? kRegressionExit : 0;
     }
@@ -104,7 +139,7 @@ int compareCommand(const std::vector<std::string>& args) {
     writeFileAtomic(dir + "/compare.md", comparisonMarkdown(c, runs[0], runs[1], opt));
     writeFileAtomic(dir + "/compare.junit.xml", comparisonJUnit(c));
     writeFileAtomic(dir + "/compare.json", Json{{"regressions", c.regressions}, {"notes", c.notes}, {"ids", c.records}}.dump(2) + "\n");
-    writeHtml(dir);
+    runScript("compare", "report_html.py", {dir + "/compare.md", dir + "/compare.html"}, dir, "compare_html.log", "compare.html");
     throwIfInterrupted();
     place.commit();
     std::fprintf(stderr, "shadowlab compare: %zu regressions; wrote %s (compare.md, compare.html, compare.junit.xml)\n", c.regressions,
@@ -113,6 +148,86 @@ int compareCommand(const std::vector<std::string>& args) {
         for (const Json& g : r["regressions"])
             std::fprintf(stderr, "shadowlab compare: REGRESSION %s: %s\n", r["id"].get<std::string>().c_str(), g.get<std::string>().c_str());
     return c.regressions ? kRegressionExit : 0;
+}
+
+namespace {
+
+/// history.junit.xml: per id, whether the newest run starts a step for the worse.
+std::string historyJUnit(const History& h) {
+    std::vector<JUnitCase> cases;
+    const size_t newest = h.runs.size() - 1;
+    for (const auto& [id, v] : h.ids.items()) {
+        std::string slower, worse;
+        for (const Json& s : h.steps) {
+            if (s["id"] != id || s["run"].get<size_t>() != newest) continue;
+            if (s["direction"] == "slower") slower = "slower from the newest run: " + shortNumber(s["ratio"].get<double>(), 4) + "×";
+            if (s["direction"] == "worse")
+                worse = "worst-frame mismatch " + shortNumber(100 * s["before"].get<double>(), 4) + " % → " + shortNumber(100 * s["after"].get<double>(), 4) + " %";
+        }
+        cases.push_back({id, "newest run not slower", slower});
+        cases.push_back({id, "newest run not less accurate", worse});
+    }
+    return junitXml("shadowlab history", cases, 0.0);
+}
+
+} // namespace
+
+int historyCommand(const std::vector<std::string>& args) {
+    std::string dir, out;
+    bool force = false, thresholdGiven = false, windowGiven = false;
+    HistoryOptions opt;
+    for (size_t i = 1; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--help" || a == "-h") {
+            std::fputs((std::string("Usage:\n") + kHistoryUsage).c_str(), stdout);
+            return 0;
+        }
+        if (sharedOption(args, i, opt.threshold, thresholdGiven, opt.relativeTo, out, force)) {
+        } else if (a == "--window") {
+            if (windowGiven) throw InputError(a, "", "is given twice");
+            const std::string v = optionValue(args, i, "a number of runs");
+            if (v.size() > 3 || v.find_first_not_of("0123456789") != std::string::npos || std::stoi(v) < 1 || std::stoi(v) > 100)
+                throw InputError("--window", "", "expected a number of runs from 1 to 100, got \"" + shortText(v, 40) + "\"");
+            opt.window = size_t(std::stoi(v));
+            windowGiven = true;
+        } else if (a == "--by-name") {
+            opt.byName = true;
+        } else if (!a.empty() && a[0] == '-') {
+            throw InputError(shortText(a, 60), "", "unknown option of `history` (see shadowlab history --help)");
+        } else if (dir.empty()) {
+            dir = a;
+        } else {
+            throw InputError("history", "", "expects one folder of run folders (see shadowlab history --help)");
+        }
+    }
+    if (dir.empty()) throw InputError("history", "", "expects one folder of run folders (see shadowlab history --help)");
+    auto report = [&](const History& h) {
+        for (const Json& s : h.steps)
+            if (s["run"].get<size_t>() + 1 == h.runs.size() && (s["direction"] == "slower" || s["direction"] == "worse"))
+                std::fprintf(stderr, "shadowlab history: REGRESSION %s: %s from the newest run (%s)\n", shortText(s["id"].get<std::string>(), 60).c_str(),
+                             s["direction"].get<std::string>().c_str(), shortText(s["label"].get<std::string>(), 60).c_str());
+        std::fprintf(stderr, "shadowlab history: %zu runs, %zu steps, %zu from the newest run for the worse\n", h.runs.size(), h.steps.size(),
+                     h.newestRegressions);
+        return h.newestRegressions ? kRegressionExit : 0;
+    };
+    if (out.empty()) {
+        const History h = readHistory(dir, opt);
+        writeStandardOutput(historyMarkdown(h, dir, opt, false));
+        return report(h);
+    }
+    const History h = readHistory(dir, opt); // before the output folder: bad input leaves nothing behind
+    installInterruptHandlers();
+    OutputPlace place = OutputPlace::open(out, force);
+    const std::string outDir = place.partialDir();
+    writeFileAtomic(outDir + "/history.md", historyMarkdown(h, dir, opt, true));
+    writeFileAtomic(outDir + "/history.json", historyJson(h, opt).dump(2) + "\n");
+    writeFileAtomic(outDir + "/history.junit.xml", historyJUnit(h));
+    runScript("history", "history_plot.py", {outDir + "/history.json", outDir}, outDir, "history_plot.log", "the plots were");
+    runScript("history", "report_html.py", {outDir + "/history.md", outDir + "/history.html"}, outDir, "history_html.log", "history.html");
+    throwIfInterrupted();
+    place.commit();
+    std::fprintf(stderr, "shadowlab history: wrote %s (history.md, history.html, history.json, history.junit.xml)\n", shortText(place.finalDir(), 300).c_str());
+    return report(h);
 }
 
 } // namespace shadowlab

@@ -1,6 +1,7 @@
 #include "framework/experiment/Runner.h"
 
 #include "framework/algorithm/AlgorithmHost.h"
+#include "framework/core/BuildInfo.h"
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
 #include "framework/core/SystemMemory.h"
@@ -111,6 +112,7 @@ Json memoryRecord(const ExperimentConfig& cfg, const SceneGpu& sceneGpu, const E
 
 ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& opt, const std::string& backend) {
     auto wallStart = Clock::now();
+    const std::string startedUtc = utcTimestamp();
     std::optional<OutputPlace> ownPlace;
     OutputPlace* place = opt.place;
     if (opt.writeOutputs && !place) {
@@ -197,7 +199,10 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"moving_parts", cfg.scene->moving.size()},
                     {"moving_triangles", cfg.scene->movingTriangleCount()},
                     {"light", toString(cfg.light.type)},
-                    {"reference", cfg.reference}};
+                    {"reference", cfg.reference},
+                    // Which sources and when: what `shadowlab history` orders and names runs by.
+                    {"build", {{"commit", buildCommit()}, {"dirty", buildDirty()}}},
+                    {"started_utc", startedUtc}};
 
     std::vector<int> framesWithoutLit;  // accuracy is measured over lit pixels: none, nothing to measure
     Progress progress(opt.progress,

@@ -1,0 +1,199 @@
+// `shadowlab history` on run folders written by hand (summary.json alone: what history reads), so
+// that the noise, the steps and their runs are known: a step is named at the run it starts, noise
+// of the size measured on a shared machine is no step, the newest run's regression is exit 3, and
+// bad folders and options are exit 2.
+#include "framework/core/Error.h"
+#include "framework/experiment/History.h"
+#include "tests/SweepTestData.h"
+#include "tests/TestSupport.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Deterministic noise in [-1, 1) (a fixed LCG: the same folders every time).
+struct Noise {
+    uint32_t state;
+    double next() {
+        state = state * 1664525u + 1013904223u;
+        return double(state >> 8) / double(1u << 23) - 1.0;
+    }
+};
+
+/// One run's summary: 9 passes per id around `psvMs` and 10 ms (± `spread`), worst-frame mismatch
+/// `psvMismatch` for psv and 0 for bvh_raytrace.
+Json summaryOf(double psvMs, double psvMismatch, double spread, uint32_t seed, const std::string& commit, const std::string& started) {
+    Noise noise{seed};
+    auto passes = [&](double ms) {
+        Json p = Json::array();
+        for (int k = 0; k < 9; ++k) p.push_back(ms * (1 + spread * noise.next()));
+        return p;
+    };
+    auto entry = [&](double ms, double mismatch) {
+        return Json{{"repetitions", {{"count", 9}, {"time_ms", {{"total", passes(ms)}}}}},
+                    {"time_ms", {{"total", {{"mean", ms}}}}},
+                    {"accuracy", {{"mismatch_ratio_max", mismatch}}}};
+    };
+    return {{"complete", true},
+            {"renderer", "llvmpipe"},
+            {"started_utc", started},
+            {"build", {{"commit", commit}, {"dirty", false}}},
+            {"algorithms", {{"psv", entry(psvMs, psvMismatch)}, {"bvh_raytrace", entry(10.0, 0.0)}}}};
+}
+
+std::string commitOf(int k) { return std::string(39, 'a' + char(k % 6)) + char('0' + k % 10); }
+
+/// Runs 0..n-1 in DIR, folder names in the reverse of their order (history orders by start time).
+void writeRuns(const std::string& dir, const std::vector<double>& psvMs, const std::vector<double>& mismatch, double spread) {
+    for (size_t k = 0; k < psvMs.size(); ++k) {
+        const std::string folder = dir + "/run-" + std::to_string(100 - k);
+        fs::create_directories(folder);
+        char started[32];
+        std::snprintf(started, sizeof started, "2026-12-%02zuT10:00:00Z", k + 1);
+        std::ofstream(folder + "/summary.json") << summaryOf(psvMs[k], mismatch[k], spread, uint32_t(7 + 31 * k), commitOf(int(k)), started).dump();
+    }
+}
+
+std::vector<Json> stepsOf(const History& h, const std::string& id, const std::string& measure) {
+    std::vector<Json> out;
+    for (const Json& s : h.steps)
+        if (s["id"] == id && s["measure"] == measure) out.push_back(s);
+    return out;
+}
+
+// ±8 % per pass is wider than the passes' spread measured on the smoke config (results/ci/).
+constexpr double kSpread = 0.08;
+
+TEST(HistoryTest, NoiseAloneIsNoStep) {
+    const std::string dir = test::makeTempDir("history-flat");
+    writeRuns(dir, std::vector<double>(10, 20.0), std::vector<double>(10, 0.0), kSpread);
+    const History h = readHistory(dir, {});
+    EXPECT_EQ(h.runs.size(), 10u);
+    EXPECT_TRUE(h.steps.empty()) << h.steps.dump(2);
+    EXPECT_EQ(h.newestRegressions, 0u);
+}
+
+TEST(HistoryTest, AStepIsNamedAtTheRunItStartsAndOnlyForTheIdThatChanged) {
+    const std::string dir = test::makeTempDir("history-step");
+    std::vector<double> ms(10, 20.0), mismatch(10, 0.0);
+    for (size_t k = 5; k < 10; ++k) ms[k] = 26.0; // 30 % slower from run 5 on
+    for (size_t k = 7; k < 10; ++k) mismatch[k] = 0.002; // wrong pixels from run 7 on
+    writeRuns(dir, ms, mismatch, kSpread);
+    const History h = readHistory(dir, {});
+    const auto time = stepsOf(h, "psv", "time");
+    ASSERT_EQ(time.size(), 1u) << h.steps.dump(2);
+    EXPECT_EQ(time[0]["run"], 5u);
+    EXPECT_EQ(time[0]["direction"], "slower");
+    EXPECT_EQ(time[0]["label"], commitOf(5).substr(0, 10));
+    EXPECT_NEAR(time[0]["ratio"].get<double>(), 1.3, 0.1);
+    const auto accuracy = stepsOf(h, "psv", "accuracy");
+    ASSERT_EQ(accuracy.size(), 1u);
+    EXPECT_EQ(accuracy[0]["run"], 7u);
+    EXPECT_EQ(accuracy[0]["direction"], "worse");
+    EXPECT_TRUE(stepsOf(h, "bvh_raytrace", "time").empty()) << h.steps.dump(2);
+    // Those steps are old news: the newest run starts none.
+    EXPECT_EQ(h.newestRegressions, 0u);
+    // Relative to the machine (every id's geometric mean), psv's step stays psv's.
+    HistoryOptions relative;
+    relative.relativeTo = "*";
+    const History r = readHistory(dir, relative);
+    ASSERT_EQ(stepsOf(r, "psv", "time").size(), 1u) << r.steps.dump(2);
+    EXPECT_EQ(stepsOf(r, "psv", "time")[0]["run"], 5u);
+}
+
+TEST(HistoryTest, AFixIsAStepFasterAndBetter) {
+    const std::string dir = test::makeTempDir("history-fix");
+    std::vector<double> ms(8, 30.0), mismatch(8, 0.01);
+    for (size_t k = 4; k < 8; ++k) ms[k] = 20.0, mismatch[k] = 0.0;
+    writeRuns(dir, ms, mismatch, kSpread);
+    const History h = readHistory(dir, {});
+    ASSERT_EQ(stepsOf(h, "psv", "time").size(), 1u) << h.steps.dump(2);
+    EXPECT_EQ(stepsOf(h, "psv", "time")[0]["direction"], "faster");
+    EXPECT_EQ(stepsOf(h, "psv", "time")[0]["run"], 4u);
+    EXPECT_EQ(stepsOf(h, "psv", "accuracy")[0]["direction"], "better");
+}
+
+TEST(HistoryTest, TheNewestRunsRegressionFailsTheCommand) {
+    const std::string dir = test::makeTempDir("history-newest");
+    std::vector<double> ms(6, 20.0), mismatch(6, 0.0);
+    ms[5] = 28.0;
+    writeRuns(dir, ms, mismatch, kSpread);
+    const History h = readHistory(dir, {});
+    EXPECT_EQ(h.newestRegressions, 1u) << h.steps.dump(2);
+
+    const std::string out = test::makeTempDir("history-out") + "/report";
+    const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "history", dir, "--out", out});
+    EXPECT_EQ(ran.rc, 3) << ran.err;
+    EXPECT_NE(ran.err.find("REGRESSION psv: slower from the newest run (" + commitOf(5).substr(0, 10) + ")"), std::string::npos) << ran.err;
+    for (const char* f : {"history.md", "history.json", "history.junit.xml", "history.html", "history_time.png", "history_accuracy.png"})
+        EXPECT_TRUE(fs::is_regular_file(out + "/" + f)) << f << "\n" << ran.err;
+    std::ifstream junit(out + "/history.junit.xml");
+    const std::string xml((std::istreambuf_iterator<char>(junit)), {});
+    EXPECT_NE(xml.find("failures=\"1\""), std::string::npos) << xml;
+    // The same folder without --out: the Markdown on standard output, the same verdict.
+    const test::Ran md = test::runArgs({SHADOWLAB_BINARY, "history", dir});
+    EXPECT_EQ(md.rc, 3);
+    EXPECT_NE(md.out.find("**slower** from run 5"), std::string::npos) << md.out;
+}
+
+TEST(HistoryTest, RunsAreOrderedByStartTimeOrByName) {
+    const std::string dir = test::makeTempDir("history-order");
+    writeRuns(dir, {20, 20, 20, 20}, {0, 0, 0, 0}, kSpread);
+    fs::create_directories(dir + "/not-a-run");
+    const History byTime = readHistory(dir, {});
+    ASSERT_EQ(byTime.runs.size(), 4u);
+    EXPECT_EQ(byTime.runs[0]["folder"], "run-100");
+    EXPECT_EQ(byTime.runs[3]["folder"], "run-97");
+    ASSERT_EQ(byTime.notes.size(), 1u);
+    EXPECT_NE(byTime.notes[0].find("not-a-run"), std::string::npos);
+    HistoryOptions byName;
+    byName.byName = true;
+    EXPECT_EQ(readHistory(dir, byName).runs[0]["folder"], "run-100");
+    EXPECT_EQ(readHistory(dir, byName).runs[3]["folder"], "run-99"); // "run-100" < "run-97" < ... as text
+}
+
+TEST(HistoryTest, AFolderNameIsShownAsTextWhenItNamesARun) {
+    const std::string dir = test::makeTempDir("history-names");
+    writeRuns(dir, {20, 20}, {0, 0}, kSpread);
+    const std::string hostile = dir + "/[x](javascript:alert(1))";
+    fs::create_directories(hostile);
+    Json s = summaryOf(20, 0, kSpread, 3, "unknown", "2026-12-09T10:00:00Z");
+    std::ofstream(hostile + "/summary.json") << s.dump();
+    const History h = readHistory(dir, {});
+    ASSERT_EQ(h.runs.size(), 3u);
+    EXPECT_EQ(h.runs[2]["label"], "[x](javascript:alert(1))"); // no commit: the folder names it
+    const std::string md = historyMarkdown(h, dir, {}, false);
+    EXPECT_EQ(md.find("](javascript"), std::string::npos) << md;
+    EXPECT_NE(md.find("\\[x\\]\\(javascript\\:alert\\(1\\)\\)"), std::string::npos) << md;
+}
+
+TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
+    const std::string dir = test::makeTempDir("history-bad");
+    writeRuns(dir, {20}, {0}, kSpread);
+    EXPECT_THROW(readHistory(dir, {}), InputError); // one run is no history
+    EXPECT_THROW(readHistory(dir + "/missing", {}), InputError);
+    writeRuns(dir, {20, 20}, {0, 0}, kSpread);
+    HistoryOptions relative;
+    relative.relativeTo = "nope";
+    EXPECT_THROW(readHistory(dir, relative), InputError);
+    const std::string out = dir + "-out";
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"history"}, {"history", dir, "--window", "0"}, {"history", dir, "--window", "x"},
+          {"history", dir, "--threshold", "-1"}, {"history", dir, dir}, {"history", dir, "--bogus"},
+          {"history", dir + "/missing", "--out", out}, {"history", dir, "--relative-to", "nope", "--out", out}}) {
+        std::vector<std::string> argv{SHADOWLAB_BINARY};
+        argv.insert(argv.end(), args.begin(), args.end());
+        const test::Ran ran = test::runArgs(argv);
+        EXPECT_EQ(ran.rc, 2) << args.back() << ": " << ran.err;
+        EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
+        EXPECT_FALSE(fs::exists(out)) << "bad input left an output folder behind";
+    }
+}
+
+} // namespace
+} // namespace shadowlab
