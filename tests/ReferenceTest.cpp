@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <thread>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -455,6 +456,18 @@ TEST(ReferenceAlgorithm, RegistryEntry) {
     auto algo = info.create(ParamValues(schema), AlgorithmOptions{});
     ASSERT_TRUE(algo);
     EXPECT_EQ(algo->memoryBytes(), 0u);
+}
+
+// Threads for a frame: what was asked, else one per kPixelsPerThread pixels up to the hardware's
+// (a small frame on every hardware thread was slower and noisier than on one: the start-up and
+// the join cost more than they save).
+TEST(ReferenceTest, ThreadsFollowTheFramesSize) {
+    const int hardware = int(std::max(1u, std::thread::hardware_concurrency()));
+    EXPECT_EQ(EmbreeTracer::threadsFor(0, 128 * 128), 1);
+    EXPECT_EQ(EmbreeTracer::threadsFor(0, 0), 1);
+    EXPECT_EQ(EmbreeTracer::threadsFor(0, 2 * EmbreeTracer::kPixelsPerThread), std::min(2, hardware));
+    EXPECT_EQ(EmbreeTracer::threadsFor(0, size_t(1) << 40), hardware);
+    EXPECT_EQ(EmbreeTracer::threadsFor(13, 16), 13);
 }
 
 } // namespace

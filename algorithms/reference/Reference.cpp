@@ -27,7 +27,7 @@ constexpr size_t kCompactBvhTriangles = 10'000'000;
 const ParamStruct<ReferenceParams>& referenceParams() {
     using P = ReferenceParams;
     static const ParamStruct<P> s = ParamStruct<P>()
-        .integer("threads", &P::threads, 0, 0, 256, "", "CPU threads tracing rays (0 = all hardware threads)",
+        .integer("threads", &P::threads, 0, 0, 256, "", "CPU threads tracing rays (0 = one per 65,536 pixels, at most all hardware threads)",
                  ParamChange::Update)
         .apply(rayOffsetRow(&P::rayOffset))
         .choice("motion_update", &P::motionUpdate, "refit", {"refit", "rebuild"},
@@ -96,9 +96,9 @@ public:
     std::vector<Counter> counters() const override { return {{"rays", rays_}, {"mrays_per_s", mraysPerS_}}; }
     size_t memoryBytes() const override { return tracer_ ? tracer_->memoryBytes() : 0; }
 
-    /// The threads tracing rays (EmbreeTracer::traceVisibility's rule for 0: all hardware threads).
+    /// The threads tracing rays (EmbreeTracer::threadsFor's rule for 0, at the last frame's size).
     std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
-        return {{"threads", std::to_string(p_.threads > 0 ? p_.threads : int(std::max(1u, std::thread::hardware_concurrency())))},
+        return {{"threads", std::to_string(EmbreeTracer::threadsFor(p_.threads, visibility_.size()))},
                 {"bvh", scene_ && compactBvh(scene_->triangleCount()) ? "compact" : "fast"}};
     }
 

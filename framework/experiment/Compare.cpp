@@ -98,7 +98,9 @@ Json compareStage(const Json& a, const Json& b, const std::string& stage, double
     r["low"] = ci.valid ? Json(ci.low) : Json();
     r["high"] = ci.valid ? Json(ci.high) : Json();
     r["method"] = method;
-    r["verdict"] = timeVerdict(ci, r.contains("p") ? r["p"].get<double>() : -1.0, threshold);
+    // Frames paired or means only say nothing about how two runs of one build differ (measured
+    // here: 1 to 3 false calls in 10 per id from 4 frames paired), so they get no verdict.
+    r["verdict"] = r.contains("p") ? timeVerdict(ci, r["p"].get<double>(), threshold) : ci.valid ? "too few passes" : "no interval";
     return r;
 }
 
@@ -193,9 +195,9 @@ std::vector<std::string> configDifferences(const std::string& baseDir, const std
 } // namespace
 
 std::string timeVerdict(const Interval& ci, double p, double threshold) {
-    // A change counts when it exceeds the threshold, its whole interval lies on one side of 1 and,
-    // from repetitions, the U test finds the two samples different (p < 0.05: 5 or more each).
-    const bool significant = p < 0 || p < 0.05;
+    // A change counts when it exceeds the threshold, its whole interval lies on one side of 1 and
+    // the U test finds the two samples different (p < 0.05: 5 or more each; no test, no change).
+    const bool significant = p >= 0 && p < 0.05;
     if (!ci.valid) return "no interval";
     if (significant && ci.low > 1.0 && ci.median > 1.0 + threshold) return "slower";
     if (significant && ci.high < 1.0 && ci.median < 1.0 - threshold) return "faster";
@@ -209,35 +211,52 @@ std::vector<double> totalTimeSamples(const Json& entry, const Json* yardstick) {
     return over(numbers(entry.value("total_ms_per_frame", Json())), yardstick ? numbers((*yardstick)["total_ms_per_frame"]) : std::vector<double>{});
 }
 
-/// The yardstick of `--relative-to`: an id's entry, or for "*" one made of the geometric mean of
-/// every id's total time, pass by pass and frame by frame (the machine's speed in that pass, as
-/// all the algorithms saw it; one algorithm's change moves it by a share only).
-Json yardstickOf(const Json& summary, const std::string& id) {
+/// The yardstick of `--relative-to`: an id's entry, or for "*" the machine's speed in each pass
+/// (and frame) as the ids saw it: the median over the ids of each one's time over its scale (its
+/// median total in `scales`, the same for both runs compared). A median, not a mean: one id whose
+/// time swings between runs (the reference's CPU threads on a shared machine, measured up to
+/// 3.5x) or one that regressed leaves it where the others put it; the geometric mean moved every
+/// other id with it.
+Json yardstickOf(const Json& summary, const std::string& id, const Json& scales) {
     if (id != "*") return summary["algorithms"][id];
     std::vector<std::vector<double>> passes, frames;
     std::vector<double> means;
     for (const auto& [name, e] : summary["algorithms"].items()) {
-        passes.push_back(numbers(e.contains("repetitions") ? e["repetitions"]["time_ms"].value("total", Json()) : Json()));
-        frames.push_back(numbers(e.value("total_ms_per_frame", Json())));
-        means.push_back(e["time_ms"].contains("total") ? e["time_ms"]["total"].value("mean", 0.0) : 0.0);
+        if (!scales.contains(name) || !(scales[name].get<double>() > 0)) continue;
+        const double scale = scales[name].get<double>();
+        auto scaled = [&](std::vector<double> v) {
+            for (double& x : v) x /= scale;
+            return v;
+        };
+        passes.push_back(scaled(numbers(e.contains("repetitions") ? e["repetitions"]["time_ms"].value("total", Json()) : Json())));
+        frames.push_back(scaled(numbers(e.value("total_ms_per_frame", Json()))));
+        means.push_back((e["time_ms"].contains("total") ? e["time_ms"]["total"].value("mean", 0.0) : 0.0) / scale);
     }
-    auto geomean = [](const std::vector<std::vector<double>>& rows) {
+    auto medianAcross = [](const std::vector<std::vector<double>>& rows) {
         std::vector<double> out;
         if (rows.empty()) return out;
         for (size_t k = 0; k < rows.front().size(); ++k) {
-            double logSum = 0;
-            for (const auto& row : rows) logSum += k < row.size() && row[k] > 0 ? std::log(row[k]) : 0.0;
-            out.push_back(std::exp(logSum / double(rows.size())));
+            std::vector<double> column;
+            for (const auto& row : rows)
+                if (k < row.size() && row[k] > 0) column.push_back(row[k]);
+            out.push_back(column.empty() ? 0.0 : medianOf(column));
         }
         return out;
     };
     Json y;
-    y["repetitions"] = {{"count", passes.empty() ? 1 : passes.front().size()}, {"time_ms", {{"total", geomean(passes)}}}};
-    y["total_ms_per_frame"] = geomean(frames);
-    double logSum = 0;
-    for (double m : means) logSum += m > 0 ? std::log(m) : 0.0;
-    y["time_ms"] = {{"total", {{"mean", means.empty() ? 0.0 : std::exp(logSum / double(means.size()))}}}};
+    y["repetitions"] = {{"count", passes.empty() ? 1 : passes.front().size()}, {"time_ms", {{"total", medianAcross(passes)}}}};
+    y["total_ms_per_frame"] = medianAcross(frames);
+    y["time_ms"] = {{"total", {{"mean", means.empty() ? 0.0 : medianOf(means)}}}};
     return y;
+}
+
+Json yardstickScales(const Json& summary) {
+    Json scales = Json::object();
+    for (const auto& [name, e] : summary["algorithms"].items()) {
+        const std::vector<double> s = totalTimeSamples(e, nullptr);
+        if (!s.empty() && medianOf(s) > 0) scales[name] = medianOf(s);
+    }
+    return scales;
 }
 
 Comparison compareRuns(const std::string& baseDir, const std::string& newDir, const CompareOptions& opt) {
@@ -246,8 +265,9 @@ Comparison compareRuns(const std::string& baseDir, const std::string& newDir, co
     if (!opt.relativeTo.empty() && opt.relativeTo != "*" &&
         !(base["algorithms"].contains(opt.relativeTo) && next["algorithms"].contains(opt.relativeTo)))
         throw InputError("--relative-to", "", "\"" + shortText(opt.relativeTo, 60) + "\" is not an algorithm id of both runs (or \"*\")");
-    const Json baseYardstick = opt.relativeTo.empty() ? Json() : yardstickOf(base, opt.relativeTo);
-    const Json newYardstick = opt.relativeTo.empty() ? Json() : yardstickOf(next, opt.relativeTo);
+    const Json scales = yardstickScales(base);
+    const Json baseYardstick = opt.relativeTo.empty() ? Json() : yardstickOf(base, opt.relativeTo, scales);
+    const Json newYardstick = opt.relativeTo.empty() ? Json() : yardstickOf(next, opt.relativeTo, scales);
     if (const auto keys = configDifferences(baseDir, newDir); !keys.empty()) {
         std::string list;
         for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
@@ -310,7 +330,7 @@ Comparison compareRuns(const std::string& baseDir, const std::string& newDir, co
     for (const auto& [id, v] : base["algorithms"].items()) fewest = std::min(fewest, repetitionCount(v));
     if (fewest < 3)
         c.notes.push_back("a run has fewer than 3 repetitions (config \"repeats\"): total times are compared frame by frame, the other "
-                          "stages without an interval");
+                          "stages without an interval, and no time is called slower or faster; use \"repeats\": 9");
     else if (fewest < 5)
         c.notes.push_back("a run has fewer than 5 repetitions: the U test cannot find a difference (p < 0.05) in so few, so no time is "
                           "called slower or faster; use \"repeats\": 5 or more (9 is safer on a shared machine)");

@@ -16,7 +16,7 @@ constexpr int kRegressionExit = 3;
 
 struct CompareOptions {
     /// The smallest relative change that counts (time, accuracy, memory): 10 %, past what the same
-    /// build's runs on a shared 2-core machine differ by (results/ci/compare_noise_llvmpipe.md).
+    /// build's runs on a shared 2-core machine differ by (results/reference/compare_noise_llvmpipe.md).
     double threshold = 0.10;
     std::string imagesDir;    ///< where pictures of changed pixels go ("" none)
     /// An id whose total time, pass by pass, every other id's times are divided by before they are
@@ -34,16 +34,20 @@ struct Comparison {
 Json readRunSummary(const std::string& dir);
 
 /// What `--relative-to ID` divides by in `summary`: ID's entry, or for "*" an entry made of the
-/// geometric mean of every id's total time, pass by pass and frame by frame.
-Json yardstickOf(const Json& summary, const std::string& id);
+/// median over the ids of each one's total time over its scale (`scales`: id → ms, the same for
+/// every run compared), pass by pass and frame by frame.
+Json yardstickOf(const Json& summary, const std::string& id, const Json& scales);
+
+/// Each id's median total time in `summary` (its passes', else its frames'): the scales of "*".
+Json yardstickScales(const Json& summary);
 
 /// One id's total time as samples: the passes' means when it ran 3 or more (`repeats`), else its
 /// frames' totals; each divided by the yardstick's of the same pass or frame when one is given.
 std::vector<double> totalTimeSamples(const Json& entry, const Json* yardstick);
 
 /// "slower" or "faster" when the ratio's interval lies wholly on one side of 1, its median is past
-/// `threshold` and the U test's `p` (negative: none) is below 0.05; else "within noise", or "no
-/// interval" when `ci` is not valid.
+/// `threshold` and the U test's `p` is below 0.05 (negative: no test, no change); else "within
+/// noise", or "no interval" when `ci` is not valid.
 std::string timeVerdict(const Interval& ci, double p, double threshold);
 
 /// Reads BASE/summary.json and NEW/summary.json (InputError naming the file when either is not a

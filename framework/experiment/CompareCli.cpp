@@ -24,8 +24,8 @@ const char* kCompareUsage = R"(  shadowlab compare BASE NEW [--threshold PCT] [-
       with its whole interval above 1, accuracy worse past PCT %, or more overflow. Markdown on
       standard output, or with --out: DIR/compare.md, compare.html, compare.junit.xml and images/.
       --relative-to ID divides every time by ID's total of the same pass first ("*": by the
-      geometric mean of every id's): on a shared machine whose load changed between the runs,
-      only what changed relative to it remains.
+      median over the ids of each one's total over its median in BASE): on a shared machine
+      whose load changed between the runs, only what changed relative to it remains.
       Exit code 0 without regression, 3 with one.
 )";
 

@@ -111,32 +111,68 @@ size_t changePoint(const std::vector<double>& logMedians, size_t a, size_t b) {
     return best;
 }
 
+/// How many run-to-run standard deviations a step must be: with 9 ids judged at every commit, a
+/// normal noise crosses 4 about once in 1,700 commits (3 would be once in 40).
+constexpr double kStepSigmas = 4.0;
+
 struct Boundary {
-    Interval ci;
+    double ratio = 1;          ///< the runs after over the runs before (medians)
+    Interval ci;               ///< from the pooled passes (few runs), else not valid
     double p = -1;
+    double bar = 0;            ///< the relative change a step must pass (runs' noise), 0 with few runs
     std::string verdict;
 };
 
-/// The runs [j - window, j) against [j, j + window) of one id's present runs, pooled.
-Boundary compareAround(const std::vector<std::vector<double>>& samples, size_t j, const HistoryOptions& opt) {
-    std::vector<double> before, after;
-    for (size_t i = j > opt.window ? j - opt.window : 0; i < j; ++i) before.insert(before.end(), samples[i].begin(), samples[i].end());
-    for (size_t i = j; i < std::min(samples.size(), j + opt.window); ++i) after.insert(after.end(), samples[i].begin(), samples[i].end());
+/// The runs' medians in [from, to), in log.
+double medianLog(const std::vector<double>& logMedians, size_t from, size_t to) {
+    return medianOf(std::vector<double>(logMedians.begin() + long(from), logMedians.begin() + long(to)));
+}
+
+/// The run-to-run noise of one id as a standard deviation in log: from consecutive runs' medians
+/// (the median of their absolute differences, so that a few steps do not count as noise).
+double runToRunSigma(const std::vector<double>& logMedians) {
+    std::vector<double> diffs;
+    for (size_t i = 1; i < logMedians.size(); ++i) diffs.push_back(std::fabs(logMedians[i] - logMedians[i - 1]));
+    return std::max(1.4826 * medianOf(diffs) / std::sqrt(2.0), 1e-4);
+}
+
+/// The runs [j - window, j) against [j, j + window) of one id. With 4 or more runs the run is the
+/// unit: a run's passes share its machine state (load, clocks, memory layout), so runs of one
+/// build differ by more than their passes' spread says, and pooling passes across runs would call
+/// that a step. The medians of the runs either side must then differ past the threshold and past
+/// kStepSigmas of the id's run-to-run noise. With 2 or 3 runs there is no noise to measure: the
+/// pooled passes are judged by compare's rule.
+Boundary judge(const std::vector<std::vector<double>>& samples, const std::vector<double>& logMedians, double sigma, size_t j,
+               const HistoryOptions& opt) {
+    const size_t from = j > opt.window ? j - opt.window : 0, to = std::min(samples.size(), j + opt.window);
     Boundary b;
+    if (samples.size() >= 4) {
+        const double d = medianLog(logMedians, j, to) - medianLog(logMedians, from, j);
+        b.ratio = std::exp(d);
+        b.bar = std::exp(kStepSigmas * sigma * std::sqrt(1.0 / double(j - from) + 1.0 / double(to - j))) - 1;
+        const bool past = std::fabs(d) > std::log1p(b.bar);
+        b.verdict = past && b.ratio > 1 + opt.threshold ? "slower" : past && b.ratio < 1 - opt.threshold ? "faster" : "within noise";
+        return b;
+    }
+    std::vector<double> before, after;
+    for (size_t i = from; i < j; ++i) before.insert(before.end(), samples[i].begin(), samples[i].end());
+    for (size_t i = j; i < to; ++i) after.insert(after.end(), samples[i].begin(), samples[i].end());
     b.ci = bootstrapRatioOfMedians(before, after);
+    b.ratio = b.ci.median;
     if (before.size() >= 4 && after.size() >= 4) b.p = mannWhitneyP(before, after);
     b.verdict = timeVerdict(b.ci, b.p, opt.threshold);
     return b;
 }
 
-/// One id's time steps: the boundaries whose pooled windows differ (compare's rule), grouped where
-/// neighbours see the same step, each group named at its change point.
+/// One id's time steps: the boundaries judged a change, grouped where neighbours see the same
+/// step, each group named at its change point.
 void findTimeSteps(const std::string& id, const std::vector<size_t>& present, const std::vector<std::vector<double>>& samples,
                    const HistoryOptions& opt, History& h) {
-    std::vector<Boundary> bounds(samples.size());
-    for (size_t j = 1; j < samples.size(); ++j) bounds[j] = compareAround(samples, j, opt);
     std::vector<double> logMedians;
     for (const auto& s : samples) logMedians.push_back(std::log(std::max(medianOf(s), 1e-300)));
+    const double sigma = runToRunSigma(logMedians);
+    std::vector<Boundary> bounds(samples.size());
+    for (size_t j = 1; j < samples.size(); ++j) bounds[j] = judge(samples, logMedians, sigma, j, opt);
     for (size_t j = 1; j < samples.size();) {
         const std::string v = bounds[j].verdict;
         if (v != "slower" && v != "faster") {
@@ -149,10 +185,12 @@ void findTimeSteps(const std::string& id, const std::vector<size_t>& present, co
         size_t k = changePoint(logMedians, a, b);
         if (k < j || k > end) k = j; // the change point outside the group: its first boundary
         const Boundary& at = bounds[k];
-        const Json& run = h.runs[present[k]];
-        h.steps.push_back({{"id", id}, {"measure", "time"}, {"run", present[k]}, {"label", run["label"]}, {"direction", v},
-                           {"ratio", at.ci.median}, {"low", at.ci.low}, {"high", at.ci.high}, {"p", at.p < 0 ? Json() : Json(at.p)},
-                           {"before", std::exp(logMedians[k - 1])}, {"after", std::exp(logMedians[k])}});
+        const size_t from = k > opt.window ? k - opt.window : 0, to = std::min(samples.size(), k + opt.window);
+        Json step = {{"id", id}, {"measure", "time"}, {"run", present[k]}, {"label", h.runs[present[k]]["label"]}, {"direction", v},
+                     {"ratio", at.ratio}, {"before", std::exp(medianLog(logMedians, from, k))}, {"after", std::exp(medianLog(logMedians, k, to))}};
+        if (at.ci.valid) step.update({{"low", at.ci.low}, {"high", at.ci.high}, {"p", at.p < 0 ? Json() : Json(at.p)}});
+        else step.update({{"run_to_run_noise", std::exp(sigma) - 1}, {"bar", at.bar}});
+        h.steps.push_back(step);
         j = end + 1;
     }
 }
@@ -186,6 +224,8 @@ History readHistory(const std::string& dir, const HistoryOptions& opt) {
         if (!opt.relativeTo.empty() && opt.relativeTo != "*" && !r.summary["algorithms"].contains(opt.relativeTo))
             throw InputError("--relative-to", "", "\"" + shortText(opt.relativeTo, 60) + "\" is not an algorithm id of run " + shortText(r.folder, 100));
     }
+    // The scales of "*": the oldest run's, the same for every run, so the yardstick is comparable.
+    const Json scales = yardstickScales(runs.front().summary);
     if (renderers.size() > 1)
         h.notes.push_back("the runs ran on " + std::to_string(renderers.size()) + " different renderers: a step there may be the machine's");
     for (const std::string& id : ids) {
@@ -199,7 +239,7 @@ History readHistory(const std::string& dir, const HistoryOptions& opt) {
                 mismatch.push_back(nullptr);
                 continue;
             }
-            const Json yardstick = opt.relativeTo.empty() || id == opt.relativeTo ? Json() : yardstickOf(runs[i].summary, opt.relativeTo);
+            const Json yardstick = opt.relativeTo.empty() || id == opt.relativeTo ? Json() : yardstickOf(runs[i].summary, opt.relativeTo, scales);
             std::vector<double> s = totalTimeSamples(algs[id], yardstick.is_null() ? nullptr : &yardstick);
             const double m = mismatchOf(algs[id]);
             mismatch.push_back(std::isfinite(m) ? Json(m) : Json());
@@ -235,8 +275,11 @@ std::string interval(const Json& t) {
 std::string stepChange(const Json& s) {
     if (s["measure"] == "accuracy")
         return "worst-frame mismatch " + shortNumber(100 * s["before"].get<double>(), 4) + " % → " + shortNumber(100 * s["after"].get<double>(), 4) + " %";
-    std::string t = shortNumber(s["ratio"].get<double>(), 4) + "× (95 % interval " + shortNumber(s["low"].get<double>(), 4) + "–" +
-                    shortNumber(s["high"].get<double>(), 4);
+    std::string t = shortNumber(s["ratio"].get<double>(), 4) + "× (";
+    if (s.contains("bar"))
+        return t + "past " + shortNumber(100 * s["bar"].get<double>(), 3) + " %, " + shortNumber(kStepSigmas, 2) + "× the run-to-run noise of " +
+               shortNumber(100 * s["run_to_run_noise"].get<double>(), 3) + " %)";
+    t += "95 % interval " + shortNumber(s["low"].get<double>(), 4) + "–" + shortNumber(s["high"].get<double>(), 4);
     if (!s["p"].is_null()) t += ", p " + shortNumber(s["p"].get<double>(), 2);
     return t + ")";
 }
@@ -246,8 +289,9 @@ std::string stepChange(const Json& s) {
 std::string historyMarkdown(const History& h, const std::string& dir, const HistoryOptions& opt, bool withPlots) {
     std::ostringstream os;
     os << "# History of " << markdownLiteral(dir) << "\n\n- " << h.runs.size() << " runs, "
-       << (opt.byName ? "ordered by folder name" : "oldest first") << "; a time step is a change past " << shortNumber(100 * opt.threshold, 4)
-       << " % between the " << opt.window << " runs before and after it, with its whole 95 % interval on one side of 1\n";
+       << (opt.byName ? "ordered by folder name" : "oldest first") << "; a time step: the median of the " << opt.window
+       << " runs after a boundary over that of the " << opt.window << " before, past " << shortNumber(100 * opt.threshold, 4) << " % and past "
+       << shortNumber(kStepSigmas, 2) << "× the id's run-to-run noise (with fewer than 4 runs: compare's rule on the pooled passes)\n";
     if (!opt.relativeTo.empty())
         os << "- times relative to " << markdownLiteral(opt.relativeTo) << "'s total of the same pass (quotients, not milliseconds)\n";
     for (const auto& n : h.notes) os << "- **note**: " << markdownLiteral(n) << "\n";

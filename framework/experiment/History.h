@@ -2,11 +2,12 @@
 // `shadowlab history DIR`: the runs of one experiment kept across commits (one run folder each in
 // DIR, as a CI job leaves them), in the order they ran: each algorithm id's total time and
 // worst-frame mismatch run by run, and the runs where a step happened, named by commit (as
-// airspeed velocity does). A time step at run k is the ratio of the medians of the runs after it
-// (up to `window`, k included) over those before it, with its bootstrap interval and U test,
-// called by compare's rule (timeVerdict); of neighbouring boundaries that all see one step, the
-// largest change names it. An accuracy step is any change past the threshold from one run to the
-// next (accuracy is deterministic on one renderer).
+// airspeed velocity does). A time step at run k: the median of the runs after it (up to `window`,
+// k included) over that of the runs before, past the threshold and past a multiple of the id's
+// run-to-run noise (runs of one build differ by more than their passes do, so the run is the
+// unit); of neighbouring boundaries that all see one step, the L1 change point names it. An
+// accuracy step is any change past the threshold from one run to the next (accuracy is
+// deterministic on one renderer).
 #include "framework/core/JsonNode.h"
 
 #include <string>

@@ -208,9 +208,14 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     Progress progress(opt.progress,
                       size_t(cfg.frames * cfg.repeats + int(statFrames.size()) + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
     std::optional<CpuGBuffer> cpuG;
+    // The G-buffer and its CPU copy are every algorithm's shared input, made before any timer
+    // starts, in every pass: read back lazily, the copy was paid for by whichever CPU algorithm
+    // (the reference, line_space) a repetition's rotated order put first, a different one each
+    // pass (the reference's passes then spread over 1-2.5x).
     auto renderFrame = [&](const Camera& cam) {
         gbuffer.render(sceneGpu, cam);
-        cpuG.reset();
+        glFinish();
+        cpuG = gbuffer.readBack();
     };
     auto getCpuG = [&]() -> const CpuGBuffer& {
         if (!cpuG) cpuG = gbuffer.readBack();
@@ -245,7 +250,6 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         const TimedWork sceneUpdate = sceneGpu.setTime(cfg.sceneTimeAt(frame), timer);
         if (sceneGpu.dynamic()) checkPoseBounds(cfg, frame, sceneGpu.bounds());
         renderFrame(cam);
-        glFinish();
         const CpuGBuffer& g = getCpuG();
         std::vector<uint8_t> lit = litMask(g, light);
         std::vector<uint8_t> covered = coveredMask(g);
@@ -289,7 +293,6 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
             Light light = cfg.lightAt(frame);
             const TimedWork sceneUpdate = sceneGpu.setTime(cfg.sceneTimeAt(frame), timer);
             renderFrame(cam);
-            glFinish();
             for (size_t k = 0; k < instances.size(); ++k) {
                 Instance& inst = instances[(k + size_t(rep)) % instances.size()];
                 stopIfBroken();

@@ -238,6 +238,12 @@ float EmbreeTracer::traceSegment(glm::vec3 origin, glm::vec3 dir, float tfar, st
     return ray.tfar < 0.0f ? 0.0f : ctx.transmission;
 }
 
+int EmbreeTracer::threadsFor(int requested, size_t pixels) {
+    if (requested > 0) return requested;
+    const size_t byWork = std::max<size_t>(1, pixels / kPixelsPerThread);
+    return int(std::min<size_t>(byWork, std::max(1u, std::thread::hardware_concurrency())));
+}
+
 void EmbreeTracer::traceVisibility(const CpuGBuffer& g, const Light& light, float rayOffset, int threads,
                                    std::vector<float>& visibility) const {
     const size_t pixels = size_t(std::max(g.width, 0)) * size_t(std::max(g.height, 0));
@@ -291,8 +297,7 @@ void EmbreeTracer::traceVisibility(const CpuGBuffer& g, const Light& light, floa
         rays.fetch_add(localRays, std::memory_order_relaxed);
     };
 
-    int n = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    n = std::min(n, g.height);
+    const int n = std::min(threadsFor(threads, pixels), g.height);
     std::vector<std::thread> pool;
     pool.reserve(size_t(n - 1));
     for (int t = 1; t < n; ++t) pool.emplace_back(worker);

@@ -67,7 +67,7 @@ public:
     EmbreeTracer& operator=(const EmbreeTracer&) = delete;
 
     /// Visibility per pixel of `g` (width * height values, row-major) by the convention above.
-    /// `threads` = 0 uses std::thread::hardware_concurrency(). Resizes `visibility`.
+    /// `threads` = 0: threadsFor(0, pixels). Resizes `visibility`.
     void traceVisibility(const CpuGBuffer& g, const Light& light, float rayOffset, int threads,
                          std::vector<float>& visibility) const;
 
@@ -81,6 +81,14 @@ public:
     /// commitMoves() then updates the BVH once for all moves.
     void moveTriangles(size_t firstTriangle, const glm::vec3* positions, size_t count);
     void commitMoves();
+
+    /// The threads a frame of `pixels` is traced on: `requested` when positive; for 0, one per
+    /// kPixelsPerThread pixels, at most the hardware's threads. Threads are started for each
+    /// frame, and on a shared machine the join waits for the latest of them: a small frame traced
+    /// on every hardware thread was slower and noisier than on one (results/reference/
+    /// compare_noise_llvmpipe.md).
+    static int threadsFor(int requested, size_t pixels);
+    static constexpr size_t kPixelsPerThread = 65536;
 
     /// Rays cast by the last traceVisibility() call.
     uint64_t lastRayCount() const { return lastRays_; }
