@@ -15,8 +15,8 @@ namespace shadowlab {
 constexpr int kRegressionExit = 3;
 
 struct CompareOptions {
-    /// The smallest relative change that counts (time, accuracy, memory): 10 %, past what the same
-    /// build's runs on a shared 2-core machine differ by (results/reference/compare_noise_llvmpipe.md).
+    /// The smallest relative change that counts (time, accuracy, memory): 10 %, past what 9 in 10
+    /// pairs of one build's runs differ by relative to '*' on a shared 2-core machine (results/reference/compare_noise_llvmpipe.md).
     double threshold = 0.10;
     std::string imagesDir;    ///< where pictures of changed pixels go ("" none)
     /// An id whose total time, pass by pass, every other id's times are divided by before they are
