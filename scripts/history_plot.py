@@ -46,6 +46,17 @@ def mark_steps(ax, steps, measure, series, colour):
                 markeredgecolor="black", linestyle="none")
 
 
+def finish(fig, ax, h, title, path):
+    """Title, run labels, grid and legend, then the figure saved (atomically) and closed."""
+    ax.set_title(title)
+    ticks(ax, h["runs"])
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110)
+    plt.close(fig)
+
+
 def plot_time(h, out, colour):
     fig, ax = plt.subplots(figsize=(9, 4.8))
     for alg, v in h["ids"].items():
@@ -61,13 +72,7 @@ def plot_time(h, out, colour):
     mark_steps(ax, h["steps"], "time", at, colour)
     ax.set_yscale("log")
     ax.set_ylabel("total time per frame over the yardstick's" if h["relative_to"] else "total time per frame (ms)")
-    ax.set_title("Total time per run (a triangle: a step starts there)")
-    ticks(ax, h["runs"])
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    save_figure(fig, os.path.join(out, "history_time.png"), dpi=110)
-    plt.close(fig)
+    finish(fig, ax, h, "Total time per run (a triangle: a step starts there)", os.path.join(out, "history_time.png"))
 
 
 def plot_accuracy(h, out, colour):
@@ -82,13 +87,7 @@ def plot_accuracy(h, out, colour):
     mark_steps(ax, h["steps"], "accuracy", at, colour)
     ax.set_yscale("symlog", linthresh=1e-3)
     ax.set_ylabel("worst-frame mismatch (% of pixels)")
-    ax.set_title("Accuracy per run (a triangle: a step starts there)")
-    ticks(ax, h["runs"])
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    save_figure(fig, os.path.join(out, "history_accuracy.png"), dpi=110)
-    plt.close(fig)
+    finish(fig, ax, h, "Accuracy per run (a triangle: a step starts there)", os.path.join(out, "history_accuracy.png"))
 
 
 def main():

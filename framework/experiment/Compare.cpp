@@ -98,8 +98,8 @@ Json compareStage(const Json& a, const Json& b, const std::string& stage, double
     r["low"] = ci.valid ? Json(ci.low) : Json();
     r["high"] = ci.valid ? Json(ci.high) : Json();
     r["method"] = method;
-    // Frames paired or means only say nothing about how two runs of one build differ (measured
-    // here: 1 to 3 false calls in 10 per id from 4 frames paired), so they get no verdict.
+    // Frames paired or means only say nothing about how two runs of one build differ (false calls
+    // in results/reference/compare_noise_llvmpipe.md), so they get no verdict.
     r["verdict"] = r.contains("p") ? timeVerdict(ci, r["p"].get<double>(), threshold) : ci.valid ? "too few passes" : "no interval";
     return r;
 }
@@ -214,9 +214,9 @@ std::vector<double> totalTimeSamples(const Json& entry, const Json* yardstick) {
 /// The yardstick of `--relative-to`: an id's entry, or for "*" the machine's speed in each pass
 /// (and frame) as the ids saw it: the median over the ids of each one's time over its scale (its
 /// median total in `scales`, the same for both runs compared). A median, not a mean: one id whose
-/// time swings between runs (the reference's CPU threads on a shared machine, measured up to
-/// 3.5x) or one that regressed leaves it where the others put it; the geometric mean moved every
-/// other id with it.
+/// time swings between runs (the reference's CPU threads on a shared machine) or one that
+/// regressed leaves it where the others put it; a geometric mean moves every other id with it
+/// (results/reference/compare_noise_llvmpipe.md).
 Json yardstickOf(const Json& summary, const std::string& id, const Json& scales) {
     if (id != "*") return summary["algorithms"][id];
     std::vector<std::vector<double>> passes, frames;

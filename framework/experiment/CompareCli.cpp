@@ -33,8 +33,9 @@ const char* kHistoryUsage = R"(  shadowlab history DIR [--threshold PCT] [--rela
       The runs of one experiment kept across commits, one run folder each directly in DIR, oldest
       first (by summary.json's started_utc; --by-name: by folder name): each id's total time and
       worst-frame mismatch run by run, and the runs where a step happened, named by commit. A time
-      step: the N (default 3) runs after a boundary against the N before, past PCT (default 10) %
-      with the whole 95 % interval on one side of 1 (compare's rule); --relative-to as compare's.
+      step: the median of the N (default 3) runs after a boundary over that of the N before, past
+      PCT (default 10) % and past 4x the id's run-to-run noise (with fewer than 4 runs: compare's
+      rule on the pooled passes); --relative-to as compare's.
       Markdown on standard output, or with --out: OUT/history.md, history.html, history.json,
       history.junit.xml and the plots history_time.png, history_accuracy.png.
       Exit code 0, or 3 when the newest run starts a step for the worse (slower, less accurate).
@@ -155,11 +156,10 @@ namespace {
 /// history.junit.xml: per id, whether the newest run starts a step for the worse.
 std::string historyJUnit(const History& h) {
     std::vector<JUnitCase> cases;
-    const size_t newest = h.runs.size() - 1;
     for (const auto& [id, v] : h.ids.items()) {
         std::string slower, worse;
         for (const Json& s : h.steps) {
-            if (s["id"] != id || s["run"].get<size_t>() != newest) continue;
+            if (s["id"] != id || !isNewestRegression(h, s)) continue;
             if (s["direction"] == "slower") slower = "slower from the newest run: " + shortNumber(s["ratio"].get<double>(), 4) + "×";
             if (s["direction"] == "worse")
                 worse = "worst-frame mismatch " + shortNumber(100 * s["before"].get<double>(), 4) + " % → " + shortNumber(100 * s["after"].get<double>(), 4) + " %";
@@ -203,7 +203,7 @@ int historyCommand(const std::vector<std::string>& args) {
     if (dir.empty()) throw InputError("history", "", "expects one folder of run folders (see shadowlab history --help)");
     auto report = [&](const History& h) {
         for (const Json& s : h.steps)
-            if (s["run"].get<size_t>() + 1 == h.runs.size() && (s["direction"] == "slower" || s["direction"] == "worse"))
+            if (isNewestRegression(h, s))
                 std::fprintf(stderr, "shadowlab history: REGRESSION %s: %s from the newest run (%s)\n", shortText(s["id"].get<std::string>(), 60).c_str(),
                              s["direction"].get<std::string>().c_str(), shortText(s["label"].get<std::string>(), 60).c_str());
         std::fprintf(stderr, "shadowlab history: %zu runs, %zu steps, %zu from the newest run for the worse\n", h.runs.size(), h.steps.size(),

@@ -258,9 +258,12 @@ History readHistory(const std::string& dir, const HistoryOptions& opt) {
         findAccuracySteps(id, mismatch, opt, h);
     }
     std::stable_sort(h.steps.begin(), h.steps.end(), [](const Json& a, const Json& b) { return a["run"].get<size_t>() < b["run"].get<size_t>(); });
-    for (const Json& s : h.steps)
-        if (s["run"].get<size_t>() + 1 == runs.size() && (s["direction"] == "slower" || s["direction"] == "worse")) ++h.newestRegressions;
+    h.newestRegressions = size_t(std::count_if(h.steps.begin(), h.steps.end(), [&](const Json& s) { return isNewestRegression(h, s); }));
     return h;
+}
+
+bool isNewestRegression(const History& h, const Json& s) {
+    return s["run"].get<size_t>() + 1 == h.runs.size() && (s["direction"] == "slower" || s["direction"] == "worse");
 }
 
 namespace {

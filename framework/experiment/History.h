@@ -27,8 +27,12 @@ struct History {
     Json ids = Json::object();   ///< per id: {time: [{median, low, high} | null per run], mismatch: [number | null per run]}
     Json steps = Json::array();  ///< {id, measure ("time" | "accuracy"), run, label, direction, ratio, low, high, p, before, after}
     std::vector<std::string> notes;
-    size_t newestRegressions = 0; ///< steps for the worse that start at the newest run
+    size_t newestRegressions = 0; ///< steps for which isNewestRegression()
 };
+
+/// Whether `step` (one of h.steps) starts at the newest run and is for the worse (slower, less
+/// accurate): what fails the command, its JUnit case and its stderr line.
+bool isNewestRegression(const History& h, const Json& step);
 
 /// Reads every complete run folder directly inside `dir` (InputError when there are fewer than 2;
 /// other entries are named in notes) and finds the steps.

@@ -211,7 +211,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     // The G-buffer and its CPU copy are every algorithm's shared input, made before any timer
     // starts, in every pass: read back lazily, the copy was paid for by whichever CPU algorithm
     // (the reference, line_space) a repetition's rotated order put first, a different one each
-    // pass (the reference's passes then spread over 1-2.5x).
+    // pass (results/reference/compare_noise_llvmpipe.md).
     auto renderFrame = [&](const Camera& cam) {
         gbuffer.render(sceneGpu, cam);
         glFinish();
