@@ -90,6 +90,31 @@ TEST(HistoryTest, RunToRunNoiseIsNoStep) {
     EXPECT_TRUE(h.steps.empty()) << h.steps.dump(2);
 }
 
+// A first run 20 % slower than the 5 of one build after it: alone it was named a step (0.80x at
+// run 1 on same-build smoke runs, results/reference/compare_noise_llvmpipe.md); one run is no
+// baseline. The newest run alone after a boundary still is judged (TheNewestRunsRegression...).
+TEST(HistoryTest, AFirstRunAloneIsNoBaseline) {
+    const std::string dir = test::makeTempDir("history-first");
+    writeRuns(dir, {24.0, 20.0, 20.4, 19.8, 20.2, 19.9}, std::vector<double>(6, 0.0), 0.02);
+    const History h = readHistory(dir, {});
+    EXPECT_TRUE(h.steps.empty()) << h.steps.dump(2);
+}
+
+// The newest run's median 30 % up, but its own passes spread from the old level to 40 % up (half
+// of them met a load spike): the reference did this on same-build smoke runs beside other work
+// (results/reference/compare_noise_llvmpipe.md); its median alone was named a regression.
+TEST(HistoryTest, ANewestRunThatMetLoadIsNoStep) {
+    const std::string dir = test::makeTempDir("history-load");
+    writeRuns(dir, {20.0, 20.4, 19.8, 20.2, 19.9, 20.1}, std::vector<double>(6, 0.0), 0.02);
+    Json s = Json::parse(std::ifstream(dir + "/run-95/summary.json"));
+    Json& passes = s["algorithms"]["psv"]["repetitions"]["time_ms"]["total"];
+    passes = {20.1, 19.9, 27.6, 20.3, 26.8, 28.0, 26.0, 20.0, 27.2};
+    std::ofstream(dir + "/run-95/summary.json") << s.dump();
+    const History h = readHistory(dir, {});
+    EXPECT_TRUE(h.steps.empty()) << h.steps.dump(2);
+    EXPECT_EQ(h.newestRegressions, 0u);
+}
+
 TEST(HistoryTest, AStepIsNamedAtTheRunItStartsAndOnlyForTheIdThatChanged) {
     const std::string dir = test::makeTempDir("history-step");
     std::vector<double> ms(10, 20.0), mismatch(10, 0.0);

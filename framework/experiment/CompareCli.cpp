@@ -34,8 +34,9 @@ const char* kHistoryUsage = R"(  shadowlab history DIR [--threshold PCT] [--rela
       first (by summary.json's started_utc; --by-name: by folder name): each id's total time and
       worst-frame mismatch run by run, and the runs where a step happened, named by commit. A time
       step: the median of the N (default 3) runs after a boundary over that of the N before, past
-      PCT (default 10) % and past 4x the id's run-to-run noise (with fewer than 4 runs: compare's
-      rule on the pooled passes); --relative-to as compare's.
+      PCT (default 10) % and past 4x the id's run-to-run noise, with 2 runs or more before it (a
+      single run after it: with its whole interval; with fewer than 4 runs: compare's rule on the
+      pooled passes); --relative-to as compare's.
       Markdown on standard output, or with --out: OUT/history.md, history.html, history.json,
       history.junit.xml and the plots history_time.png, history_accuracy.png.
       Exit code 0, or 3 when the newest run starts a step for the worse (slower, less accurate).

@@ -140,17 +140,32 @@ double runToRunSigma(const std::vector<double>& logMedians) {
 /// unit: a run's passes share its machine state (load, clocks, memory layout), so runs of one
 /// build differ by more than their passes' spread says, and pooling passes across runs would call
 /// that a step. The medians of the runs either side must then differ past the threshold and past
-/// kStepSigmas of the id's run-to-run noise. With 2 or 3 runs there is no noise to measure: the
-/// pooled passes are judged by compare's rule.
+/// kStepSigmas of the id's run-to-run noise, with at least 2 runs before the boundary: one run is
+/// no baseline (a first run's machine state alone can sit past the bar; HistoryTest
+/// AFirstRunAloneIsNoBaseline). One run after must do, or the newest commit could never be
+/// called; that run alone must be past the bar with its whole interval, not its median only: a
+/// run whose own passes spread across the bar met load, not a slower build (HistoryTest
+/// ANewestRunThatMetLoadIsNoStep). With 2 or 3 runs there is no noise to measure: the pooled
+/// passes are judged by compare's rule.
 Boundary judge(const std::vector<std::vector<double>>& samples, const std::vector<double>& logMedians, double sigma, size_t j,
                const HistoryOptions& opt) {
     const size_t from = j > opt.window ? j - opt.window : 0, to = std::min(samples.size(), j + opt.window);
     Boundary b;
     if (samples.size() >= 4) {
-        const double d = medianLog(logMedians, j, to) - medianLog(logMedians, from, j);
+        if (j - from < 2) {
+            b.verdict = "too few runs before";
+            return b;
+        }
+        const double before = medianLog(logMedians, from, j);
+        const double d = medianLog(logMedians, j, to) - before;
         b.ratio = std::exp(d);
         b.bar = std::exp(kStepSigmas * sigma * std::sqrt(1.0 / double(j - from) + 1.0 / double(to - j))) - 1;
-        const bool past = std::fabs(d) > std::log1p(b.bar);
+        double nearest = d; // the after side's value nearest to the before side
+        if (to - j == 1 && samples[j].size() >= 3) {
+            const Interval own = bootstrapMedian(samples[j]);
+            nearest = d > 0 ? std::min(d, std::log(own.low) - before) : std::max(d, std::log(own.high) - before);
+        }
+        const bool past = std::fabs(nearest) > std::log1p(b.bar) && d * nearest > 0;
         b.verdict = past && b.ratio > 1 + opt.threshold ? "slower" : past && b.ratio < 1 - opt.threshold ? "faster" : "within noise";
         return b;
     }
@@ -294,7 +309,7 @@ std::string historyMarkdown(const History& h, const std::string& dir, const Hist
     os << "# History of " << markdownLiteral(dir) << "\n\n- " << h.runs.size() << " runs, "
        << (opt.byName ? "ordered by folder name" : "oldest first") << "; a time step: the median of the " << opt.window
        << " runs after a boundary over that of the " << opt.window << " before, past " << shortNumber(100 * opt.threshold, 4) << " % and past "
-       << shortNumber(kStepSigmas, 2) << "× the id's run-to-run noise (with fewer than 4 runs: compare's rule on the pooled passes)\n";
+       << shortNumber(kStepSigmas, 2) << "× the id's run-to-run noise, with 2 runs or more before it and a single run after it past with its whole interval (with fewer than 4 runs: compare's rule on the pooled passes)\n";
     if (!opt.relativeTo.empty())
         os << "- times relative to " << markdownLiteral(opt.relativeTo) << "'s total of the same pass (quotients, not milliseconds)\n";
     for (const auto& n : h.notes) os << "- **note**: " << markdownLiteral(n) << "\n";
