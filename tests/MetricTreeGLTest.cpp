@@ -127,6 +127,9 @@ const AccuracyCase kAccuracy[] = {
     // Closed meshes (and a ground facing the light, which shadows nothing): culling is exact.
     {"normal_cone_culling", thousandsOfTriangles, {{"normal_cone_culling", true}}, 1e-4},
     {"normal_cone_culling_directional", directionalObjects, {{"normal_cone_culling", true}}, 1e-4},
+    // Spot lights: the pixels outside the cone make no query; the cone cuts the ground and casters.
+    {"spot", smokeSpotShot, {}, 1e-4},
+    {"spot_narrow_pixel_query", narrowSpot, {{"query", std::string("pixel")}}, 1e-4},
     // The rows above run the default tile query (tile auto); the paper's per-pixel query and every
     // tile size, on point and directional lights.
     {"pixel_query_engine", engine, {{"query", std::string("pixel")}}, 1e-4},
@@ -487,7 +490,7 @@ TEST(MetricTreeTest, SchemaDeclaresEveryAblation) {
         EXPECT_NE(info.schema().find(key), nullptr) << key;
     EXPECT_TRUE(info.supports(LightType::Point));
     EXPECT_TRUE(info.supports(LightType::Directional));
-    EXPECT_FALSE(info.supports(LightType::Spot));
+    EXPECT_TRUE(info.supports(LightType::Spot));
     EXPECT_TRUE(info.exact);
 }
 

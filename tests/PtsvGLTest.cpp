@@ -126,6 +126,10 @@ const AccuracyCase kAccuracy[] = {
     {"thousands_no_planes", thousandsOfTriangles, {{"culling_planes", false}}, 1e-4},
     {"thousands_plane_bias", thousandsOfTriangles, {{"plane_bias", 1e-6}}, 1e-4}, // no caster touches a receiver
     {"engine", engineOnGround, {}, 1e-4},
+    // Spot lights: the samples outside the cone take no part; the cone cuts the ground and casters.
+    {"spot", smokeSpotShot, {}, 1e-4},
+    {"spot_narrow_cooperative", narrowSpot, {kCooperative}, 1e-4},
+    {"spot_narrow_invocation_implicit", narrowSpot, {kPerInvocation, {"bounds", std::string("implicit")}}, 1e-4},
 };
 
 class PtsvAccuracyGLTest : public PtsvGLTest, public ::testing::WithParamInterface<AccuracyCase> {};

@@ -110,6 +110,7 @@ TEST(PtsvTest, SchemaDeclaresEveryAblation) {
     EXPECT_EQ(std::get<int>(info.schema().find("tile_size")->def), 8);
     EXPECT_TRUE(info.supports(LightType::Point));
     EXPECT_TRUE(info.supports(LightType::Directional));
+    EXPECT_TRUE(info.supports(LightType::Spot));
     EXPECT_FALSE(info.supports(LightType::Area));
     EXPECT_TRUE(info.exact);
 }

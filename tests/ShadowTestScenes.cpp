@@ -220,6 +220,12 @@ Shot smokeSpotShot() {
     return s;
 }
 
+Shot narrowSpot() {
+    Shot s = smokeSpotShot();
+    s.light.coneDeg = 22.0f;
+    return s;
+}
+
 Shot smokeDirectionalShot() {
     Shot s = smokePointShot();
     s.light = directionalLight({3.0f, 4.0f, 2.0f});

@@ -72,6 +72,8 @@ Shot withEdgeOnWall(Shot s);
 Shot smokePointShot();
 /// smokePointShot() under a 35° spot light aimed at the origin.
 Shot smokeSpotShot();
+/// smokeSpotShot() with a 22° cone: the cone's border crosses the casters and their shadows.
+Shot narrowSpot();
 /// smokePointShot() under a directional light shining towards the origin.
 Shot smokeDirectionalShot();
 /// smokePointShot() under a square area light of side `side` facing the origin, with `samples`

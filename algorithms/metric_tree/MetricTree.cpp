@@ -623,7 +623,7 @@ Footprint metricTreeFootprint(const FootprintQuery& q) {
 AlgorithmInfo metricTreeInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<MetricTree>("metric_tree",
                                     "clusters bounded by spheres/capsules in a per-frame ternary metric tree (compute), per-pixel query",
-                                    {LightType::Point, LightType::Directional}, true, &metricTreeSchema);
+                                    {LightType::Point, LightType::Spot, LightType::Directional}, true, &metricTreeSchema);
     info.motion = MotionHandling::Rigid;
     info.footprint = &metricTreeFootprint;
     return info;

@@ -445,7 +445,7 @@ private:
         // edge planes pass through it); 4e-6 of it is far above float error (psv uses the same) and
         // only sends nodes that close to a plane one level further down.
         float magnitude = glm::length(center) + radius + glm::length(camera.position);
-        if (light.type == LightType::Point) magnitude = std::max(magnitude, glm::length(light.position));
+        if (light.type != LightType::Directional) magnitude = std::max(magnitude, glm::length(light.position));
         const float tolerance = 4e-6f * magnitude;
         const float rayOffset = p_.rayOffset * radius;
         const float aspect = float(resolution_.x) / float(resolution_.y);
@@ -569,7 +569,7 @@ Footprint ptsvFootprint(const FootprintQuery& q) {
 AlgorithmInfo ptsvInfo() {
     AlgorithmInfo info = makeAlgorithmInfo<Ptsv>("ptsv",
                                     "per-triangle shadow volumes through a per-frame view-sample cluster hierarchy (compute)",
-                                    {LightType::Point, LightType::Directional}, true, &ptsvSchema);
+                                    {LightType::Point, LightType::Spot, LightType::Directional}, true, &ptsvSchema);
     info.footprint = &ptsvFootprint;
     return info;
 }

@@ -371,7 +371,8 @@ void main() {
             vec3 x = pos.xyz, nrm = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // facing away from the light
             // The reference's ray origin: the same offset along the same (unnormalised) normal.
-            if (dot(nrm, toLight(x)) > 0.0) { needs = true; q = x + nrm * uRayOffset; }
+            // Outside a spot's cone the light does not reach x (the reference's rule, Light::illuminates).
+            if (lightIlluminates(x) && dot(nrm, toLight(x)) > 0.0) { needs = true; q = x + nrm * uRayOffset; }
         }
     }
     Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false, false);
