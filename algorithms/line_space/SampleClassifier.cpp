@@ -44,7 +44,7 @@ SampleClasses classifySamples(const EmbreeTracer& tracer, const CpuGBuffer& g, c
                 const size_t i = size_t(y) * size_t(g.width) + size_t(x);
                 if (!g.covered(i)) continue;
                 const glm::vec3 p = g.positionAt(i), n = g.normalAt(i);
-                if (!light.illuminates(p) || glm::dot(n, light.toLight(p)) <= 0.0f) continue;
+                if (!light.reaches(p, n)) continue;
                 const glm::vec3 o = p + n * rayOffset; // the reference's ray, float for float
                 const uint32_t start = perPixel[i * stride];
                 for (size_t s = 0; s < count; ++s) {

@@ -10,7 +10,7 @@ std::vector<uint8_t> litMask(const CpuGBuffer& g, const Light& light) {
     for (size_t i = 0; i < n; ++i) {
         if (!g.covered(i)) continue;
         glm::vec3 p = g.positionAt(i);
-        mask[i] = light.illuminates(p) && glm::dot(g.normalAt(i), light.toLight(p)) > 0.0f;
+        mask[i] = light.reaches(p, g.normalAt(i));
     }
     return mask;
 }

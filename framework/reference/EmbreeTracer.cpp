@@ -270,7 +270,7 @@ void EmbreeTracer::traceVisibility(const CpuGBuffer& g, const Light& light, floa
                 const size_t i = size_t(y) * size_t(g.width) + size_t(x);
                 if (!g.covered(i)) continue; // background stays 1
                 const glm::vec3 p = g.positionAt(i), n = g.normalAt(i);
-                if (!light.illuminates(p) || glm::dot(n, light.toLight(p)) <= 0.0f) {
+                if (!light.reaches(p, n)) {
                     visibility[i] = 0.0f;
                     continue;
                 }

@@ -5,10 +5,10 @@
 // Ground-truth convention (every algorithm is measured against exactly this):
 //   For each pixel i of the G-buffer:
 //   * background (not covered)                               → visibility 1 (nothing to shadow).
-//   * !light.illuminates(p) (outside a spot cone, behind an
-//     area light's plane) or dot(n, L) <= 0 with
-//     L = light.toLight(p) (the area light's centre for area
-//     lights; n is the camera-facing normal)                  → visibility 0 (unlit by geometry;
+//   * !light.reaches(p, n) (outside a spot cone, behind an
+//     area light's plane, or n facing away from the light
+//     or its centre; n is the camera-facing normal; decided
+//     by the same float operations as the shaders' lightReaches) → visibility 0 (unlit by geometry;
 //                                                                the metrics ignore such pixels).
 //   * otherwise, for each sample point s of light.samplePoints() (a single point for point and spot
 //     lights; for a directional light one ray along -direction() with tfar = +inf), one occlusion

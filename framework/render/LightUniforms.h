@@ -12,6 +12,7 @@ inline void setLightUniforms(const ShaderProgram& p, const Light& light) {
     p.set("uLightPosition", light.position);
     p.set("uLightDirection", light.direction());
     p.set("uLightCosCone", float(std::cos(glm::radians(light.coneDeg))));
+    p.set("uLightCosConeSq", light.cosConeSquared());
 }
 
 } // namespace shadowlab

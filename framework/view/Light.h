@@ -33,8 +33,17 @@ struct Light {
     std::vector<glm::vec3> samplePoints() const;
     /// Unit direction from surface point p towards the light (for N·L), ignoring occlusion.
     glm::vec3 toLight(glm::vec3 p) const;
-    /// Whether p receives direct light at all before occlusion: inside a spot cone, in front of an area light.
+    /// Whether p receives direct light at all before occlusion: inside a spot cone, in front of an
+    /// area light (as lightIlluminates() in shaders/common/light.glsl decides it, see reaches()).
     bool illuminates(glm::vec3 p) const;
+    /// Whether a surface point p of normal n (not normalised) receives direct light before
+    /// occlusion: illuminates(p) and n facing the light. The decision every exact algorithm and the
+    /// reference share: the same float operations as lightReaches() in shaders/common/light.glsl,
+    /// each rounded as IEEE single with subnormal results flushed to zero, so that GPU and CPU
+    /// decide alike even where the answer is a tie (grazing light, the cone's surface).
+    bool reaches(glm::vec3 p, glm::vec3 n) const;
+    /// cos² of the spot's half-angle as the shaders get it (uLightCosConeSq).
+    float cosConeSquared() const;
 };
 
 /// Sample offsets in [-0.5, 0.5]^2 on the unit rectangle; deterministic for (pattern, count, seed).

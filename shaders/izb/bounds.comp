@@ -19,7 +19,7 @@ void main() {
     if (any(greaterThanEqual(px, uResolution))) return;
     vec4 pos = texelFetch(uPosition, px, 0);
     vec3 n = texelFetch(uNormal, px, 0).xyz;
-    if (!(pos.w >= 0.5 && lightIlluminates(pos.xyz) && dot(n, toLight(pos.xyz)) > 0.0)) return;
+    if (!(pos.w >= 0.5 && lightReaches(pos.xyz, n))) return;
     vec3 x = pos.xyz + n * uRayOffset;
     int face = 0;
     vec2 uv;

@@ -30,7 +30,7 @@ void main() {
     vec4 pos = texelFetch(uPosition, px, 0);
     vec3 n = texelFetch(uNormal, px, 0).xyz;
     vec3 x = pos.xyz + n * uRayOffset;
-    if (pos.w >= 0.5 && lightIlluminates(pos.xyz) && dot(n, toLight(pos.xyz)) > 0.0) {
+    if (pos.w >= 0.5 && lightReaches(pos.xyz, n)) {
         if (lightIsDirectional()) {
             at = izbCellOf(0, izbOrtho(x));
             cell = izbCellIndex(0, at);

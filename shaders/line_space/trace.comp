@@ -604,7 +604,7 @@ void main() {
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
-            if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
+            if (lightReaches(p, n)) {
                 vec3 o = p + n * uRayOffset;
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
                 int count = directional ? 1 : uSampleCount, first = uSampleFirst, end = directional ? 1 : uSampleEnd;

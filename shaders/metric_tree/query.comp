@@ -372,7 +372,7 @@ void main() {
             visibility = 0.0; // facing away from the light
             // The reference's ray origin: the same offset along the same (unnormalised) normal.
             // Outside a spot's cone the light does not reach x (the reference's rule, Light::illuminates).
-            if (lightIlluminates(x) && dot(nrm, toLight(x)) > 0.0) { needs = true; q = x + nrm * uRayOffset; }
+            if (lightReaches(x, nrm)) { needs = true; q = x + nrm * uRayOffset; }
         }
     }
     Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false, false);

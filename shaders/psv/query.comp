@@ -270,7 +270,7 @@ void main() {
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // facing away from the light, or outside a spot's cone
-            if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
+            if (lightReaches(p, n)) {
                 // The reference's ray origin: the same offset along the same (unnormalised) normal.
                 Query Q;
                 Q.q = p + n * uRayOffset;

@@ -25,7 +25,7 @@ void main() {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             key = PTSV_KEY_AWAY;
             // Outside a spot's cone the light does not reach p (the reference's rule, Light::illuminates).
-            if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
+            if (lightReaches(p, n)) {
                 // The reference's ray origin: the same offset along the same (unnormalised) normal.
                 q = p + n * uRayOffset;
                 // The key follows the G-buffer point p (in this pixel's frustum); q is at most

@@ -37,7 +37,7 @@ void main() {
     if (pos.w >= 0.5) {
         vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
         visibility = 0.0;
-        if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
+        if (lightReaches(p, n)) {
             uint stencil = texelFetch(uStencil, px, 0).x & 255u;
             int count = int(texelFetch(uCount, px, 0).x);
             countView = float(count);

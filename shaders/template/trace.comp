@@ -65,7 +65,7 @@ void main() {
     if (pos.w >= 0.5) {
         vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
         visibility = 0.0; // not reached by the light (the metrics skip these pixels)
-        if (lightIlluminates(p) && dot(n, toLight(p)) > 0.0) {
+        if (lightReaches(p, n)) {
             vec3 o = p + n * uRayOffset;
             bool directional = lightIsDirectional();
             int count = directional ? 1 : uSampleCount, end = directional ? 1 : uSampleEnd;
