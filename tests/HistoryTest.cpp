@@ -232,5 +232,27 @@ TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
     }
 }
 
+// Seventh probe: `compare A B --out A --force` and `history H --out H/r1 --force` replaced a run
+// they had just read with their report (exit 0). An output that is, holds or lies inside an input
+// is refused before anything is read or written.
+TEST(HistoryTest, NeitherHistoryNorCompareReplacesARunItReads) {
+    const std::string dir = test::makeTempDir("history-inputs");
+    writeRuns(dir, {20, 20, 20}, {0, 0, 0}, kSpread);
+    const std::string a = dir + "/run-100", b = dir + "/run-99";
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"compare", a, b, "--out", a, "--force"}, {"compare", a, b, "--out", b, "--force"},
+          {"compare", a, b, "--out", dir, "--force"}, {"compare", a, b, "--out", a + "/cmp"},
+          {"history", dir, "--out", a, "--force"}, {"history", dir, "--out", dir, "--force"}, {"history", dir, "--out", dir + "/h"}}) {
+        std::vector<std::string> argv{SHADOWLAB_BINARY};
+        argv.insert(argv.end(), args.begin(), args.end());
+        const test::Ran ran = test::runArgs(argv);
+        EXPECT_EQ(ran.rc, 2) << args[0] << " --out " << args[4] << ": " << ran.err;
+        EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
+        for (const std::string& run : {a, b}) EXPECT_TRUE(fs::is_regular_file(run + "/summary.json")) << run;
+    }
+    EXPECT_FALSE(fs::exists(a + "/cmp"));
+    EXPECT_FALSE(fs::exists(dir + "/h"));
+}
+
 } // namespace
 } // namespace shadowlab

@@ -179,22 +179,13 @@ void refuseInputsInsideReplacedOutput(const std::string& config, const std::vect
     namespace fs = std::filesystem;
     std::error_code ec;
     if (!fs::is_directory(fs::symlink_status(dir, ec))) return;
-    const fs::path root = fs::weakly_canonical(fs::absolute(dir), ec);
-    auto inside = [&](const std::string& file) {
-        const fs::path p = fs::weakly_canonical(fs::absolute(file), ec);
-        const auto [a, b] = std::mismatch(root.begin(), root.end(), p.begin(), p.end());
-        return a == root.end();
-    };
     Json j = JsonNode::parseFile(config);
     for (const auto& o : overrides) applyOverride(j, o);
     const std::vector<std::string> gltf = gltfPathsOf(j.value("scene", Json()));
     std::vector<std::string> inputs = {config};
     const fs::path folder = fs::absolute(config).parent_path();
     for (const std::string& g : gltf) inputs.push_back(fs::path(g).is_absolute() ? g : (folder / g).string());
-    for (const std::string& file : inputs)
-        if (inside(file))
-            throw InputError(shortText(dir, 300), "", "--force would replace the folder with everything in it, and this run reads " +
-                                                          shortText(file, 200) + " from inside it: move that file out, or choose another --out");
+    OutputPlace::refuseInputsInside(dir, inputs, "this run");
 }
 
 int run(const std::vector<std::string>& args) {

@@ -132,6 +132,7 @@ int compareCommand(const std::vector<std::string>& args) {
         std::fprintf(stderr, "shadowlab compare: %zu regressions\n", c.regressions);
         return c.regressions ? kRegressionExit : 0;
     }
+    OutputPlace::refuseInputsInside(out, runs, "compare"); // --force would delete a run it compares
     installInterruptHandlers();
     OutputPlace place = OutputPlace::open(out, force);
     const std::string dir = place.partialDir();
@@ -217,6 +218,7 @@ int historyCommand(const std::vector<std::string>& args) {
         return report(h);
     }
     const History h = readHistory(dir, opt); // before the output folder: bad input leaves nothing behind
+    OutputPlace::refuseInputsInside(out, {dir}, "history"); // --force would delete runs it reads
     installInterruptHandlers();
     OutputPlace place = OutputPlace::open(out, force);
     const std::string outDir = place.partialDir();

@@ -396,6 +396,24 @@ void removeEmptyFolders(const std::vector<std::string>& folders) {
 }
 } // namespace
 
+void OutputPlace::refuseInputsInside(const std::string& dir, const std::vector<std::string>& inputs, const std::string& what) {
+    std::error_code ec;
+    const fs::path root = fs::weakly_canonical(fs::absolute(dir), ec);
+    auto within = [](const fs::path& outer, const fs::path& inner) {
+        const auto [a, b] = std::mismatch(outer.begin(), outer.end(), inner.begin(), inner.end());
+        return a == outer.end();
+    };
+    for (const std::string& input : inputs) {
+        const fs::path p = fs::weakly_canonical(fs::absolute(input), ec);
+        if (within(root, p))
+            throw InputError(shortPath(dir), "", "the output would replace the folder with everything in it, and " + what + " reads " +
+                                                     shortPath(input) + " from inside it: choose another --out");
+        if (within(p, root))
+            throw InputError(shortPath(dir), "", "the output lies inside " + shortPath(input) + ", which " + what +
+                                                     " reads: choose an --out outside it");
+    }
+}
+
 OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<std::string>* notes, const std::string& runConfig) {
     const std::string dir = normalize(given);
     check(dir, runConfig);  // before anything is created
