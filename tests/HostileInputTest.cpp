@@ -153,6 +153,23 @@ std::vector<BadCase> badCases() {
         {"SphereFarFromTheOrigin", "c.json",
          configWith({{"scene", R"({"objects": [{"procedural": "sphere", "radius": 0.5, "transform": {"translate": [1e7, 0, 0]}}]})"}}),
          {"/scene/objects/0", "would be drawn distorted", "at most 1 %"}},
+        // Seventh probe: a grid's copies were checked as one object 1e8 across, each a 2-unit
+        // sphere where a float's spacing is 4 (nested too, the outer grid moved far away).
+        {"GridCopiesFarFromTheOrigin", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "grid", "count": [2, 1, 1], "spacing": [1e8, 0, 0],
+                                    "object": {"procedural": "sphere", "triangles": 16}}]})"}}),
+         {"/scene/objects/0", "copy 1 of the grid's 2", "would be drawn distorted"}},
+        {"NestedGridMovedFarFromTheOrigin", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "grid", "count": [2, 1, 1], "spacing": [1e3, 0, 0],
+                                    "transform": {"translate": [1e8, 0, 0]}, "object": {"procedural": "grid", "count": [2, 1, 1],
+                                    "spacing": [3, 0, 0], "object": {"procedural": "sphere", "triangles": 16}}}]})"}}),
+         {"/scene/objects/0", "of the grid's 4", "would be drawn distorted"}},
+        // Seventh probe: a sphere whose path took it to 1e8 ran, where it sat static was refused.
+        {"MovingSphereFarFromTheOrigin", "c.json",
+         configWith({{"frames", "2"}, {"scene", R"({"objects": [{"procedural": "plane"}, {"procedural": "sphere", "radius": 0.6,
+                                    "triangles": 100, "path": {"interpolation": "linear", "keyframes": [{"time": 0, "translate": [0, 0, 0]},
+                                    {"time": 1, "translate": [1e8, 0, 0]}]}}]})"}}),
+         {"/scene/objects/1/path", "the moving object", "would be drawn distorted", "frame 1"}},
         // Sixth probe: an absolute buffer path was "not found" without a JSON path; "%zz" was called a NUL.
         {"GltfBufferAbsolutePath", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "/etc/hostname"}])"}}),
          {"m.gltf", "/buffers/0/uri", "an absolute path"}},

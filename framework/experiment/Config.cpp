@@ -1,6 +1,7 @@
 #include "framework/experiment/Config.h"
 
 #include "framework/core/Text.h"
+#include "framework/scene/Scene.h"
 #include "framework/scene/SceneConfig.h"
 
 #include <algorithm>
@@ -162,10 +163,16 @@ static void checkPoses(const ExperimentConfig& c) {
                                        (k & 4) ? part.localMax.z : part.localMin.z);
                 b.extend(glm::vec3(pose[p] * glm::vec4(corner, 1.0f)));
             }
+            const std::string file = part.sourceFile.empty() ? c.file : part.sourceFile;
+            const std::string path = part.sourcePath.empty() ? "/scene" : part.sourcePath;
             if (!withinCoordinates(b))
-                throw InputError(part.sourceFile.empty() ? c.file : part.sourceFile, part.sourcePath.empty() ? "/scene" : part.sourcePath,
-                                 "the moving object reaches beyond ±1e15 scene units (or a non-finite position) at " +
-                                     frameText(c, f) + " (check its translate and scale)");
+                throw InputError(file, path, "the moving object reaches beyond ±1e15 scene units (or a non-finite position) at " +
+                                                 frameText(c, f) + " (check its translate and scale)");
+            // As a static object is held to (seventh probe: a sphere moved to 1e8 ran, where it sat
+            // static was refused).
+            if (const std::string why = floatDistortion(b); !why.empty())
+                throw InputError(file, path, "the moving object, " + why + ", at " + frameText(c, f) +
+                                                 ": keep its path nearer the origin or make the object larger");
         }
         checkPoseBounds(c, f, scene.boundsAt(pose));
         if (f == c.frames - 1) break;

@@ -4,9 +4,31 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace shadowlab {
+
+std::string floatPrecisionAt(const Bounds& b) {
+    const float far = std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
+    char text[160];
+    std::snprintf(text, sizeof text, "coordinates up to %.3g, where a float's spacing is %.3g", double(far),
+                  double(std::nextafter(far, INFINITY) - far));
+    return text;
+}
+
+std::string floatDistortion(const Bounds& b) {
+    const glm::vec3 extent = b.extent();
+    const float size = std::max({extent.x, extent.y, extent.z});
+    const float far = std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
+    const float spacing = std::nextafter(far, INFINITY) - far;
+    if (!(size > 0.0f && spacing > 0.01f * size)) return "";
+    char text[160];
+    std::snprintf(text, sizeof text, "%.3g units across, would be drawn distorted: ", double(size));
+    char ratio[48];
+    std::snprintf(ratio, sizeof ratio, ", %.3g %% of its size (at most 1 %%)", 100.0 * double(spacing) / double(size));
+    return text + floatPrecisionAt(b) + ratio;
+}
 
 void Scene::addTriangles(const std::vector<glm::vec3>& tri, const Material& material) {
     uint32_t mat = static_cast<uint32_t>(materials.size());

@@ -50,6 +50,12 @@ private:
     static float highest(float a, float b) { return std::isnan(a) || std::isnan(b) ? std::nanf("") : (b > a ? b : a); }
 };
 
+/// "" when what lies in `b` keeps its shape in float (a float's spacing at its farthest coordinate
+/// at most 1 % of its size); else why not, as "N units across, would be drawn distorted: ...".
+std::string floatDistortion(const Bounds& b);
+/// "coordinates up to X, where a float's spacing is Y" for what lies in `b`.
+std::string floatPrecisionAt(const Bounds& b);
+
 /// One part's world matrix at `time`, checked as poseAt() checks it.
 glm::mat4 poseOf(const MovingPart& part, double time);
 

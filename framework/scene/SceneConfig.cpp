@@ -90,6 +90,10 @@ struct Builder {
     /// Triangles in moving parts and the parts (upper bounds); none when not set.
     std::function<std::pair<size_t, size_t>()> moving = {};
     std::pair<size_t, size_t> movingCount() const { return moving ? moving() : std::pair<size_t, size_t>{0, 0}; }
+    /// Grids: the triangles of the object the innermost grid repeats (its copies lie one after the
+    /// other in the built scene, however the grids nest); 0 when not set (not a grid).
+    std::function<size_t()> leaf = {};
+    size_t leafCount() const { return leaf ? leaf() : 0; }
     Scene operator()() const { return make(); }
 };
 
@@ -252,7 +256,14 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
                    [=] {
                        const auto [triangles, parts] = inner->movingCount();
                        return std::pair{saturatingMul(triangles, copies), saturatingMul(parts, copies)};
-                   }};
+                   },
+                   [=] { return inner->leafCount() ? inner->leafCount() : inner->count(); }};
+}
+
+/// Refuses `what` (lying in `b`) where a float's spacing exceeds 1 % of its size.
+void checkPrecision(JsonNode& node, const std::string& what, const Bounds& b) {
+    if (const std::string why = floatDistortion(b); !why.empty())
+        node.failHere(what + ", " + why + ": move the scene nearer the origin or make the object larger");
 }
 
 /// The built object must be usable: an overflowing radius or scale turns every triangle into
@@ -264,36 +275,28 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
 /// generated object that lost triangles to float rounding (`exactCount`: what its generator
 /// makes, 0 when not known exactly, as for a glTF file's own degenerate triangles), or that lies
 /// where a float's spacing exceeds 1 % of its size, is refused, naming the precision there.
-void checkBuilt(const Scene& s, JsonNode& node, size_t exactCount) {
+void checkBuilt(const Scene& s, JsonNode& node, size_t exactCount, size_t leaf) {
     if (s.triangleCount() == 0)
         node.failHere("the object has no triangles left: every one is degenerate or overflows a float (check sizes, "
                       "radii and scale)");
     for (int i = 0; i < 3; ++i)
         if (!(std::abs(double(s.bounds.min[i])) <= kMaxCoordinate && std::abs(double(s.bounds.max[i])) <= kMaxCoordinate))
             node.failHere("the object reaches beyond ±1e15 scene units (check sizes, radii, scale and translate)");
-    const glm::vec3 extent = s.bounds.extent();
-    const float size = std::max({extent.x, extent.y, extent.z});
-    const float far = std::max({std::abs(s.bounds.min.x), std::abs(s.bounds.min.y), std::abs(s.bounds.min.z), std::abs(s.bounds.max.x),
-                                std::abs(s.bounds.max.y), std::abs(s.bounds.max.z)});
-    const float spacing = std::nextafter(far, INFINITY) - far;
-    auto precision = [&] {
-        char text[160];
-        std::snprintf(text, sizeof text, "coordinates up to %.3g, where a float's spacing is %.3g", double(far), double(spacing));
-        return std::string(text);
-    };
     if (exactCount > 0 && s.triangleCount() < exactCount && s.moving.empty())
         node.failHere(std::to_string(exactCount - s.triangleCount()) + " of its " + std::to_string(exactCount) +
-                      " triangles have no normal in float (" + precision() +
+                      " triangles have no normal in float (" + floatPrecisionAt(s.bounds) +
                       "; a triangle needs an area the coordinates' precision can show, and edges below about 1e9 units): "
                       "move the scene nearer the origin, or change the object's size");
-    if (size > 0.0f && spacing > 0.01f * size) {
-        char share[96];
-        std::snprintf(share, sizeof share, "%.3g units across, would be drawn distorted: ", double(size));
-        char ratio[32];
-        std::snprintf(ratio, sizeof ratio, "%.3g %%", 100.0 * double(spacing) / double(size));
-        node.failHere(std::string("the object, ") + share + precision() + ", " + ratio +
-                      " of its size (at most 1 %): move the scene nearer the origin or make the object larger");
-    }
+    checkPrecision(node, "the object", s.bounds);
+    // A grid's copies, each on its own (seventh probe: 2 copies 1e8 apart of a 2-unit sphere passed
+    // as one object 1e8 across; each copy lay where a float's spacing is 4).
+    if (leaf > 0 && s.triangleCount() % leaf == 0 && s.triangleCount() > leaf)
+        for (size_t first = 0; first < s.triangleCount(); first += leaf) {
+            Bounds b;
+            for (size_t v = 3 * first; v < 3 * (first + leaf); ++v) b.extend(s.positions[v]);
+            checkPrecision(node, "copy " + std::to_string(first / leaf + 1) + " of the grid's " + std::to_string(s.triangleCount() / leaf) +
+                                     " (its innermost object)", b);
+        }
 }
 
 /// Reads and checks one OBJECT (and, for grids, the objects inside it) without building anything.
@@ -386,6 +389,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
     placed.count = [built] { return built->count(); };
     placed.materials = [built] { return built->materialCount(); };
     placed.moves = built->moves || path != nullptr;
+    placed.leaf = [built] { return built->leafCount(); };
     // A path moves the whole object: its static runs (at most one more than its parts) become parts.
     placed.moving = [built, moves = path != nullptr] {
         if (!moves) return built->movingCount();
@@ -410,7 +414,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         if (m != glm::mat4(1.0f)) transformInPlace(s, m);
         // The path moves the placed object: world(t) = path(t) · transform · object.
         if (path) s.attachMotion(motion, path->startTime(), path->endTime(), path->file, path->jsonPath);
-        checkBuilt(s, node, expected);
+        checkBuilt(s, node, expected, built->leafCount());
         return s;
     };
     return placed;
