@@ -7,6 +7,8 @@
 #include "tests/SmallExperiment.h"
 #include "tests/TestSupport.h"
 
+#include <filesystem>
+
 namespace shadowlab {
 namespace {
 
@@ -71,6 +73,27 @@ TEST_F(CompareGLTest, PlantedRegressionsAreNamedAndARunAgainstItselfChangesNothi
     const Comparison relative = compareRuns(dir + "/base", dir + "/planted", opt);
     EXPECT_EQ(record(relative, "psv")["time"].back()["verdict"], "slower") << record(relative, "psv")["time"].dump(2);
     EXPECT_EQ(record(relative, "bvh_raytrace")["regressions"].size(), 0u);
+}
+
+// Seventh probe: an image compare could not read (truncated, missing, a FIFO, another size) was
+// skipped without a word, and the report read as if nothing had changed. Each is now named.
+TEST_F(CompareGLTest, ImagesThatCannotBeComparedAreNamed) {
+    const std::string dir = test::makeTempDir("compare-images");
+    runInto(dir + "/base");
+    std::filesystem::copy(dir + "/base", dir + "/broken", std::filesystem::copy_options::recursive);
+    std::filesystem::resize_file(dir + "/broken/images/psv_f0002_visibility.png", 200);
+    std::filesystem::remove(dir + "/broken/images/bvh_raytrace_f0002_visibility.png");
+    const Comparison c = compareRuns(dir + "/base", dir + "/broken", {});
+    for (const char* id : {"psv", "bvh_raytrace"}) {
+        const Json& images = record(c, id)["images"];
+        ASSERT_EQ(images.size(), 1u) << id;
+        EXPECT_TRUE(images[0]["changed_pixels"].is_null()) << id;
+        EXPECT_NE(images[0]["note"].get<std::string>().find("NEW's image " + std::string(id) + "_f0002_visibility.png"), std::string::npos)
+            << images.dump();
+    }
+    const std::string md = comparisonMarkdown(c, dir + "/base", dir + "/broken", {});
+    EXPECT_NE(md.find("psv frame 2: images not compared"), std::string::npos) << md;
+    EXPECT_NE(md.find("bvh_raytrace frame 2: images not compared"), std::string::npos) << md;
 }
 
 } // namespace

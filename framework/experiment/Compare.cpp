@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/Text.h"
+#include "framework/experiment/Config.h"
 #include "framework/experiment/JUnit.h"
 #include "framework/metrics/Noise.h"
 
@@ -118,19 +119,24 @@ struct Picture {
     std::vector<unsigned char> rgba;
 };
 
-bool readPng(const std::string& path, Picture& p) {
+/// Reads a run's saved image; "" when it was read, else why not (a run's images are at most the
+/// largest resolution a config takes, so a larger one is not a run's and is not decoded).
+std::string readPng(const std::string& path, Picture& p) {
     std::vector<unsigned char> bytes;
     try {
         bytes = readInputFileBytes(path, size_t(256) << 20);
-    } catch (const InputError&) {
-        return false;
+    } catch (const InputError& e) {
+        return e.cause();
     }
     int n = 0;
+    if (!stbi_info_from_memory(bytes.data(), int(bytes.size()), &p.width, &p.height, &n)) return "not an image stb can read";
+    if (p.width > configlimits::kResolutionMax || p.height > configlimits::kResolutionMax)
+        return std::to_string(p.width) + "×" + std::to_string(p.height) + " pixels, larger than any run's image";
     unsigned char* data = stbi_load_from_memory(bytes.data(), int(bytes.size()), &p.width, &p.height, &n, 4);
-    if (!data) return false;
+    if (!data) return std::string("cannot be decoded: ") + stbi_failure_reason();
     p.rgba.assign(data, data + size_t(p.width) * size_t(p.height) * 4);
     stbi_image_free(data);
-    return true;
+    return "";
 }
 
 /// The saved visibility images of `id` in both runs, frame by frame: pixels that differ, and a
@@ -139,18 +145,30 @@ Json compareImages(const std::string& baseDir, const std::string& newDir, const 
     Json out = Json::array();
     const std::string prefix = id + "_f", suffix = "_visibility.png";
     std::error_code ec;
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(newDir + "/images", ec)) {
-        const std::string n = e.path().filename().string();
-        if (n.starts_with(prefix) && n.ends_with(suffix) && n.size() == prefix.size() + 4 + suffix.size()) names.push_back(n);
-    }
-    std::sort(names.begin(), names.end());
+    // The frames either run saved (a frame saved by one run only is named, not skipped).
+    std::set<std::string> names;
+    for (const std::string& dir : {baseDir, newDir})
+        for (const auto& e : fs::directory_iterator(dir + "/images", ec)) {
+            const std::string n = e.path().filename().string();
+            if (n.starts_with(prefix) && n.ends_with(suffix) && n.size() == prefix.size() + 4 + suffix.size() &&
+                std::all_of(n.begin() + long(prefix.size()), n.begin() + long(prefix.size() + 4), [](char c) { return c >= '0' && c <= '9'; }))
+                names.insert(n);
+        }
     for (const std::string& n : names) {
-        Picture a, b;
-        if (!readPng(baseDir + "/images/" + n, a) || !readPng(newDir + "/images/" + n, b)) continue;
         const int frame = std::stoi(n.substr(prefix.size(), 4));
+        auto notCompared = [&](const std::string& why) { out.push_back({{"frame", frame}, {"changed_pixels", Json()}, {"note", why}}); };
+        Picture a, b;
+        if (const std::string why = readPng(baseDir + "/images/" + n, a); !why.empty()) {
+            notCompared("BASE's image " + n + ": " + why);
+            continue;
+        }
+        if (const std::string why = readPng(newDir + "/images/" + n, b); !why.empty()) {
+            notCompared("NEW's image " + n + ": " + why);
+            continue;
+        }
         if (a.width != b.width || a.height != b.height) {
-            out.push_back({{"frame", frame}, {"changed_pixels", Json()}, {"note", "the images differ in size"}});
+            notCompared("the images differ in size (" + std::to_string(a.width) + "×" + std::to_string(a.height) + " → " +
+                        std::to_string(b.width) + "×" + std::to_string(b.height) + ")");
             continue;
         }
         size_t changed = 0;
@@ -382,7 +400,12 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
             os << "- " << markdownLiteral(r["id"].get<std::string>()) << " " << markdownLiteral(name) << ": " << shortNumber(v["base"].get<double>(), 4)
                << " → " << shortNumber(v["new"].get<double>(), 4) << "\n";
         for (const Json& im : r["images"]) {
-            if (im["changed_pixels"].is_null() || im["changed_pixels"].get<size_t>() == 0) continue;
+            if (im.contains("note")) {
+                os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << ": images not compared: "
+                   << markdownLiteral(im["note"].get<std::string>()) << "\n";
+                continue;
+            }
+            if (im["changed_pixels"].get<size_t>() == 0) continue;
             os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << ": " << im["changed_pixels"] << " of "
                << im["pixels"] << " pixels changed";
             if (im.contains("picture")) os << "\n\n  ![changed pixels](" << im["picture"].get<std::string>() << ")";

@@ -242,7 +242,7 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     // The name titles the report and every progress line: plain text of one line (Text.h's rule).
     if (const std::string why = userTextProblem(c.name); !why.empty()) root.fail("name", "the name \"" + shortText(c.name, 60) + "\" " + why);
     if (c.name.empty()) root.fail("name", "must not be empty (it titles the report)");
-    c.resolution = root.getIVec2("resolution", {256, 256}, 8, 8192);
+    c.resolution = root.getIVec2("resolution", {256, 256}, configlimits::kResolutionMin, configlimits::kResolutionMax);
     c.frames = root.getInt("frames", 30, 1, 1000000);
     c.warmupFrames = root.getInt("warmup_frames", 3, 0, 1000);
     // Read only when given: a resolved config without it stays what it was (sweeps' run ids).

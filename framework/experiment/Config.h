@@ -77,6 +77,7 @@ namespace configlimits {
 constexpr float kFovMinDeg = 1.0f, kFovMaxDeg = 179.0f;
 constexpr float kConeMinDeg = 0.1f, kConeMaxDeg = 89.0f;
 constexpr int kAreaSamplesMin = 1, kAreaSamplesMax = 1024;
+constexpr int kResolutionMin = 8, kResolutionMax = 8192; ///< each side of a frame, pixels
 } // namespace configlimits
 
 /// Reads and validates a config file (and loads its scene unless `loadScene` is false).
