@@ -3,6 +3,7 @@
 // is lit. Results are never lost or left half-written, and a vacuous 0 % mismatch is never reported.
 #include "framework/core/JsonNode.h"
 #include "tests/HostileInputs.h"
+#include "tests/SweepTestData.h"
 #include "tests/TestSupport.h"
 
 #include <algorithm>
@@ -182,6 +183,32 @@ TEST(RunSafetyTest, ValidateTriesTheOutputPlaceAndASilentPlotterIsNamed) {
               0)
         << log;
     EXPECT_NE(log.find("wrote no report.html"), std::string::npos) << log;
+}
+
+// Seventh probe: validate accepted an output.dir that run refuses with and without --force: a
+// user's folder, a sweep, the folder holding the config. Each is now refused by validate too.
+TEST(RunSafetyTest, ValidateRefusesAnOutputNoRunCouldReplace) {
+    const std::string base = test::makeTempDir("validate-places");
+    fs::create_directories(base + "/notes");
+    std::ofstream(base + "/notes/todo.txt") << "mine\n";
+    fs::create_directories(base + "/sweep");
+    std::ofstream(base + "/sweep/sweep.json") << "{}\n";
+    fs::create_directories(base + "/inside");
+    std::ofstream(base + "/inside/c.json") << test::configWith({{"output", "{\"dir\": \"" + base + "/inside\"}"}});
+    std::ofstream(base + "/c.json") << test::configWith({});
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+        {{base + "/c.json", "--set", "output.dir=" + base + "/notes"}, "not a shadowlab output"},
+        {{base + "/c.json", "--set", "output.dir=" + base + "/sweep"}, "is a sweep"},
+        {{base + "/inside/c.json"}, "not a shadowlab output"}};
+    for (const auto& [args, cause] : cases) {
+        std::vector<std::string> argv{SHADOWLAB_BINARY, "validate"};
+        argv.insert(argv.end(), args.begin(), args.end());
+        const test::Ran ran = test::runArgs(argv);
+        EXPECT_EQ(ran.rc, 2) << ran.err;
+        EXPECT_NE(ran.err.find("at /output/dir: "), std::string::npos) << ran.err;
+        EXPECT_NE(ran.err.find(cause), std::string::npos) << ran.err;
+    }
+    EXPECT_TRUE(fs::exists(base + "/notes/todo.txt"));
 }
 
 TEST(RunSafetyTest, SigtermWhilePlottingStopsThePlotterAndKeepsThePreviousResults) {

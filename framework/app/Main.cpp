@@ -224,11 +224,11 @@ int run(const std::vector<std::string>& args) {
     // The output place is checked and locked before the scene is loaded and anything rendered, so a
     // run that could not save its results fails at once instead of after the work.
     ExperimentConfig cfg = loadConfig(config, false, overrides);
-    if (opt.force) refuseInputsInsideReplacedOutput(config, overrides, opt.outputDir.empty() ? cfg.outputDir : opt.outputDir);
     std::vector<std::string> notes;
     // A place from the config is named as validate names it: the config and /output/dir.
     OutputPlace place = [&] {
         try {
+            if (opt.force) refuseInputsInsideReplacedOutput(config, overrides, opt.outputDir.empty() ? cfg.outputDir : opt.outputDir);
             return OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes,
                                      overrides.empty() ? config : std::string());
         } catch (const InputError& e) {
@@ -313,8 +313,12 @@ int plan(const std::vector<std::string>& args) {
 int validate(const std::string& config, const std::vector<std::string>& overrides) {
     ExperimentConfig cfg = loadConfig(config, false, overrides);
     // The output place too (run --out may name another).
+    // An existing one must be one `run --force` can replace (seventh probe: a user's folder, a sweep
+    // and the config's own folder were "valid", and every run refused them).
     try {
         OutputPlace::check(cfg.outputDir, overrides.empty() ? config : std::string());
+        OutputPlace::checkReplaceable(cfg.outputDir);
+        refuseInputsInsideReplacedOutput(config, overrides, cfg.outputDir);
     } catch (const InputError& e) {
         throw InputError(config, "/output/dir", e.cause());
     }

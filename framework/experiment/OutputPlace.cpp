@@ -375,6 +375,27 @@ void OutputPlace::checkSweepPlace(const std::string& given) {
                                          "runs/, plan.json, sweep.csv and sweep.md there; choose another --out or an empty folder");
 }
 
+void OutputPlace::checkReplaceable(const std::string& given) {
+    const std::string dir = normalize(given);
+    const fs::path finalPath(dir);
+    std::error_code ec;
+    const auto status = fs::symlink_status(finalPath, ec);
+    if (!fs::exists(status)) return;
+    if (fs::is_symlink(status))
+        throw InputError(shortPath(dir), "", "the output path is a symbolic link; give the directory it should name instead");
+    if (!fs::is_directory(status)) throw InputError(shortPath(dir), "", "the output path exists and is not a directory");
+    if (markerOf(finalPath) == "sweep.json")
+        throw InputError(shortPath(dir), "", "the directory is a sweep (it holds sweep.json); --force replaces only one run's output");
+    const bool output = isShadowlabOutput(finalPath);
+    // Whatever it is, a run in progress or another output inside it is never replaced with it.
+    if (const std::string inside = nestedInside(finalPath, output ? 200000 : 10000); !inside.empty() &&
+                                                                                 (output || inside.find(".lock") != std::string::npos))
+        throw InputError(shortPath(dir), "", "the directory holds " + inside + "; --force replaces only a single run's output");
+    if (!output)
+        throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no " + std::string(kOutputMark) +
+                                  " mark, nor a summary.json of a run); --force replaces only outputs");
+}
+
 void OutputPlace::check(const std::string& given, const std::string& runConfig) {
     const std::string dir = normalize(given);
     checkPlace(dir, runConfig, "results/run1");
@@ -479,16 +500,7 @@ OutputPlace OutputPlace::open(const std::string& given, bool force, std::vector<
         if (!force)
             throw InputError(shortPath(dir), "", "output directory already exists; pass --force to replace it once the new run "
                                       "completes, or --out DIR");
-        if (markerOf(finalPath) == "sweep.json")
-            throw InputError(shortPath(dir), "", "the directory is a sweep (it holds sweep.json); --force replaces only one run's output");
-        const bool output = isShadowlabOutput(finalPath);
-        // Whatever it is, a run in progress or another output inside it is never replaced with it.
-        if (const std::string inside = nestedInside(finalPath, output ? 200000 : 10000); !inside.empty() &&
-                                                                                     (output || inside.find(".lock") != std::string::npos))
-            throw InputError(shortPath(dir), "", "the directory holds " + inside + "; --force replaces only a single run's output");
-        if (!output)
-            throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no " + std::string(kOutputMark) +
-                                      " mark, nor a summary.json of a run); --force replaces only outputs");
+        checkReplaceable(dir);
         place.oldFd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
         struct stat st {};
         if (place.oldFd_ >= 0 && ::fstat(place.oldFd_, &st) == 0)

@@ -39,6 +39,10 @@ public:
     /// InputError when `dir` cannot be a sweep's folder: as check() (but no place inside a sweep at
     /// all, not even its runs/ID), and an existing folder must be empty or hold a sweep (sweep.json).
     static void checkSweepPlace(const std::string& dir);
+    /// InputError when `dir` exists and `run --force` could not replace it: not a directory, a link,
+    /// a sweep, not a shadowlab output, or holding another output or a run in progress. `validate`
+    /// checks a config's output.dir with it, so that what it accepts a run can write.
+    static void checkReplaceable(const std::string& dir);
     /// InputError when `dir`, once replaced with everything in it, would take an input with it: a
     /// file or folder the command reads that lies inside `dir`, is `dir`, or holds it (a command's
     /// output inside its input folder would land among the runs it reads). `what`: "this run",
