@@ -8,7 +8,10 @@
 #include <filesystem>
 #include <fstream>
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace shadowlab {
 namespace {
@@ -150,6 +153,29 @@ TEST(UserTextTest, AFullOrClosedStandardOutputIsAnError) {
         std::string out;
         EXPECT_EQ(test::runCommand(kBin + command + " > /dev/full 2>/dev/null", out), 2) << command;
         EXPECT_EQ(test::runCommand(kBin + command + " >&- 2>/dev/null", out), 2) << command;
+    }
+}
+
+// Seventh probe: a pipe whose reader has gone ended the process by SIGPIPE, without a word.
+TEST(UserTextTest, APipeWhoseReaderHasGoneIsAnError) {
+    for (const char* command : {"list", "info"}) {
+        int fds[2];
+        ASSERT_EQ(::pipe(fds), 0);
+        ::close(fds[0]);
+        const pid_t pid = ::fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            ::dup2(fds[1], 1);
+            const int null = ::open("/dev/null", O_WRONLY);
+            ::dup2(null, 2);
+            ::execl(kBin.c_str(), kBin.c_str(), command, "--json", static_cast<char*>(nullptr));
+            ::_exit(127);
+        }
+        ::close(fds[1]);
+        int status = 0;
+        ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+        EXPECT_TRUE(WIFEXITED(status)) << command << ": ended by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+        if (WIFEXITED(status)) EXPECT_EQ(WEXITSTATUS(status), 2) << command;
     }
 }
 

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <cerrno>
 #include <cstdio>
@@ -390,6 +391,10 @@ static int dispatch(std::vector<std::string> args);
 
 int main(int argc, char** argv) {
     reopenClosedStandardStreams();
+    // A write to a pipe whose reader is gone then fails with EPIPE, which checkStandardOutput()
+    // reports in one line (exit 2), instead of SIGPIPE ending the process without a word (seventh
+    // probe). Children get the default back (SweepProcess, runChildProcess).
+    std::signal(SIGPIPE, SIG_IGN);
     return checkStandardOutput(dispatch(std::vector<std::string>(argv + 1, argv + argc)));
 }
 

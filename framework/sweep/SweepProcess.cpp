@@ -58,6 +58,7 @@ pid_t startLoggedChild(const std::vector<std::string>& argv, const std::string& 
         }
         ::dup2(fd, 1);
         ::dup2(fd, 2);
+        ::signal(SIGPIPE, SIG_DFL); // shadowlab ignores it (main); an ignored signal survives exec
         ::execv(args[0], args.data());
         say(2, failText.c_str());
         say(2, std::strerror(errno));
@@ -81,6 +82,7 @@ int captureChild(const std::vector<std::string>& argv, std::string& output, size
     if (pid == 0) {
         ::dup2(fds[1], 1);
         ::dup2(fds[1], 2);
+        ::signal(SIGPIPE, SIG_DFL); // shadowlab ignores it (main); an ignored signal survives exec
         ::execvp(args[0], args.data());
         ::_exit(127);
     }
