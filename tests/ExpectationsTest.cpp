@@ -56,6 +56,13 @@ TEST(ExpectationsTest, BoundsAreCheckedPerIdWithHowFarTheyMissed) {
     EXPECT_EQ(expectationLine(bad[2]), "psv: time_ms.total.median / bvh_raytrace's = 3, above max 1.5 (2×) (/expect/1)");
 }
 
+// Seventh probe: a negative bound printed a meaningless ratio, "above max -1 (-0×)".
+TEST(ExpectationsTest, ARatioToTheBoundOnlyWhereBothArePositive) {
+    const auto e = parse(R"([{"id": "psv", "measure": "overflow", "max": -1}])", ids());
+    const Json r = checkExpectations(e, ids(), summaryWith(0.0, 3.0, 2.5));
+    EXPECT_EQ(r[0]["why"], "psv: overflow = 0, above max -1");
+}
+
 TEST(ExpectationsTest, AStageOrCounterTheRunDidNotMeasureFailsNamingWhatItHas) {
     const auto e = parse(R"([{"id": "psv", "measure": "time_ms.buidl.median", "max": 9}])", ids());
     const Json r = checkExpectations(e, ids(), summaryWith(0, 1, 1));

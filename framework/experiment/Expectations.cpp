@@ -153,12 +153,13 @@ Json checkExpectations(const std::vector<Expectation>& expectations, const Expec
             const std::string what = id + ": " + e.measure + (e.relativeTo.empty() ? "" : " / " + e.relativeTo + "'s");
             if (has) {
                 r["value"] = value;
+                // A ratio to the bound only where both are positive (seventh probe: "above max -1 (-0×)").
                 if (e.max && !(value <= *e.max))
                     why = what + " = " + shortNumber(value) + ", above max " + shortNumber(*e.max) +
-                          (*e.max != 0 ? " (" + shortNumber(value / *e.max) + "×)" : "");
+                          (*e.max > 0 && value > 0 ? " (" + shortNumber(value / *e.max) + "×)" : "");
                 else if (e.min && !(value >= *e.min))
                     why = what + " = " + shortNumber(value) + ", below min " + shortNumber(*e.min) +
-                          (*e.min != 0 ? " (" + shortNumber(value / *e.min) + "×)" : "");
+                          (*e.min > 0 && value > 0 ? " (" + shortNumber(value / *e.min) + "×)" : "");
             } else {
                 why = "not measured: " + why;
             }
