@@ -173,6 +173,30 @@ TEST(SweepInputTest, HugeNamesAndLabelsAreRefusedWithoutEchoingThem) {
     EXPECT_EQ(runArgs(sweep({"plan", test::writeJson(dir + "/ok.sweep.json", ok)})).rc, 0);
 }
 
+// Seventh probe: labels such as "=HYPERLINK(...)" reached sweep.csv and the plan's TSV as typed,
+// formulas to a spreadsheet. A given label is refused; one made of a value becomes its JSON text.
+TEST(SweepInputTest, LabelsASpreadsheetWouldRunAreRefusedOrQuoted) {
+    const std::string dir = test::makeTempDir("sweep-formula");
+    for (const char* label : {"=HYPERLINK(\"http://x\")", "@SUM(1)", "+1+2", "-x"}) {
+        Json given = test::smallSweep();
+        given["axes"][1]["labels"] = {label, "b"};
+        const Ran r = runArgs(sweep({"plan", test::writeJson(dir + "/given.sweep.json", given)}));
+        EXPECT_EQ(r.rc, 2) << label;
+        EXPECT_NE(r.err.find("/axes/1/labels/0"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("formula"), std::string::npos) << r.err;
+        expectOneShortLine(r);
+    }
+    Json numbers = test::smallSweep();
+    numbers["axes"][1]["labels"] = {"-0.5", "+2"};
+    EXPECT_EQ(runArgs(sweep({"plan", test::writeJson(dir + "/numbers.sweep.json", numbers)})).rc, 0);
+    Json derived = test::smallSweep();
+    derived["axes"] = Json::array({{{"name", "n"}, {"values", {{"name", {"=1+1", "plain"}}}}}});
+    const Ran plan = runArgs(sweep({"plan", test::writeJson(dir + "/derived.sweep.json", derived)}));
+    EXPECT_EQ(plan.rc, 0) << plan.err;
+    EXPECT_NE(plan.out.find("\"=1+1\""), std::string::npos) << plan.out;
+    EXPECT_EQ(plan.out.find("\t=1+1"), std::string::npos) << plan.out;
+}
+
 TEST(SweepInputTest, EmptyOutIsRefusedAndNothingIsCreated) {
     ASSERT_FALSE(fs::exists("/runs")) << "a /runs folder exists already: this test cannot tell";
     const std::string dir = test::makeTempDir("sweep-empty-out"), file = smallFile(dir);

@@ -5,6 +5,7 @@
 #include "framework/sweep/SweepText.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,15 @@
 namespace shadowlab {
 
 namespace {
+
+/// Text a spreadsheet would read as a formula in a CSV cell: it starts with =, +, - or @ and is not
+/// a plain number (a numeric axis's "-0.5" stays as it is).
+bool looksLikeFormula(const std::string& s) {
+    if (s.empty() || std::string("=+-@").find(s[0]) == std::string::npos) return false;
+    char* end = nullptr;
+    std::strtod(s.c_str(), &end);
+    return end != s.c_str() + s.size();
+}
 
 // A sweep beyond this is almost certainly a mistake (an axis of 1000 values times a few more), and
 // expanding it would validate millions of configs before saying so.
@@ -156,6 +166,13 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
             if (const std::string why = userTextProblem(l.get<std::string>()); !why.empty())
                 throw InputError(node.file(), node.childPath("labels") + "/" + std::to_string(k),
                                  "the label \"" + shortText(l.get<std::string>(), 60) + "\" " + why);
+            // Seventh probe: "=HYPERLINK(...)" went into sweep.csv as typed, a formula to any
+            // spreadsheet that opens it.
+            if (looksLikeFormula(l.get<std::string>()))
+                throw InputError(node.file(), node.childPath("labels") + "/" + std::to_string(k),
+                                 "the label \"" + shortText(l.get<std::string>(), 60) +
+                                     "\" starts with =, +, - or @ and is not a number: a spreadsheet opening sweep.csv would run it "
+                                     "as a formula; start it otherwise");
             axis.labels.push_back(l.get<std::string>());
         }
     } else if (axis.paths.size() > 1) {
@@ -165,8 +182,10 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
             const Json& v = axis.values.front()[k];
             // A string that is not plain one-line text is shown as JSON text with every non-ASCII
             // character escaped: the label stays one visible cell.
-            std::string label = v.is_string() && userTextProblem(v.get<std::string>()).empty() ? v.get<std::string>()
-                                                                                               : v.dump(-1, ' ', true);
+            // So is a string a spreadsheet would read as a formula (it then starts with a quote).
+            std::string label = v.is_string() && userTextProblem(v.get<std::string>()).empty() && !looksLikeFormula(v.get<std::string>())
+                                    ? v.get<std::string>()
+                                    : v.dump(-1, ' ', true);
             if (label.size() > kMaxLabelChars)
                 node.fail("labels", "value " + std::to_string(k) + " (" + shortText(label, 60) + ") is longer than " +
                                         std::to_string(kMaxLabelChars) + " characters as a label: give the axis labels");
