@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 namespace shadowlab {
 namespace {
@@ -230,6 +231,31 @@ TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
         EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
         EXPECT_FALSE(fs::exists(out)) << "bad input left an output folder behind";
     }
+}
+
+// Seventh probe: a run whose started_utc was "not-a-date" sorted as the newest and decided the
+// exit code; negative times were tabulated. Such a summary is not a run's: history leaves
+// it out with a note, compare refuses it.
+TEST(HistoryTest, ASummaryNoRunWritesIsLeftOut) {
+    const std::string dir = test::makeTempDir("history-tampered");
+    writeRuns(dir, {20, 20, 20, 20}, {0, 0, 0, 0}, kSpread);
+    auto edit = [&](const std::string& run, const std::function<void(Json&)>& change) {
+        Json s = Json::parse(std::ifstream(dir + "/" + run + "/summary.json"));
+        change(s);
+        std::ofstream(dir + "/" + run + "/summary.json") << s.dump();
+    };
+    edit("run-100", [](Json& s) { s["started_utc"] = "not-a-date"; });
+    edit("run-99", [](Json& s) { s["algorithms"]["psv"]["repetitions"]["time_ms"]["total"][0] = -5.0; });
+    edit("run-98", [](Json& s) { s["algorithms"]["psv"]["repetitions"]["time_ms"]["total"][3] = "fast"; });
+    writeRuns(dir + "/more", {20, 20}, {0, 0}, kSpread);
+    for (const char* run : {"run-100", "run-99"}) fs::rename(dir + "/more/" + run, dir + "/ok-" + run);
+    const History h = readHistory(dir, {});
+    EXPECT_EQ(h.runs.size(), 3u); // run-97 and the two good ones
+    ASSERT_FALSE(h.notes.empty());
+    EXPECT_NE(h.notes[0].find("left out"), std::string::npos) << h.notes[0];
+    const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "compare", dir + "/run-97", dir + "/run-99"});
+    EXPECT_EQ(ran.rc, 2) << ran.err;
+    EXPECT_NE(ran.err.find("/algorithms/psv"), std::string::npos) << ran.err;
 }
 
 // Seventh probe: `compare A B --out A --force` and `history H --out H/r1 --force` replaced a run

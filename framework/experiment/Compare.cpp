@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -21,6 +22,20 @@ namespace shadowlab {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+bool isUtcTimestamp(const Json& j) {
+    if (!j.is_string()) return false;
+    const std::string& t = j.get_ref<const std::string&>();
+    static const char* kShape = "dddd-dd-ddTdd:dd:ddZ";
+    if (t.size() != std::strlen(kShape)) return false;
+    for (size_t k = 0; k < t.size(); ++k)
+        if (kShape[k] == 'd' ? !(t[k] >= '0' && t[k] <= '9') : t[k] != kShape[k]) return false;
+    return true;
+}
+
+} // namespace
+
 Json readRunSummary(const std::string& dir) {
     const std::string file = dir + "/summary.json";
     std::error_code ec;
@@ -29,6 +44,25 @@ Json readRunSummary(const std::string& dir) {
     const Json s = JsonNode::parseFile(file);
     if (!s.is_object() || s.value("complete", false) != true || !s.contains("algorithms") || !s["algorithms"].is_object())
         throw InputError(shortText(file, 300), "", "is not a complete run's summary (no \"complete\": true and \"algorithms\")");
+    // What compare and history order and divide by is what a run writes (seventh probe: a
+    // started_utc of "not-a-date" sorted as the newest run and decided history's exit code;
+    // negative times were tabulated).
+    if (s.contains("started_utc") && !isUtcTimestamp(s["started_utc"]))
+        throw InputError(shortText(file, 300), "/started_utc", "is not a UTC time as a run writes it (YYYY-MM-DDTHH:MM:SSZ)");
+    for (const auto& [id, entry] : s["algorithms"].items()) {
+        const Json& reps = entry.contains("repetitions") ? entry["repetitions"] : Json();
+        for (const Json* times : {reps.is_object() && reps.contains("time_ms") ? &reps["time_ms"] : nullptr,
+                                  entry.contains("total_ms_per_frame") ? &entry : nullptr}) {
+            if (!times) continue;
+            const Json& list = times == &entry ? entry["total_ms_per_frame"] : (*times).value("total", Json());
+            if (!list.is_array()) continue;
+            for (const Json& t : list)
+                // Zero is a time a coarse timer can read; below it, or not finite, is no run's.
+                if (!t.is_number() || !(t.get<double>() >= 0) || !std::isfinite(t.get<double>()))
+                    throw InputError(shortText(file, 300), "/algorithms/" + shortText(id, 60),
+                                     "holds a time of " + shortText(t.dump(), 40) + " ms: a run's times are finite and not negative");
+        }
+    }
     return s;
 }
 
