@@ -87,6 +87,8 @@ const BadCase kBad[] = {
      "/algorithms/1/id", "only in case"},
     {"id_reference_in_another_case", R"({"algorithms": [{"algorithm": "shadow_map", "id": "Reference"}]})", "/algorithms/0/id", "only in case"},
     {"unknown_top_key", R"({"framez": 3})", "/framez", "accepted keys"},
+    // Seventh probe: keys the file did not use (expect, repeats) were missing from the list.
+    {"unknown_key_lists_unused_keys", R"({"framez": 3})", "/framez", "expect, frames, light, name, output, reference, repeats"},
     {"wrong_type", R"({"frames": "ten"})", "/frames", "expected an integer"},
     {"out_of_range", R"({"resolution": [0, 64]})", "/resolution", "must lie in"},
     {"unknown_algorithm", R"({"algorithms": [{"algorithm": "magic"}]})", "/algorithms/0/algorithm", "registered: shadow_map"},

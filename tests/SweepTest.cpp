@@ -67,11 +67,17 @@ const BadSweep kBadSweeps[] = {
     {"NoBase", R"({"base": null})", "/base|required"},
     {"BadRatio", R"({"merge": {"ratios": ["psv"]}})", "/merge/ratios|not ID/ID"},
     // Fifth probe: an id over itself, or a ratio or stage twice, gave rows of 1 or the same numbers twice.
-    {"RatioOfAnIdOverItself", R"({"merge": {"ratios": ["psv/psv"]}})", "/merge/ratios|an id over itself"},
+    {"RatioOfAnIdOverItself", R"({"merge": {"ratios": ["psv/psv"]}})", "/merge/ratios/0|an id over itself"},
+    // Seventh probe: no index in the path, and "/" was called an id over itself.
+    {"RatioOfEmptyIds", R"({"merge": {"ratios": ["psv/shadow_map", "/"]}})", "/merge/ratios/1|an empty id"},
+    // Seventh probe: a base file that cannot be read named neither the sweep file nor /base.
+    {"BaseFileMissing", R"({"base": "missing-base.json"})", "/base|the base config|missing-base.json"},
+    {"BaseFileIsAFolder", R"({"base": "."})", "/base|the base config"},
     {"RatioTwice", R"({"merge": {"ratios": ["psv/shadow_map", "psv/shadow_map"]}})", "/merge/ratios/1|given twice"},
     {"StageTwice", R"({"merge": {"stages": ["total", "total"]}})", "/merge/stages/1|given twice"},
     {"PaperTimeNotPositive", R"({"merge": {"paper": {"source": "s", "times_ms": {"psv": 0}}}})", "/merge/paper/times_ms/psv|out of range"},
     {"PaperWithoutSource", R"({"merge": {"paper": {"times_ms": {"psv": 1}}}})", "/merge/paper/source|required"},
+    {"PaperWithAnEmptySource", R"({"merge": {"paper": {"source": "", "times_ms": {"psv": 1}}}})", "/merge/paper/source|must name the paper"},
     {"PaperWithoutTimes", R"({"merge": {"paper": {"source": "s"}}})", "/merge/paper/times_ms|expected an object"},
     // Every fixed column of sweep.csv, `kind` included: the report reads rows by column name.
     {"AxisNamedKind", R"({"axes": [{"name": "kind", "values": {"frames": [1, 2]}}]})", "/axes/0/name|column"},

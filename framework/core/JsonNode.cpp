@@ -43,7 +43,14 @@ Json parseJsonOrString(const std::string& text) {
 
 Json JsonNode::parseFile(const std::string& file) { return parseJson(readInputFile(file), file); }
 
-bool JsonNode::has(const std::string& key) const { return value_->contains(key); }
+bool JsonNode::has(const std::string& key) const {
+    // A key the parser asks about is one it accepts: an absent one joins the "accepted keys" an
+    // unknown key's error lists (seventh probe: expect, repeats and time_range were left out of it
+    // unless the file already used them). A present one is marked when it is read.
+    const bool present = value_->contains(key);
+    if (!present) read_->insert(key);
+    return present;
+}
 
 std::string JsonNode::childPath(const std::string& key) const { return path_ + "/" + key; }
 

@@ -415,7 +415,14 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     if (base.is_string()) {
         baseFile = resolvePath(sweepDir, base.get<std::string>());
         if (const std::string why = pathTextProblem(baseFile); !why.empty()) root.fail("base", "the file name " + why);
-        s.base = JsonNode::parseFile(baseFile);
+        // A file that cannot be read as JSON is named from the sweep's /base (seventh probe: a
+        // FIFO or a missing file named neither the sweep file nor /base).
+        try {
+            s.base = JsonNode::parseFile(baseFile);
+        } catch (const InputError& e) {
+            if (!e.jsonPath().empty()) throw;
+            throw InputError(file, "/base", "the base config " + shortText(baseFile, 200) + ": " + e.cause());
+        }
         baseDir = absoluteFolder(parentDir(baseFile));
         baseWhere = "";
     } else if (base.is_object()) {
@@ -448,13 +455,17 @@ Sweep parseSweep(const Json& json, const std::string& file) {
         for (const Json& v : list) ok = ok && v.is_string() && userTextProblem(v.get<std::string>()).empty();
         if (!ok) merge.fail(key, "expected a list of strings (one line each, at most " + std::to_string(kMaxLabelChars) + " characters)");
         if (std::string(key) == "ratios")
-            for (const Json& v : list) {
-                const std::string ratio = v.get<std::string>();
+            for (size_t k = 0; k < list.size(); ++k) {
+                const std::string ratio = list[k].get<std::string>();
                 const size_t slash = ratio.find('/');
+                // Each named at its index (seventh probe: "/merge/ratios" without one, "/" called an id over itself).
+                const std::string where = std::string(key) + "/" + std::to_string(k);
                 if (slash == std::string::npos)
-                    merge.fail(key, "\"" + ratio + "\" is not ID/ID (the total time of one algorithm id over another's)");
+                    merge.fail(where, "\"" + shortText(ratio, 60) + "\" is not ID/ID (the total time of one algorithm id over another's)");
+                if (slash == 0 || slash + 1 == ratio.size())
+                    merge.fail(where, "\"" + shortText(ratio, 60) + "\" has an empty id: name two ids, ID/ID");
                 if (ratio.substr(0, slash) == ratio.substr(slash + 1))
-                    merge.fail(key, "\"" + ratio + "\" is an id over itself (always 1): name two ids");
+                    merge.fail(where, "\"" + shortText(ratio, 60) + "\" is an id over itself (always 1): name two ids");
             }
         // A table row or column twice would show the same numbers twice under one name.
         std::set<std::string> seen;
@@ -468,6 +479,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
         JsonNode paper = merge.child("paper");
         const std::string source = paper.requireString("source");
         if (const std::string why = userTextProblem(source); !why.empty()) paper.fail("source", "the source " + why);
+        if (source.find_first_not_of(' ') == std::string::npos) paper.fail("source", "must name the paper (it heads the paper's column)");
         JsonNode times = paper.child("times_ms");
         if (!paper.raw().contains("times_ms") || !paper.raw()["times_ms"].is_object() || paper.raw()["times_ms"].empty())
             paper.fail("times_ms", "expected an object of algorithm id: milliseconds");
