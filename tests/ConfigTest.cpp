@@ -30,6 +30,16 @@ TEST(ConfigTest, MissingKeysTakeDefaults) {
     EXPECT_EQ(c.resolved["light"]["type"], "point");
 }
 
+// Seventh probe: frames took 1.0 while resolution refused [1e2, 32]; every integer takes both.
+TEST(ConfigTest, IntegersWrittenAsFloatsAreIntegersEverywhere) {
+    Json j = minimal();
+    j["resolution"] = Json::parse("[1e2, 64.0]");
+    j["frames"] = Json::parse("3.0");
+    const ExperimentConfig c = parseConfig(j, "/tmp/x/cfg.json");
+    EXPECT_EQ(c.resolution, glm::ivec2(100, 64));
+    EXPECT_EQ(c.frames, 3);
+}
+
 TEST(ConfigTest, ResolvedConfigParsesToTheSameExperiment) {
     ExperimentConfig a = parseConfig(minimal(), "/tmp/x/cfg.json");
     ExperimentConfig b = parseConfig(a.resolved, "/tmp/x/cfg.json");
@@ -87,6 +97,9 @@ const BadCase kBad[] = {
      "/algorithms/1/id", "only in case"},
     {"id_reference_in_another_case", R"({"algorithms": [{"algorithm": "shadow_map", "id": "Reference"}]})", "/algorithms/0/id", "only in case"},
     {"unknown_top_key", R"({"framez": 3})", "/framez", "accepted keys"},
+    // Seventh probe: an integer written as a float was taken by frames but not by resolution; both take
+    // it now, and a fraction is refused by both.
+    {"resolution_with_a_fraction", R"({"resolution": [100.5, 32]})", "/resolution", "expected integers"},
     // Seventh probe: keys the file did not use (expect, repeats) were missing from the list.
     {"unknown_key_lists_unused_keys", R"({"framez": 3})", "/framez", "expect, frames, light, name, output, reference, repeats"},
     {"wrong_type", R"({"frames": "ten"})", "/frames", "expected an integer"},

@@ -166,7 +166,9 @@ std::vector<T> JsonNode::numberArray(const std::string& key, size_t n, bool inte
         fail(key, "expected an array of " + (n ? std::to_string(n) + " " : std::string()) + "numbers, got " + shortDump(*v));
     std::vector<T> out;
     for (const auto& e : *v) {
-        if (!e.is_number() || (integral && !e.is_number_integer()))
+        // An integer written as 1e2 or 100.0 is one, as getInt() takes it (seventh probe: frames
+        // took 1.0, resolution refused [1e2, 32]).
+        if (!e.is_number() || (integral && !e.is_number_integer() && std::floor(e.get<double>()) != e.get<double>()))
             fail(key, std::string("expected ") + (integral ? "integers" : "numbers") + ", got " + shortDump(*v));
         double d = e.get<double>();
         if (!std::isfinite(d)) fail(key, "non-finite number in " + shortDump(*v));
