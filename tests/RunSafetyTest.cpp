@@ -185,6 +185,28 @@ TEST(RunSafetyTest, ValidateTriesTheOutputPlaceAndASilentPlotterIsNamed) {
     EXPECT_NE(log.find("wrote no report.html"), std::string::npos) << log;
 }
 
+// Seventh probe: a disk that filled while plotting left a run without report.html or plots, and
+// the run exited 0 with a warning naming a plots.log that was never written. A full disk is a
+// failed write: exit 1, and the results already there stay. The disk: a 150 KiB tmpfs in a mount
+// namespace of its own (unshare), which the tables fit and the plots do not.
+TEST(RunSafetyTest, ADiskThatFillsWhilePlottingFailsTheRunAndKeepsThePreviousResults) {
+    const std::string base = test::makeTempDir("full-disk");
+    std::ofstream(base + "/c.json") << test::configWith({{"resolution", "[32, 32]"}, {"frames", "1"}, {"warmup_frames", "0"}});
+    const std::string tiny = base + "/tiny", out = tiny + "/r";
+    fs::create_directories(tiny);
+    const std::string run = std::string(SHADOWLAB_BINARY) + " run " + base + "/c.json --no-progress --out " + out;
+    // First a run on the tmpfs with plots off (it fits), then one with plots over it.
+    const std::string script = "mount -t tmpfs -o size=150k tmpfs " + tiny + " || exit 99; " + run +
+                               " --set output.plots=false >/dev/null 2>&1 || exit 98; " + run + " --set output.plots=true --force; echo rc=$?; ls " + out;
+    std::string log;
+    const int rc = test::runCommand("unshare -rm sh -c '" + script + "' 2>&1", log);
+    if (rc == 99 * 256 || log.find("unshare:") == 0) GTEST_SKIP() << "no mount namespace here: " << log;
+    EXPECT_NE(log.find("rc=1"), std::string::npos) << log;
+    EXPECT_NE(log.find("is full: the plots and report.html could not be written"), std::string::npos) << log;
+    EXPECT_NE(log.find("summary.json"), std::string::npos) << "the first run's results are gone: " << log;
+    EXPECT_EQ(log.find("plots.log"), std::string::npos) << log;
+}
+
 // Seventh probe: validate accepted an output.dir that run refuses with and without --force: a
 // user's folder, a sweep, the folder holding the config. Each is now refused by validate too.
 TEST(RunSafetyTest, ValidateRefusesAnOutputNoRunCouldReplace) {

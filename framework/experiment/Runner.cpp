@@ -22,6 +22,7 @@
 #include <map>
 #include <filesystem>
 #include <optional>
+#include <sys/statvfs.h>
 
 namespace shadowlab {
 
@@ -76,14 +77,20 @@ void runPlots(const std::string& dir, const std::string& finalDir, const std::st
     const char* python = std::getenv("SHADOWLAB_PYTHON");
     std::string script = std::string(SHADOWLAB_SOURCE_DIR) + "/scripts/plot_results.py";
     std::string log = dir + "/plots.log";
-    if (runChildProcess({python && *python ? python : SHADOWLAB_PLOT_PYTHON, script, dir, timeSource}, log) != 0)
-        std::fprintf(stderr, "warning: plotting failed (see %s/plots.log); tables and images are complete\n", finalDir.c_str());
-    else if (!std::filesystem::exists(dir + "/report.html"))
-        // An interpreter that exits 0 without doing the work (a wrong SHADOWLAB_PYTHON) is said too.
-        std::fprintf(stderr, "warning: the plotter exited 0 but wrote no report.html (see %s/plots.log); tables and images are complete\n",
-                     finalDir.c_str());
-    else
+    const bool failed = runChildProcess({python && *python ? python : SHADOWLAB_PLOT_PYTHON, script, dir, timeSource}, log) != 0;
+    if (!failed && std::filesystem::exists(dir + "/report.html")) {
         std::filesystem::remove(log);
+        return;
+    }
+    // A full disk is a failed write, not a missing plot (seventh probe: the run exited 0 without
+    // report.html): the run fails and the previous results stay.
+    struct statvfs fs {};
+    if (::statvfs(dir.c_str(), &fs) == 0 && uint64_t(fs.f_bavail) * uint64_t(fs.f_frsize) < (uint64_t(1) << 20))
+        throw RuntimeError("the disk holding " + shortText(finalDir, 300) + " is full: the plots and report.html could not be written");
+    const std::string see = std::filesystem::exists(log) ? " (see " + finalDir + "/plots.log)" : " (its log could not be written)";
+    if (failed) std::fprintf(stderr, "warning: plotting failed%s; tables and images are complete\n", see.c_str());
+    // An interpreter that exits 0 without doing the work (a wrong SHADOWLAB_PYTHON) is said too.
+    else std::fprintf(stderr, "warning: the plotter exited 0 but wrote no report.html%s; tables and images are complete\n", see.c_str());
 }
 
 } // namespace
