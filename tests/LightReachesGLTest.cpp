@@ -75,18 +75,7 @@ Cases onTheCone(const Light& spot, std::mt19937& rng, int count) {
 
 /// GPU decisions (now, before) per case.
 std::vector<glm::uvec2> decide(const Light& light, const Cases& c) {
-    const uint32_t n = uint32_t(c.count());
-    GlBuffer cases = GlBuffer::fromVector(c.pn);
-    GlBuffer out = GlBuffer::fromVector(std::vector<glm::uvec2>(n, glm::uvec2(7u)));
-    ShaderProgram probe = ShaderProgram::compute("tests/light_reaches_probe.comp");
-    setLightUniforms(probe, light);
-    probe.set("uCases", n);
-    cases.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
-    out.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
-    probe.use();
-    glDispatchCompute((n + 63) / 64, 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    return out.read<glm::uvec2>(n);
+    return runComputeProbe("tests/light_reaches_probe.comp", light, "uCases", c.pn, uint32_t(c.count()), glm::uvec2(7u));
 }
 
 /// The CPU's decision as it was made before (glm::normalize, std::cos).

@@ -56,17 +56,7 @@ struct PlaneError {
 
 PlaneError planeErrors(const Edges& e) {
     const uint32_t n = uint32_t(e.ends.size() / 2);
-    GlBuffer ends = GlBuffer::fromVector(e.ends);
-    GlBuffer planes = GlBuffer::fromVector(std::vector<glm::vec4>(n, glm::vec4(0.0f)));
-    ShaderProgram probe = ShaderProgram::compute("tests/edge_plane_probe.comp");
-    setLightUniforms(probe, e.light);
-    probe.set("uEdges", n);
-    ends.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
-    planes.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
-    probe.use();
-    glDispatchCompute((n + 63) / 64, 1, 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    const std::vector<glm::vec4> p = planes.read<glm::vec4>(n);
+    const std::vector<glm::vec4> p = runComputeProbe("tests/edge_plane_probe.comp", e.light, "uEdges", e.ends, n, glm::vec4(0.0f));
     const double u = std::ldexp(1.0, -24);
     const glm::dvec3 light(e.light.position);
     PlaneError out;

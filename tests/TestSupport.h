@@ -2,11 +2,14 @@
 // Shared test helpers: a GL context with a debug callback that fails the test on any GL error,
 // and paths to the real test data.
 #include "framework/gl/GlContext.h"
+#include "framework/gl/GlObjects.h"
 #include "framework/gl/Shader.h"
+#include "framework/render/LightUniforms.h"
 
 #include <gtest/gtest.h>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace shadowlab::test {
 
@@ -28,6 +31,25 @@ public:
     ScopedShaderFaults(const ScopedShaderFaults&) = delete;
     ScopedShaderFaults& operator=(const ScopedShaderFaults&) = delete;
 };
+
+/// Runs the test-only compute probe `shader` (shaders/tests/, 64 invocations a group) on `count`
+/// items: `in` at storage binding 0, `count` values of `fill` at binding 1, the light's uniforms and
+/// `countUniform` set; returns binding 1 as the probe left it.
+template <class In, class Out>
+std::vector<Out> runComputeProbe(const std::string& shader, const Light& light, const char* countUniform, const std::vector<In>& in,
+                                 uint32_t count, Out fill) {
+    GlBuffer input = GlBuffer::fromVector(in);
+    GlBuffer output = GlBuffer::fromVector(std::vector<Out>(count, fill));
+    ShaderProgram probe = ShaderProgram::compute(shader);
+    setLightUniforms(probe, light);
+    probe.set(countUniform, count);
+    input.bindBase(GL_SHADER_STORAGE_BUFFER, 0);
+    output.bindBase(GL_SHADER_STORAGE_BUFFER, 1);
+    probe.use();
+    glDispatchCompute((count + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    return output.read<Out>(count);
+}
 
 /// Debian's assimp-testmodels glTF folder.
 inline const std::string kAssimpGltf = "/usr/share/assimp/models/glTF2";
