@@ -272,7 +272,7 @@ TEST(HistoryTest, NeitherHistoryNorCompareReplacesARunItReads) {
         std::vector<std::string> argv{SHADOWLAB_BINARY};
         argv.insert(argv.end(), args.begin(), args.end());
         const test::Ran ran = test::runArgs(argv);
-        EXPECT_EQ(ran.rc, 2) << args[0] << " --out " << args[4] << ": " << ran.err;
+        EXPECT_EQ(ran.rc, 2) << ::testing::PrintToString(args) << ": " << ran.err;
         EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
         for (const std::string& run : {a, b}) EXPECT_TRUE(fs::is_regular_file(run + "/summary.json")) << run;
     }

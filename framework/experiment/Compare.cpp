@@ -50,13 +50,14 @@ Json readRunSummary(const std::string& dir) {
     if (s.contains("started_utc") && !isUtcTimestamp(s["started_utc"]))
         throw InputError(shortText(file, 300), "/started_utc", "is not a UTC time as a run writes it (YYYY-MM-DDTHH:MM:SSZ)");
     for (const auto& [id, entry] : s["algorithms"].items()) {
-        const Json& reps = entry.contains("repetitions") ? entry["repetitions"] : Json();
-        for (const Json* times : {reps.is_object() && reps.contains("time_ms") ? &reps["time_ms"] : nullptr,
-                                  entry.contains("total_ms_per_frame") ? &entry : nullptr}) {
-            if (!times) continue;
-            const Json& list = times == &entry ? entry["total_ms_per_frame"] : (*times).value("total", Json());
-            if (!list.is_array()) continue;
-            for (const Json& t : list)
+        const Json passes = entry.is_object() && entry.contains("repetitions") && entry["repetitions"].is_object() &&
+                                    entry["repetitions"].contains("time_ms") && entry["repetitions"]["time_ms"].is_object()
+                                ? entry["repetitions"]["time_ms"].value("total", Json())
+                                : Json();
+        const Json frames = entry.is_object() ? entry.value("total_ms_per_frame", Json()) : Json();
+        for (const Json* list : {&passes, &frames}) {
+            if (!list->is_array()) continue;
+            for (const Json& t : *list)
                 // Zero is a time a coarse timer can read; below it, or not finite, is no run's.
                 if (!t.is_number() || !(t.get<double>() >= 0) || !std::isfinite(t.get<double>()))
                     throw InputError(shortText(file, 300), "/algorithms/" + shortText(id, 60),

@@ -9,8 +9,17 @@
 
 namespace shadowlab {
 
+namespace {
+
+/// The largest absolute coordinate of `b`: where its float precision is coarsest.
+float farthestCoordinate(const Bounds& b) {
+    return std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
+}
+
+} // namespace
+
 std::string floatPrecisionAt(const Bounds& b) {
-    const float far = std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
+    const float far = farthestCoordinate(b);
     char text[160];
     std::snprintf(text, sizeof text, "coordinates up to %.3g, where a float's spacing is %.3g", double(far),
                   double(std::nextafter(far, INFINITY) - far));
@@ -20,7 +29,7 @@ std::string floatPrecisionAt(const Bounds& b) {
 std::string floatDistortion(const Bounds& b) {
     const glm::vec3 extent = b.extent();
     const float size = std::max({extent.x, extent.y, extent.z});
-    const float far = std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
+    const float far = farthestCoordinate(b);
     const float spacing = std::nextafter(far, INFINITY) - far;
     if (!(size > 0.0f && spacing > 0.01f * size)) return "";
     char text[160];

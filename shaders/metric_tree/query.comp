@@ -371,7 +371,7 @@ void main() {
             vec3 x = pos.xyz, nrm = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // facing away from the light
             // The reference's ray origin: the same offset along the same (unnormalised) normal.
-            // Outside a spot's cone the light does not reach x (the reference's rule, Light::illuminates).
+            // Facing the light and inside a spot's cone, decided as the reference decides it (Light::reaches).
             if (lightReaches(x, nrm)) { needs = true; q = x + nrm * uRayOffset; }
         }
     }

@@ -24,7 +24,7 @@ void main() {
         if (pos.w >= 0.5) {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             key = PTSV_KEY_AWAY;
-            // Outside a spot's cone the light does not reach p (the reference's rule, Light::illuminates).
+            // Facing the light and inside a spot's cone, decided as the reference decides it (Light::reaches).
             if (lightReaches(p, n)) {
                 // The reference's ray origin: the same offset along the same (unnormalised) normal.
                 q = p + n * uRayOffset;
