@@ -344,6 +344,46 @@ TEST(SceneConfigTest, ScaleMaterialAndGrid) {
     EXPECT_NEAR(build(R"({"objects": [{"procedural": "sphere", "transform": {"scale": 3}}]})").bounds.max.y, 3.0f, 1e-4f);
 }
 
+TEST(SceneConfigTest, MeshTakesItsTrianglesAsWritten) {
+    // Three by three without indices; through index triples with them. The coordinates are kept
+    // bit for bit (the exactness fuzzer's shrunk cases depend on it), the winding gives the normal.
+    Json resolved;
+    Scene s = build(R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 0.1, -1e-3]]},
+        {"procedural": "mesh", "vertices": [[0, 1, 0], [0, 1, 1], [1, 1, 1], [1, 1, 0]], "indices": [[0, 1, 2], [0, 2, 3]],
+         "material": {"albedo": [0.5, 0.5, 0.5]}}]})", &resolved);
+    ASSERT_EQ(s.triangleCount(), 3u);
+    EXPECT_EQ(s.positions[2], glm::vec3(0.0f, 0.1f, -1e-3f));
+    EXPECT_EQ(s.positions[5], glm::vec3(1, 1, 1));
+    EXPECT_EQ(s.positions[8], glm::vec3(1, 1, 0));
+    EXPECT_GT(s.normals[1].y, 0.99f);  // (0,1,0)-(0,1,1)-(1,1,1) is counter-clockwise seen from +Y
+    EXPECT_EQ(resolved["objects"][1]["indices"], Json::parse("[[0, 1, 2], [0, 2, 3]]"));
+}
+
+TEST(SceneConfigTest, MeshRefusesWhatItWouldHaveToChange) {
+    const std::pair<const char*, std::vector<const char*>> cases[] = {
+        {R"({"objects": [{"procedural": "mesh"}]})", {"/scene/objects/0/vertices", "needs"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0]]}]})", {"/scene/objects/0/vertices", "multiple of 3"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [2, 0, 0]]}]})",
+         {"/scene/objects/0/vertices/0", "no area"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1e-50, 0]]}]})",
+         {"/scene/objects/0/vertices/2", "float"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [[0, 1, 3]]}]})",
+         {"/scene/objects/0/indices/0", "[0, 2]"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": [[0, 1, 1]]}]})",
+         {"/scene/objects/0/indices/0", "no area"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "indices": []}]})",
+         {"/scene/objects/0/indices", "at least one triangle"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 2e15, 0]]}]})",
+         {"/scene/objects/0/vertices/2", "1e15"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, "x"], [0, 1, 0]]}]})", {"/scene/objects/0/vertices/1"}},
+        {R"({"objects": [{"procedural": "mesh", "vertices": {"a": 1}}]})", {"/scene/objects/0/vertices", "array"}},
+    };
+    for (const auto& [text, fragments] : cases) {
+        std::string msg = inputErrorOf([&] { build(text); });
+        for (const char* f : fragments) EXPECT_NE(msg.find(f), std::string::npos) << "config " << text << "\nmessage: " << msg;
+    }
+}
+
 TEST(SceneConfigTest, BadInputsAreInputErrorsWithPaths) {
     const std::pair<const char*, std::vector<const char*>> cases[] = {
         {R"({"objects": [{"procedural": "sphere", "radiuss": 2}]})", {"test.json", "/scene/objects/0/radiuss", "accepted keys"}},

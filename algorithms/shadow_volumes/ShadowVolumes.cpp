@@ -276,6 +276,10 @@ public:
         closeList_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_CLOSE_LIST_BINDING);
         closeArgs_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_CLOSE_ARGS_BINDING);
         setLightUniforms(resolvePass_, f.light);
+        resolvePass_.set("uRayOffset", offset);
+        resolvePass_.set("uCloseCall", closeCallLength());
+        scene_->bindStorage();  // the own triangle's plane (resolve.comp)
+        glBindTextureUnit(SV_TRIANGLE_ID_UNIT, f.gbuffer.triangleId());
         if (options_.instrumentation) runPixelPass(f, resolvePass_, {&closeView_, &countView_});
         else runPixelPass(f, resolvePass_, {});
         f.timer.end();
@@ -379,7 +383,8 @@ private:
         volumePass_ = ShaderProgram::graphics("shadow_volumes/volume.vert", "shadow_volumes/volume.frag",
                                               {instr, check, {"SV_CLOSE_CALLS", p_.closeCalls ? "1" : "0"},
                                                {"SV_ANALYTIC", p_.depthTest == "analytic" ? "1" : "0"}});
-        resolvePass_ = ShaderProgram::compute("shadow_volumes/resolve.comp", {instr, check});
+        resolvePass_ = ShaderProgram::compute("shadow_volumes/resolve.comp",
+                                              {instr, check, {"SV_CLOSE_CALLS", p_.closeCalls ? "1" : "0"}});
         eyePass_ = ShaderProgram::compute("shadow_volumes/eye_count.comp", {{"SCENE_POSITION_TEXELS", "1"}});
         closeArgsPass_ = ShaderProgram::compute("shadow_volumes/close_args.comp", {});
         closeRayPass_ = ShaderProgram::compute("shadow_volumes/close_rays.comp", {instr});

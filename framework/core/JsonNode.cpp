@@ -203,6 +203,42 @@ glm::vec2 JsonNode::getVec2(const std::string& key, glm::vec2 def) {
     return out;
 }
 
+namespace {
+/// Reads each element of the array `v` (at `path`) through `read`, as the value of a one-key object
+/// whose key is its index: the element gets the single-value readers' checks and its path in errors.
+template <class T, class Read>
+std::vector<T> readElements(const JsonNode& owner, const std::string& key, const Json& v, Read read) {
+    if (!v.is_array()) owner.fail(key, "expected an array, got " + std::string(v.type_name()));
+    std::vector<T> out;
+    out.reserve(v.size());
+    for (size_t i = 0; i < v.size(); ++i) {
+        const std::string index = std::to_string(i);
+        const Json holder = {{index, v[i]}};
+        JsonNode element(owner.file(), &holder, owner.childPath(key), nullptr);
+        out.push_back(read(element, index));
+    }
+    return out;
+}
+} // namespace
+
+std::vector<glm::vec3> JsonNode::getPointList(const std::string& key) {
+    const Json* v = lookup(key);
+    if (!v) return {};
+    auto out = readElements<glm::vec3>(*this, key, *v, [](JsonNode& e, const std::string& i) { return e.getPoint(i, glm::vec3(0.0f)); });
+    record(key, *v);
+    return out;
+}
+
+std::vector<glm::ivec3> JsonNode::getIndexTriples(const std::string& key, int count) {
+    const Json* v = lookup(key);
+    if (!v) return {};
+    auto out = readElements<glm::ivec3>(*this, key, *v, [count](JsonNode& e, const std::string& i) {
+        return e.getIVec3(i, glm::ivec3(0), 0, count - 1);
+    });
+    record(key, *v);
+    return out;
+}
+
 glm::ivec2 JsonNode::getIVec2(const std::string& key, glm::ivec2 def, int minValue, int maxValue) {
     auto a = numberArray<int>(key, 2, true);
     glm::ivec2 out = a.empty() ? def : glm::ivec2(a[0], a[1]);

@@ -55,6 +55,11 @@ public:
     /// A position in world units: a vec3 whose components lie within ±kMaxCoordinate.
     glm::vec3 getPoint(const std::string& key, glm::vec3 def);
     glm::vec2 getVec2(const std::string& key, glm::vec2 def);
+    /// An array of positions ([[x, y, z], ...], each held to getPoint's rules); an error names the
+    /// element (KEY/i). Empty when absent.
+    std::vector<glm::vec3> getPointList(const std::string& key);
+    /// An array of integer triples ([[a, b, c], ...]), each value in [0, count); empty when absent.
+    std::vector<glm::ivec3> getIndexTriples(const std::string& key, int count);
     glm::ivec2 getIVec2(const std::string& key, glm::ivec2 def, int minValue, int maxValue);
     glm::ivec3 getIVec3(const std::string& key, glm::ivec3 def, int minValue, int maxValue);
     std::vector<int> getIntList(const std::string& key, const std::vector<int>& def);

@@ -191,15 +191,36 @@ Json totalTimeRatios(const Json& algs) {
 }
 } // namespace
 
+namespace {
+/// A frame's first wrong pixel as {"frame", "x", "y"}: y counts rows up from the image's bottom
+/// row, as GL reads them (images/ are written top row first: row height - 1 - y there).
+Json wrongPixelJson(const FrameRecord& f, int width) {
+    const int64_t i = f.accuracy.firstWrongPixel, w = std::max(1, width);
+    return {{"frame", f.frame}, {"x", i % w}, {"y", i / w}};
+}
+} // namespace
+
+int ExperimentResults::imageWidth() const {
+    const Json res = meta.value("resolution", Json());
+    return res.is_array() && !res.empty() && res[0].is_number_integer() ? res[0].get<int>() : 1;
+}
+
 Json ExperimentResults::summary() const {
     Json out = meta;
     Json algs = Json::object();
     const bool gpuTimes = meta.value("stage_time_source", std::string("gpu")) == "gpu";
     for (const auto& a : algorithms) {
         std::vector<double> mismatch, falseLit, falseShadowed, rmse;
+        std::vector<size_t> wrongPixels;
+        size_t falseLitPixels = 0, falseShadowedPixels = 0;
+        Json firstWrong = nullptr;  // where a failure can be looked at (and the exactness fuzzer shrinks to)
         uint64_t overflow = 0;
         for (const auto& f : a.frames) {
             if (f.hasAccuracy) {
+                wrongPixels.push_back(f.accuracy.falseLitPixels + f.accuracy.falseShadowedPixels);
+                falseLitPixels += f.accuracy.falseLitPixels;
+                falseShadowedPixels += f.accuracy.falseShadowedPixels;
+                if (firstWrong.is_null() && f.accuracy.firstWrongPixel >= 0) firstWrong = wrongPixelJson(f, imageWidth());
                 mismatch.push_back(f.accuracy.mismatchRatio);
                 falseLit.push_back(f.accuracy.falseLit);
                 falseShadowed.push_back(f.accuracy.falseShadowed);
@@ -224,6 +245,15 @@ Json ExperimentResults::summary() const {
             for (const auto& st : f.stages)
                 if (st.name == "total") perFrame.push_back(st.cpuMs);
         j["total_ms_per_frame"] = perFrame;
+        // Each frame's visibility image as a hash (hex): two runs that must give the same image
+        // (a scene rewritten without changing what it is, docs/exactness_fuzzing.md) compare these.
+        Json hashes = Json::array();
+        for (const auto& f : a.frames) {
+            char hex[17];
+            std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(f.visibilityHash));
+            hashes.push_back(hex);
+        }
+        j["visibility_hash_per_frame"] = hashes;
         if (!mismatch.empty()) {
             Stats m = computeStats(mismatch);
             j["accuracy"] = {{"mismatch_ratio", m.mean},
@@ -232,7 +262,11 @@ Json ExperimentResults::summary() const {
                              {"false_lit", computeStats(falseLit).mean},
                              {"false_shadowed", computeStats(falseShadowed).mean},
                              {"rmse", computeStats(rmse).mean},
-                             {"per_frame_mismatch", mismatch}};
+                             {"per_frame_mismatch", mismatch},
+                             {"false_lit_pixels", falseLitPixels},
+                             {"false_shadowed_pixels", falseShadowedPixels},
+                             {"per_frame_wrong_pixels", wrongPixels},
+                             {"first_wrong_pixel", firstWrong}};
         } else {
             j["accuracy"] = nullptr;  // no reference, or no frame with a lit pixel to compare
         }

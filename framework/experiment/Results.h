@@ -20,6 +20,7 @@ struct FrameRecord {
     bool hasAccuracy = false;
     Accuracy accuracy;
     uint64_t overflow = 0;
+    uint64_t visibilityHash = 0; ///< of the frame's visibility image: runs that must agree compare it
 };
 
 struct AlgorithmResults {
@@ -51,6 +52,8 @@ Stats computeStats(std::vector<double> values);
 
 struct ExperimentResults {
     Json meta; ///< name, renderer, device, resolution, triangles, ... (copied into summary.json)
+    /// The frames' width in pixels, from meta's resolution (1 without one).
+    int imageWidth() const;
     std::vector<AlgorithmResults> algorithms;
 
     /// frames.csv (the timed pass) or, with `statisticsPass`, statistics.csv (the statistics pass).

@@ -280,8 +280,9 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                 rec.hasAccuracy = true;
                 rec.accuracy = compareVisibility(vis, reference, lit);
             }
-            if (isStatFrame(frame)) inst.timedVisibility[frame] = visibilityHash(vis);
-            if (cfg.repeats > 1) inst.firstImages.push_back(visibilityHash(vis));
+            rec.visibilityHash = visibilityHash(vis);
+            if (isStatFrame(frame)) inst.timedVisibility[frame] = rec.visibilityHash;
+            if (cfg.repeats > 1) inst.firstImages.push_back(rec.visibilityHash);
             if (saveImages) {
                 shading.run(gbuffer, inst.host->visibility(), light);
                 writeFrameImages(dir, inst.entry->id, frame, res, shading, vis, cfg.reference && !isReference ? &reference : nullptr,

@@ -31,9 +31,12 @@ Accuracy compareVisibility(const std::vector<float>& vis, const std::vector<floa
         bool v = vis[i] >= 0.5f, r = ref[i] >= 0.5f;
         if (v && !r) ++falseLit;
         if (!v && r) ++falseShadowed;
+        if (v != r && a.firstWrongPixel < 0) a.firstWrongPixel = int64_t(i);
         double d = double(vis[i]) - double(ref[i]);
         sq += d * d;
     }
+    a.falseLitPixels = falseLit;
+    a.falseShadowedPixels = falseShadowed;
     if (a.litPixels) {
         double n = double(a.litPixels);
         a.falseLit = double(falseLit) / n;

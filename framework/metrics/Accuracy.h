@@ -20,6 +20,9 @@ struct Accuracy {
     double falseLit = 0;      ///< share of lit pixels lit by the algorithm but shadowed in the reference
     double falseShadowed = 0; ///< share of lit pixels shadowed by the algorithm but lit in the reference
     double rmse = 0;          ///< root mean square difference of visibility over lit pixels
+    size_t falseLitPixels = 0, falseShadowedPixels = 0;
+    /// The first wrong pixel in memory order (row 0 at the image's bottom, as GL stores it); -1: none.
+    int64_t firstWrongPixel = -1;
 };
 
 Accuracy compareVisibility(const std::vector<float>& visibility, const std::vector<float>& reference,

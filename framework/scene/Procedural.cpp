@@ -257,6 +257,13 @@ Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint
     return scene;
 }
 
+Scene makeMesh(const std::vector<glm::vec3>& vertices, const std::vector<glm::ivec3>& triangles, const Material& m) {
+    Scene scene;
+    Writer w(scene, m, triangles.size());
+    for (const glm::ivec3& t : triangles) w.add(vertices[size_t(t.x)], vertices[size_t(t.y)], vertices[size_t(t.z)]);
+    return scene;
+}
+
 Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg) {
     count = glm::max(count, glm::ivec3(1));
     Scene scene;

@@ -65,6 +65,9 @@ Scene makeCylinder(float radius, float height, int triangles, const Material& m)
 Scene makeFence(int posts, float spacing, float height, float radius, int rails, int trianglesPerCylinder, const Material& m);
 /// `triangles` random triangles of edge length about `triangleSize` inside a box of `extent` centred at the origin.
 Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint32_t seed, const Material& m);
+/// The triangles `triangles` (indices into `vertices`, counter-clockwise seen from the front), as
+/// given; a degenerate one (no unit normal) is left out, so callers refuse those first.
+Scene makeMesh(const std::vector<glm::vec3>& vertices, const std::vector<glm::ivec3>& triangles, const Material& m);
 /// `count.x × count.y × count.z` copies of `object`, spaced by `spacing`, grid centred on the origin in X and Z.
 Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg = glm::vec3(0.0f));
 

@@ -24,6 +24,8 @@
 //     cylinder  radius = 0.5, height = 1, triangles = 500                     along Y from y = 0, capped
 //     fence     posts = 10, spacing = 0.5, height = 1.5, radius = 0.03, rails = 2, triangles_per_cylinder = 64
 //     soup      triangles = 1000, extent [4, 4, 4], triangle_size = 0.2, seed = 1
+//     mesh      vertices [[x, y, z], ...], indices [[a, b, c], ...] (default: the vertices three by
+//               three)                                                  the triangles as written
 //     grid      object = OBJECT (any, recursively), count [nx, ny, nz] = [2, 1, 2] (1..100000),
 //               spacing [sx, sy, sz] = [2, 2, 2], rotate_step_deg [rx, ry, rz] = [0, 0, 0] (copy i, counted
 //               along x, then z, then y, is turned by i × step about its own origin, Euler as in T);
@@ -62,7 +64,7 @@
 namespace shadowlab {
 namespace {
 
-const std::vector<std::string> kKinds = {"plane", "sphere", "torus", "cylinder", "fence", "soup", "grid"};
+const std::vector<std::string> kKinds = {"plane", "sphere", "torus", "cylinder", "fence", "soup", "mesh", "grid"};
 constexpr int kMaxTrianglesCeiling = int(kMaxSceneTriangles);
 /// The default max_triangles follows the machine: the triangles whose least possible footprint
 /// (kMinBytesPerTriangle: the Scene's 52 bytes on the host and its 52 on the GPU, which a software
@@ -187,6 +189,38 @@ void overrideMaterials(Scene& s, const Material& m) {
 
 Builder parseObject(JsonNode node, int depth, int budget);
 
+/// A mesh's triangles, as written (the exactness fuzzer's scenes and the cases it shrinks,
+/// docs/exactness_fuzzing.md): vertices and optional index triples. A triangle without area at
+/// float precision is refused, never dropped: a run does not succeed on a scene it changed.
+Builder parseMesh(JsonNode& node, const Material& m, int budget) {
+    if (!node.has("vertices")) node.fail("vertices", "a mesh needs its \"vertices\"");
+    const std::vector<glm::vec3> vertices = node.getPointList("vertices");
+    if (vertices.size() > 3 * size_t(budget))
+        node.fail("vertices", std::to_string(vertices.size()) + " vertices, more than 3 × the scene's max_triangles (" +
+                                  std::to_string(budget) + ")");
+    const bool indexed = node.has("indices");
+    std::vector<glm::ivec3> triangles = node.getIndexTriples("indices", int(vertices.size()));
+    if (!indexed) {
+        if (vertices.size() < 3 || vertices.size() % 3 != 0)
+            node.fail("vertices", "without \"indices\" the vertices are taken three by three: " + std::to_string(vertices.size()) +
+                                      " is not a positive multiple of 3");
+        for (int v = 0; v < int(vertices.size()); v += 3) triangles.emplace_back(v, v + 1, v + 2);
+    }
+    if (triangles.empty()) node.fail("indices", "a mesh needs at least one triangle");
+    if (triangles.size() > size_t(budget))
+        node.fail("indices", std::to_string(triangles.size()) + " triangles, more than the scene's max_triangles (" +
+                                 std::to_string(budget) + ")");
+    for (size_t t = 0; t < triangles.size(); ++t) {
+        glm::vec3 n;
+        const glm::ivec3 i = triangles[t];
+        if (!unitNormal(vertices[size_t(i.x)], vertices[size_t(i.y)], vertices[size_t(i.z)], n))
+            node.fail(indexed ? "indices/" + std::to_string(t) : "vertices/" + std::to_string(3 * t),
+                      "triangle " + std::to_string(t) + " has no area at float precision (its vertices are collinear or repeated)");
+    }
+    const size_t count = triangles.size();
+    return Builder{[=] { return makeMesh(vertices, triangles, m); }, [=] { return count; }};
+}
+
 /// Reads a procedural object's generator keys; returns the generator (run later). `budget` is the
 /// scene's triangle limit: a request above it fails here, before any memory is spent on it.
 Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& m, int depth, int budget) {
@@ -237,6 +271,7 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
         uint32_t seed = uint32_t(node.getInt("seed", 1, 0));
         return Builder{[=] { return makeTriangleSoup(n, extent, size, seed, m); }, [=] { return soupTriangles(n); }};
     }
+    if (kind == "mesh") return parseMesh(node, m, budget);
     // grid
     if (depth >= kMaxGridDepth) node.fail("object", "grids nest deeper than " + std::to_string(kMaxGridDepth) + " levels");
     if (!node.has("object")) node.fail("object", "a grid needs the \"object\" to repeat");
@@ -305,7 +340,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
     if (isGltf && isProcedural) node.failHere("an object takes either \"gltf\" or \"procedural\", not both");
     if (!isGltf && !isProcedural)
         node.failHere("an object needs \"gltf\" (a file) or \"procedural\" (plane, sphere, torus, cylinder, fence, "
-                      "soup or grid)");
+                      "soup, mesh or grid)");
 
     Builder build;
     std::string kind = isGltf ? "gltf" : node.getEnum("procedural", "", kKinds);

@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""The exactness fuzzer finds a planted fault and shrinks it (docs/exactness_fuzzing.md).
+
+The fault is the test-only SHADOWLAB_FAULT_PLANTED_LIT of psv's query (every 61st pixel written
+lit), switched on in a copy of the shaders (SHADOWLAB_SHADER_DIR). Fixed seeds: the fuzzer must
+find psv wrong, shrink the case to at most 10 triangles, and the shrunk config must fail with the
+fault (exit 3: its expectation) and pass on the real shaders (exit 0). Its pieces are checked too:
+ddmin finds a minimal subset, the generator is reproducible, the median split is exact.
+
+Usage: test_exactness_fuzz.py SHADOWLAB_BINARY SOURCE_DIR   (ctest runs it)
+"""
+import glob
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+BINARY, SOURCE = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+FUZZ = os.path.join(SOURCE, "scripts", "exactness_fuzz.py")
+sys.path.insert(0, os.path.join(SOURCE, "scripts"))
+import exactness_fuzz as ef  # noqa: E402
+
+
+def planted_shaders(folder):
+    """A copy of the shaders with psv's planted-lit fault on."""
+    shaders = os.path.join(folder, "shaders")
+    shutil.copytree(os.path.join(SOURCE, "shaders"), shaders)
+    query = os.path.join(shaders, "psv", "query.comp")
+    with open(query) as f:
+        text = f.read()
+    assert "#if SHADOWLAB_FAULT_PLANTED_LIT" in text
+    with open(query, "w") as f:
+        f.write(text.replace("#if SHADOWLAB_FAULT_PLANTED_LIT", "#if 1"))
+    return shaders
+
+
+class Pieces(unittest.TestCase):
+    def test_ddmin_finds_a_minimal_failing_subset(self):
+        calls = []
+
+        def fails(s):
+            calls.append(len(s))
+            return 3 in s and 17 in s
+        self.assertEqual(sorted(ef.ddmin(list(range(40)), fails)), [3, 17])
+        self.assertLess(len(calls), 100)  # ddmin is O(n log n) here; a broken one is O(n²): 1,600
+
+    def test_the_generator_is_reproducible_and_varied(self):
+        self.assertEqual(json.dumps(ef.generate(7)), json.dumps(ef.generate(7)))
+        kinds = {ef.generate(s)["light"]["type"] for s in range(40)}
+        self.assertEqual(kinds, {"point", "spot", "directional"})
+
+    def test_the_median_split_covers_the_triangle_exactly(self):
+        case = {"objects": [{"tris": [[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]}]}
+        import random
+        split = ef.split_along_median(case, random.Random(1))
+        halves = split["objects"][0]["tris"]
+        self.assertEqual(len(halves), 2)
+        self.assertAlmostEqual(sum(ef.area2(t) for t in halves), ef.area2(case["objects"][0]["tris"][0]), places=12)
+        # No float midpoint, no split there (the halves would not cover the triangle).
+        self.assertIsNone(ef.exact_midpoint([0.0, 1.0, 0.0], [1.0, ef.f32(1 + 2 ** -23), 0.0]))
+
+
+class PlantedFault(unittest.TestCase):
+    def test_a_planted_fault_is_found_and_shrunk_to_a_few_triangles(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            env = dict(os.environ, SHADOWLAB_SHADER_DIR=planted_shaders(tmp))
+            out = os.path.join(tmp, "out")
+            r = subprocess.run([sys.executable, FUZZ, "--binary", BINARY, "run", "--seconds", "600", "--cases", "3",
+                                "--seed", "11", "--only", "psv", "--relations", "0", "--out", out, "--expect-failure"],
+                               env=env, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+            self.assertEqual(r.returncode, 0, r.stdout[-3000:] + r.stderr[-2000:])
+            with open(os.path.join(out, "report.json")) as f:
+                report = json.load(f)
+            shrunk = [f for f in report["failures"] if "shrunk" in f]
+            self.assertTrue(shrunk)
+            for f in shrunk:
+                self.assertTrue(f["id"].startswith("psv"))
+                self.assertLessEqual(f["triangles"], 10, f)
+            case = os.path.join(out, shrunk[0]["shrunk"])
+            for shader_env, code in ((env, 3), (dict(os.environ), 0)):
+                run = subprocess.run([BINARY, "run", case, "--out", os.path.join(tmp, f"replay{code}"), "--no-progress"],
+                                     env=shader_env, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+                self.assertEqual(run.returncode, code, run.stderr[-2000:])
+
+
+class Corpus(unittest.TestCase):
+    def test_every_kept_case_holds(self):
+        cases = sorted(glob.glob(os.path.join(SOURCE, "tests", "data", "exactness", "*.json")))
+        if not cases:
+            self.skipTest("no case kept yet")
+        r = subprocess.run([sys.executable, FUZZ, "--binary", BINARY, "replay"] + cases, capture_output=True, text=True,
+                           stdin=subprocess.DEVNULL)
+        self.assertEqual(r.returncode, 0, r.stdout[-4000:])
+
+
+if __name__ == "__main__":
+    unittest.main(argv=sys.argv[:1])
