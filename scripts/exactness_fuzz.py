@@ -406,7 +406,7 @@ def failures(summary, entries):
         if wrong == 0:
             continue
         kind = "overflow" if s.get("overflow", 0) else ("false_lit" if one_sided else "wrong")
-        frames = [f for f, n in enumerate(acc["per_frame_wrong_pixels"]) if n]
+        frames = [f for f, n in enumerate(acc["per_frame_wrong_pixels"]) if n]  # null: a frame not measured
         found.append({"id": e["id"], "entry": e, "frames": frames, "pixel": acc["first_wrong_pixel"], "kind": kind,
                       "false_lit": acc["false_lit_pixels"], "false_shadowed": acc["false_shadowed_pixels"]})
     return found
@@ -662,11 +662,18 @@ def campaign(args, sl, log=print):
         for e in entries:
             stats["by_id"].setdefault(e["id"], {"frames": 0, "failures": 0})["frames"] += case["frames"]
         found = failures(summary, entries)
+        # Every algorithm wrong on the same first pixel: the reference is the odd one out.
+        exact_found = [f for f in found if f["entry"]["algorithm"] not in ONE_SIDED]
+        algorithms_wrong = {f["entry"]["algorithm"] for f in exact_found}
+        against_reference = len(algorithms_wrong) >= 3 and len({json.dumps(f["pixel"]) for f in exact_found}) == 1
+        if against_reference:
+            log(f"seed {case['seed']}: {len(algorithms_wrong)} algorithms agree against the reference: suspect the reference")
         for f in found:
             stats["by_id"][f["id"]]["failures"] += 1
             log(f"seed {case['seed']}: {f['id']} {f['kind']}: {f['false_lit']} false lit, {f['false_shadowed']} "
                 f"false shadowed, first at {f['pixel']}")
-            record = {"seed": case["seed"], "id": f["id"], "kind": f["kind"], "false_lit": f["false_lit"],
+            record = {"seed": case["seed"], "id": f["id"], "kind": f["kind"], "against_reference": against_reference,
+                      "false_lit": f["false_lit"],
                       "false_shadowed": f["false_shadowed"], "pixel": f["pixel"]}
             shrunk_of_id = sum(1 for r in stats["failures"] if r["id"] == f["id"] and "shrunk" in r)
             if args.shrink and f["kind"] != "overflow" and shrunk_of_id < args.shrinks_per_id:

@@ -46,7 +46,7 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
     if (options.withReference) {
         EmbreeTracer tracer(shot.scene);
         // The algorithm's own offset, so both trace from the same points and only the tests differ.
-        tracer.traceVisibility(o.gbuffer, shot.light, float(rayOffsetOf(params)) * shot.scene.bounds.radius(), 0, o.reference);
+        tracer.traceVisibility(o.gbuffer, shot.light, rayOffsetLength(float(rayOffsetOf(params)), shot.scene.bounds), 0, o.reference);
         o.accuracy = compareVisibility(o.visibility, o.reference, o.lit);
     }
     return o;

@@ -258,6 +258,35 @@ TEST(HistoryTest, ASummaryNoRunWritesIsLeftOut) {
     EXPECT_NE(ran.err.find("/algorithms/psv"), std::string::npos) << ran.err;
 }
 
+// Eighth probe: a field of the wrong type (a time written as "NaN", an overflow as "many", a
+// renderer as a number) stopped compare with a library's message and exit 1. It is bad input,
+// named by its file and JSON path, and history leaves such a run out.
+TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
+    const std::vector<std::pair<std::function<void(Json&)>, std::string>> edits = {
+        {[](Json& s) { s["algorithms"]["psv"]["time_ms"]["total"]["mean"] = "NaN"; }, "/algorithms/psv/time_ms/total/mean"},
+        {[](Json& s) { s["algorithms"]["psv"]["overflow"] = "many"; }, "/algorithms/psv/overflow"},
+        {[](Json& s) { s["algorithms"]["psv"]["memory_bytes"] = Json::array({1, "x"}); }, "/algorithms/psv/memory_bytes/1"},
+        {[](Json& s) { s["algorithms"]["psv"] = 7; }, "/algorithms/psv"},
+        {[](Json& s) { s["renderer"] = 3; }, "/renderer"},
+        {[](Json& s) { s["build"] = {{"commit", 5}}; }, "/build"},
+    };
+    for (const auto& [change, path] : edits) {
+        SCOPED_TRACE(path);
+        const std::string dir = test::makeTempDir("compare-types");
+        writeRuns(dir, {20, 20, 20}, {0, 0, 0}, kSpread);
+        Json s = Json::parse(std::ifstream(dir + "/run-99/summary.json"));
+        change(s);
+        std::ofstream(dir + "/run-99/summary.json") << s.dump();
+        for (const auto& args : {std::vector<std::string>{dir + "/run-98", dir + "/run-99"}, {dir + "/run-99", dir + "/run-98"}}) {
+            const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "compare", args[0], args[1], "--out", dir + "/cmp"});
+            EXPECT_EQ(ran.rc, 2) << ran.err;
+            EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
+            EXPECT_NE(ran.err.find("run-99/summary.json: at " + path), std::string::npos) << ran.err;
+        }
+        EXPECT_EQ(readHistory(dir, {}).runs.size(), 2u);
+    }
+}
+
 // Seventh probe: `compare A B --out A --force` and `history H --out H/r1 --force` replaced a run
 // they had just read with their report (exit 0). An output that is, holds or lies inside an input
 // is refused before anything is read or written.

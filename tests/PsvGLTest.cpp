@@ -258,6 +258,31 @@ TEST_F(PsvGLTest, FaultEscapeLoopIsCappedAndWrittenShadowed) {
     }
 }
 
+// 20,000 copies of one triangle over a plane (eighth probe): a walk along the shadow's border visits
+// most of their nodes and runs into llvmpipe's loop limit (rule 13) inside the node loop, which then
+// left without a capping node, and the walk decided a triangle it had not found (a wrong pixel with
+// no overflow). Every walk the device ends must be counted; on a device without the limit the image
+// is simply exact.
+TEST_F(PsvGLTest, NodeLoopsTheDeviceEndsAreCounted) {
+    Shot s;
+    s.scene = ground(4.0f);
+    const std::vector<glm::vec3> vertices = {{-0.5f, 1, -0.5f}, {-0.5f, 1, 0.5f}, {0.5f, 1, -0.5f}};
+    s.scene.append(makeMesh(vertices, std::vector<glm::ivec3>(20000, glm::ivec3(0, 1, 2)), Material{}), glm::mat4(1.0f));
+    s.camera = lookAt({0, 2, 6}, {0, 0, 0});
+    s.light = pointLight({2, 4, 2});
+    RunOptions options;
+    options.resolution = 32;
+    for (const char* walk : {"stack", "stackless", "hybrid"}) {
+        SCOPED_TRACE(walk);
+        const AlgorithmRun o = runAlgorithm(psvInfo(), s, {{"traversal", std::string(walk)}}, options);
+        std::printf("[psv] %s over 20,000 copies: %zu false shadowed, %.0f walks capped\n", walk,
+                    o.accuracy.falseShadowedPixels, o.counters.at("loop_capped_pixels"));
+        EXPECT_EQ(o.accuracy.falseLitPixels, 0u);
+        EXPECT_LE(o.accuracy.falseShadowedPixels, o.overflow);
+        expectOverflowedPixelsShadowed(o, o.counters.at("loop_capped_pixels") + o.counters.at("stack_overflow_pixels"));
+    }
+}
+
 // x-ray shadows keep a capping plane's negative child pending besides its other side, which one
 // escape per triangle cannot express: the stackless walks refuse transparency by name.
 TEST_F(PsvGLTest, StacklessWalksRefuseTransparency) {

@@ -357,6 +357,8 @@ TEST(SceneConfigTest, MeshTakesItsTrianglesAsWritten) {
     EXPECT_EQ(s.positions[8], glm::vec3(1, 1, 0));
     EXPECT_GT(s.normals[1].y, 0.99f);  // (0,1,0)-(0,1,1)-(1,1,1) is counter-clockwise seen from +Y
     EXPECT_EQ(resolved["objects"][1]["indices"], Json::parse("[[0, 1, 2], [0, 2, 3]]"));
+    // The resolved config holds the floats used, as for every other vector (0.1 is not one).
+    EXPECT_EQ(resolved["objects"][0]["vertices"][2][1].get<double>(), double(0.1f));
 }
 
 TEST(SceneConfigTest, MeshRefusesWhatItWouldHaveToChange) {
@@ -377,6 +379,10 @@ TEST(SceneConfigTest, MeshRefusesWhatItWouldHaveToChange) {
          {"/scene/objects/0/vertices/2", "1e15"}},
         {R"({"objects": [{"procedural": "mesh", "vertices": [[0, 0, 0], [1, 0, "x"], [0, 1, 0]]}]})", {"/scene/objects/0/vertices/1"}},
         {R"({"objects": [{"procedural": "mesh", "vertices": {"a": 1}}]})", {"/scene/objects/0/vertices", "array"}},
+        // One large triangle beside a small one that float rounding changes by half its size: each
+        // triangle is held to the 1 % rule (eighth probe).
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[-2e6, 0.5, -1], [0, 0.5, 2e6], [2e6, 0.5, -1],
+            [1000000, 1, 0], [1000000, 1, 0.04], [1000000.04, 1, 0]]}]})", {"/scene/objects/0/vertices/3", "triangle 1", "distorted"}},
     };
     for (const auto& [text, fragments] : cases) {
         std::string msg = inputErrorOf([&] { build(text); });

@@ -543,7 +543,7 @@ private:
         }
         prepare_.set("uDepthTolerance", tolerance);
         insert_.set("uDelta0", delta0);
-        query_.set("uRayOffset", p_.rayOffset * radius);
+        query_.set("uRayOffset", rayOffsetLength(p_.rayOffset, *scene_));
         query_.set("uSlabTolerance", tolerance);
     }
 

@@ -243,7 +243,7 @@ private:
         if (light.type != LightType::Directional) magnitude = std::max(magnitude, glm::length(light.position));
         const float tolerance = 4e-6f * magnitude;
         const glm::vec3 depthOrigin = center - light.direction() * (2.0f * radius);
-        const float rayOffset = p_.rayOffset * radius;
+        const float rayOffset = rayOffsetLength(p_.rayOffset, *scene_);
         const uint32_t n = uint32_t(scene_->triangleCount());
         for (const ShaderProgram* p : {&frusta_, &build_, &query_}) {
             setLightUniforms(*p, light);

@@ -447,7 +447,7 @@ private:
         float magnitude = glm::length(center) + radius + glm::length(camera.position);
         if (light.type != LightType::Directional) magnitude = std::max(magnitude, glm::length(light.position));
         const float tolerance = 4e-6f * magnitude;
-        const float rayOffset = p_.rayOffset * radius;
+        const float rayOffset = rayOffsetLength(p_.rayOffset, *scene_);
         const float aspect = float(resolution_.x) / float(resolution_.y);
         const float tanHalf = std::tan(glm::radians(camera.fovYDeg) * 0.5f);
         const glm::mat4 view = camera.view();

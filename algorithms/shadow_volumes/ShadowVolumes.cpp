@@ -241,6 +241,7 @@ public:
             if (checked()) glBindImageTexture(SV_OTHER_IMAGE, other_.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32I);
             setLightUniforms(volumePass_, f.light);
             volumePass_.set("uViewProj", f.gbuffer.viewProjection());
+            volumePass_.set("uInverseViewProj", glm::inverse(f.gbuffer.viewProjection()));
             volumePass_.set("uCapacity", unsigned(capacity_));
             volumePass_.set("uEye", f.camera.position);
             volumePass_.set("uForward", glm::normalize(f.camera.target - f.camera.position));

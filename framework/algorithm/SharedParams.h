@@ -4,6 +4,8 @@
 #include "framework/core/Params.h"
 #include "framework/render/SceneGpu.h"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace shadowlab {
@@ -22,11 +24,23 @@ template <class T> auto rayOffsetRow(float T::*member) {
     };
 }
 
-/// The ray offset in scene units: `offset` radii of the scene as currently posed (1 for an empty
-/// scene). Every algorithm reads it per frame, so all trace from the same points even as parts move.
-inline float rayOffsetLength(float offset, const SceneGpu& scene) {
-    return offset * (scene.bounds().empty() ? 1.0f : scene.bounds().radius());
+/// The float steps of the scene's largest coordinate that the ray offset never falls below. A
+/// G-buffer point is interpolated from those coordinates and lies off its own triangle's plane by a
+/// few of their steps; an origin moved less than that along the normal can land behind its own
+/// triangle, where the reference's ray and an algorithm's test of the same triangle may round the
+/// other way (far from the origin, where a scene's coordinates are large beside its radius).
+constexpr float kRayOffsetFloatSteps = 64.0f;
+
+/// The ray offset in scene units: `offset` radii of the scene `b` as currently posed (1 for an empty
+/// scene), and at least kRayOffsetFloatSteps float steps of its largest coordinate. Every algorithm
+/// and the reference read it per frame, so all trace from the same points even as parts move.
+inline float rayOffsetLength(float offset, const Bounds& b) {
+    if (b.empty()) return offset;
+    const glm::vec3 largest = glm::max(glm::abs(b.min), glm::abs(b.max));
+    const float magnitude = std::max(largest.x, std::max(largest.y, largest.z));
+    return std::max(offset * b.radius(), kRayOffsetFloatSteps * std::ldexp(magnitude, -23));
 }
+inline float rayOffsetLength(float offset, const SceneGpu& scene) { return rayOffsetLength(offset, scene.bounds()); }
 
 /// `stack_size`: a fixed-size traversal stack, compiled into the shader. Overflow is never silent:
 /// the pixel (or ray) is written shadowed (blocked) and counted in the overflow.

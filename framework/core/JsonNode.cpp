@@ -225,7 +225,9 @@ std::vector<glm::vec3> JsonNode::getPointList(const std::string& key) {
     const Json* v = lookup(key);
     if (!v) return {};
     auto out = readElements<glm::vec3>(*this, key, *v, [](JsonNode& e, const std::string& i) { return e.getPoint(i, glm::vec3(0.0f)); });
-    record(key, *v);
+    Json used = Json::array(); // the floats used, as every other vector records them
+    for (const glm::vec3& p : out) used.push_back({p.x, p.y, p.z});
+    record(key, used);
     return out;
 }
 

@@ -36,6 +36,38 @@ bool isUtcTimestamp(const Json& j) {
 
 } // namespace
 
+namespace {
+/// Every leaf of `j` is a number (or null): else bad input, naming its JSON path.
+void checkNumbersOnly(const Json& j, const std::string& file, const std::string& path) {
+    if (j.is_object() || j.is_array()) {
+        size_t i = 0;
+        for (auto it = j.begin(); it != j.end(); ++it, ++i)
+            checkNumbersOnly(*it, file, path + "/" + (j.is_object() ? shortText(it.key(), 60) : std::to_string(i)));
+    } else if (!j.is_number() && !j.is_null()) {
+        throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a number");
+    }
+}
+
+/// The fields compare and history read have the types a run writes (eighth probe: a time written
+/// as the string "NaN" stopped compare with a library's message and exit 1).
+void checkRunFieldTypes(const Json& s, const std::string& file) {
+    for (const char* key : {"renderer", "name"})
+        if (s.contains(key) && !s[key].is_string()) throw InputError(file, std::string("/") + key, "is not text, as a run writes it");
+    if (s.contains("build")) {
+        const Json& b = s["build"];
+        if (!b.is_object() || (b.contains("commit") && !b["commit"].is_string()) || (b.contains("dirty") && !b["dirty"].is_boolean()))
+            throw InputError(file, "/build", "is not a run's build record ({\"commit\": text, \"dirty\": true or false})");
+    }
+    for (const auto& [id, entry] : s["algorithms"].items()) {
+        const std::string at = "/algorithms/" + shortText(id, 60);
+        if (!entry.is_object()) throw InputError(file, at, "is not an object, as a run writes each algorithm's results");
+        for (const char* key : {"accuracy", "counters", "cpu_time_ms", "time_ms", "memory_bytes", "overflow", "preprocess_ms",
+                                "resident_bytes", "statistics_pass", "total_ms_per_frame", "repetitions"})
+            if (entry.contains(key)) checkNumbersOnly(entry[key], file, at + "/" + key);
+    }
+}
+} // namespace
+
 Json readRunSummary(const std::string& dir) {
     const std::string file = dir + "/summary.json";
     std::error_code ec;
@@ -49,6 +81,7 @@ Json readRunSummary(const std::string& dir) {
     // negative times were tabulated).
     if (s.contains("started_utc") && !isUtcTimestamp(s["started_utc"]))
         throw InputError(shortText(file, 300), "/started_utc", "is not a UTC time as a run writes it (YYYY-MM-DDTHH:MM:SSZ)");
+    checkRunFieldTypes(s, shortText(file, 300));
     for (const auto& [id, entry] : s["algorithms"].items()) {
         const Json passes = entry.is_object() && entry.contains("repetitions") && entry["repetitions"].is_object() &&
                                     entry["repetitions"].contains("time_ms") && entry["repetitions"]["time_ms"].is_object()

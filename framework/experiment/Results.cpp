@@ -211,13 +211,13 @@ Json ExperimentResults::summary() const {
     const bool gpuTimes = meta.value("stage_time_source", std::string("gpu")) == "gpu";
     for (const auto& a : algorithms) {
         std::vector<double> mismatch, falseLit, falseShadowed, rmse;
-        std::vector<size_t> wrongPixels;
+        Json wrongPixels = Json::array(); // one entry per frame: null where nothing was measured
         size_t falseLitPixels = 0, falseShadowedPixels = 0;
         Json firstWrong = nullptr;  // where a failure can be looked at (and the exactness fuzzer shrinks to)
         uint64_t overflow = 0;
         for (const auto& f : a.frames) {
+            wrongPixels.push_back(f.hasAccuracy ? Json(f.accuracy.falseLitPixels + f.accuracy.falseShadowedPixels) : Json());
             if (f.hasAccuracy) {
-                wrongPixels.push_back(f.accuracy.falseLitPixels + f.accuracy.falseShadowedPixels);
                 falseLitPixels += f.accuracy.falseLitPixels;
                 falseShadowedPixels += f.accuracy.falseShadowedPixels;
                 if (firstWrong.is_null() && f.accuracy.firstWrongPixel >= 0) firstWrong = wrongPixelJson(f, imageWidth());

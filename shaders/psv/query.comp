@@ -144,6 +144,9 @@ bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
             }
             PSV_STEP(side, (node - 1u) / PSV_NODES_PER_TRIANGLE)
         }
+        // The node loop leaves only by returning or with a capping node: without one it was ended
+        // from outside (rule 13), and `cap` names no triangle to decide.
+        if (cap == 0u) break;
         uint t = (cap - 1u) / PSV_NODES_PER_TRIANGLE;
         bool clearly;
         if (psvShadows(Q, t, clearly, r)) { r.visibility = 0.0; return true; }
@@ -215,6 +218,9 @@ Result query(Query Q) {
             if (subtree != 0u) break;
 #endif
         }
+        // The node loop leaves with the walk done, a capping node or (hybrid) a subtree to walk
+        // stacklessly; with none of these it was ended from outside (rule 13): capped.
+        if (walking && cap == 0u && subtree == 0u) { r.capped = true; break; }
         if (cap != 0u) {
             uint t = (cap - 1u) / PSV_NODES_PER_TRIANGLE;
             bool clearly;

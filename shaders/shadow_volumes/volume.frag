@@ -47,6 +47,7 @@ uniform vec3 uForward;     // the camera's unit view axis
 uniform float uDepthScale; // (far - near) / (far * near): world depth per unit of window depth, over z^2
 uniform float uPixelAngle; // a pixel's angular size: 2 tan(fov / 2) / height
 uniform float uBorderMargin; // pixels: four steps of the rasteriser's subpixel grid (the host reads it)
+uniform mat4 uInverseViewProj; // a background pixel's view ray (markNeighbours)
 layout(location = 0) out float oCount;
 
 #if SHADOWLAB_INSTRUMENTATION
@@ -112,6 +113,50 @@ int borderSide(vec3 v, float se, out float tPlane, out float tBorder) {
     return svClosestAlong(uEye, b[nearest].a, b[nearest].d, v, tBorder) ? SV_SIDE_BORDER : SV_SIDE_CLOSE;
 }
 
+#if SV_CLOSE_CALLS
+// How far X, where the view ray (unit v) meets this face's plane, lies inside the face's nearest
+// border, in pixels there (0 where it cannot be told: the face edge-on, or behind the eye).
+float borderPixels(vec3 v, float se) {
+    float cosine = dot(vPlane.xyz, v);
+    if (abs(cosine) < 1e-6) return 0.0;
+    float t = -se / cosine;
+    if (!(t > 0.0)) return 0.0;
+    vec3 x = uEye + v * t, n = vPlane.xyz;
+    vec3 ra = lightIsDirectional() ? uLightDirection : vA - uLightPosition;
+    vec3 rb = lightIsDirectional() ? uLightDirection : vB - uLightPosition;
+    float d = vKind == SV_FACE_NEAR_CAP
+                  ? min(min(inside(x, Border(vA, vB - vA), n, vC - vA, v), inside(x, Border(vB, vC - vB), n, vA - vB, v)),
+                        inside(x, Border(vC, vA - vC), n, vB - vC, v))
+                  : min(min(inside(x, Border(vA, vB - vA), n, ra, v), inside(x, Border(vA, ra), n, vB - vA, v)),
+                        inside(x, Border(vB, rb), n, vA - vB, v));
+    return max(d, 0.0) / (t * uPixelAngle);
+}
+
+// The lateral case. A face that passes between a neighbour pixel's test point q and its ray origin
+// x (up to ray_offset apart) while its border keeps it off that pixel's centre gives the neighbour
+// no fragment: neither its count nor its own tests see the face, though the face may put x in a
+// volume that q is not in. So a fragment within 1.5 pixels of its face's border (deeper inside, the
+// face covers the neighbours' centres too, and each tests it itself) tests the face's plane against
+// its 8 neighbours' q and x, and makes each it passes between (or near) a close call. What is left:
+// a face that reaches no pixel centre within a pixel of the point (docs/algorithms/shadow_volumes.md).
+void markNeighbours(ivec2 px) {
+    ivec2 size = textureSize(uPosition, 0);
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 m = px + ivec2(dx, dy);
+            if ((dx == 0 && dy == 0) || any(lessThan(m, ivec2(0))) || any(greaterThanEqual(m, size))) continue;
+            vec4 pm = texelFetch(uPosition, m, 0);
+            if (pm.w < 0.5) continue;
+            // The neighbour's own triangle: resolve.comp tests it (ownTriangleMayHide).
+            if (vTriangle != ~0u && vTriangle + 1u == texelFetch(uTriangleId, m, 0).x) continue;
+            vec3 nm = texelFetch(uNormal, m, 0).xyz;
+            vec3 qm = svTestPoint(pm.xyz, nm, uRayOffset), xm = pm.xyz + nm * uRayOffset;
+            float sq = dot(vPlane.xyz, qm) + vPlane.w, sx = dot(vPlane.xyz, xm) + vPlane.w;
+            if (min(abs(sq), abs(sx)) <= uCloseCall || (sq > 0.0) != (sx > 0.0)) imageStore(uClose, m, uvec4(1u));
+        }
+}
+#endif
+
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
     addWide(SV_C_FRAGMENTS_LO, 1u);
@@ -120,8 +165,18 @@ void main() {
 #if SV_ANALYTIC || SV_CLOSE_CALLS
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 pos = texelFetch(uPosition, px, 0);
-    if (pos.w < 0.5) return; // background: the resolve pass writes 1 whatever the count
     bool farCap = vPlane == kNever;
+    if (pos.w < 0.5) { // background: the resolve pass writes 1 whatever the count
+#if SV_CLOSE_CALLS
+        if (!farCap) {
+            vec2 ndc = 2.0 * gl_FragCoord.xy / vec2(textureSize(uPosition, 0)) - 1.0;
+            vec4 far = uInverseViewProj * vec4(ndc, 1.0, 1.0);
+            vec3 v = normalize(far.xyz / far.w - uEye);
+            if (borderPixels(v, dot(vPlane.xyz, uEye) + vPlane.w) <= 1.5) markNeighbours(px);
+        }
+#endif
+        return;
+    }
     bool own = vTriangle != ~0u && vTriangle + 1u == texelFetch(uTriangleId, px, 0).x;
     vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
     vec3 q = svTestPoint(p, n, uRayOffset);
@@ -132,16 +187,15 @@ void main() {
     if (!farCap && !own) {
         vec3 x = p + n * uRayOffset;
         float tol = uCloseCall;
-#if !SV_ANALYTIC
         vec3 v = normalize(p - uEye);
+#if !SV_ANALYTIC
         float z = dot(p - uEye, uForward);
         tol = max(tol, float(SV_DEPTH_ULPS) * exp2(-24.0) * z * z * uDepthScale / max(dot(v, uForward), 1e-3));
 #endif
         float sp = dot(vPlane.xyz, p) + vPlane.w, sx = dot(vPlane.xyz, x) + vPlane.w;
         // The eye on the plane: the side test can flip.
         close = min(min(abs(sp), abs(sq)), min(abs(sx), abs(se))) <= tol || sign(sp) != sign(sx) || sign(sq) != sign(sx);
-#if SV_ANALYTIC
-        vec3 v = normalize(p - uEye);
+        // The rasteriser's rounding at a face's border, whichever test counts the face.
         float tPlane, tBorder;
         int side = borderSide(v, se, tPlane, tBorder);
         if (side == SV_SIDE_CLOSE) close = true;
@@ -150,10 +204,10 @@ void main() {
             float reach = abs(tPlane - tBorder) + uPixelAngle * max(tq, 0.0) + 2.0 * uCloseCall;
             close = close || abs(tq - tBorder) <= reach;
         }
-#endif
     }
 #if SV_CLOSE_CALLS
     if (close) imageStore(uClose, px, uvec4(1u));
+    if (!farCap && borderPixels(normalize(p - uEye), se) <= 1.5) markNeighbours(px);
 #endif
 #if SV_ANALYTIC
     if (behind != (uCountBehind != 0)) {

@@ -63,6 +63,39 @@ class Pieces(unittest.TestCase):
         self.assertIsNone(ef.exact_midpoint([0.0, 1.0, 0.0], [1.0, ef.f32(1 + 2 ** -23), 0.0]))
 
 
+class SummaryPixels(unittest.TestCase):
+    def test_wrong_pixels_are_listed_per_frame_and_located(self):
+        """Frame 0 has no lit pixel (the light under the plane): its entry is null, so frame 1's
+        wrong pixels stay at index 1 (eighth probe: the list skipped it and the fuzzer cut the
+        wrong keyframe)."""
+        tri = [[-0.5, 0.2, -0.5], [-0.5, 0.2, 0.5], [0.5, 0.2, -0.5]]
+        config = {"name": "pixels", "resolution": [24, 24], "frames": 2, "warmup_frames": 0, "statistics": "none",
+                  "scene": {"objects": [{"procedural": "plane", "size": [4, 4]}, {"procedural": "mesh", "vertices": tri}]},
+                  "camera": {"position": [0, 3, 4], "target": [0, 0, 0]},
+                  "light": {"path": {"keyframes": [{"time": 0, "position": [0.1, -4, 0.1]},
+                                                   {"time": 1, "position": [1, 4, 1]}]}},
+                  "algorithms": [{"id": "sm", "algorithm": "shadow_map", "params": {"bias_constant": 0.1}}],
+                  "output": {"images_at_frames": [], "plots": False}}
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "c.json")
+            with open(path, "w") as f:
+                json.dump(config, f)
+            r = subprocess.run([BINARY, "run", path, "--out", os.path.join(tmp, "out"), "--no-progress"], capture_output=True,
+                               text=True, stdin=subprocess.DEVNULL)
+            self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+            with open(os.path.join(tmp, "out", "summary.json")) as f:
+                acc = json.load(f)["algorithms"]["sm"]["accuracy"]
+        self.assertEqual(acc["frames_measured"], 1)
+        self.assertEqual(len(acc["per_frame_wrong_pixels"]), 2)
+        self.assertIsNone(acc["per_frame_wrong_pixels"][0])
+        self.assertEqual(acc["per_frame_wrong_pixels"][1], acc["false_lit_pixels"] + acc["false_shadowed_pixels"])
+        # A depth bias of 0.28 units detaches the shadow of a triangle 0.2 above the plane: all of it lit.
+        self.assertGreater(acc["false_lit_pixels"], 0)
+        px = acc["first_wrong_pixel"]
+        self.assertEqual(px["frame"], 1)
+        self.assertTrue(0 <= px["x"] < 24 and 0 <= px["y"] < 24)
+
+
 class PlantedFault(unittest.TestCase):
     def test_a_planted_fault_is_found_and_shrunk_to_a_few_triangles(self):
         with tempfile.TemporaryDirectory() as tmp:
