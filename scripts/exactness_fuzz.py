@@ -697,9 +697,9 @@ def print_stats(stats, log=print):
         f"in {stats['seconds']} s: {stats['cases_per_hour']} cases/hour; seeds {stats['first_seed']}..{stats['next_seed'] - 1}; "
         f"{stats['refused']} refused; {len(stats['crashes'])} crashed runs; {stats['relations_checked']} relation checks, "
         f"{len(stats['relations_broken'])} broken")
-    log("failures by id (frames checked):")
+    log("by id: cases failed, frames checked")
     for i, s in sorted(stats["by_id"].items()):
-        log(f"  {i:40s} {s['failures']:4d} of {s['frames']} frames' cases")
+        log(f"  {i:40s} {s['failures']:4d} failed, {s['frames']:6d} frames")
     for f in stats["failures"]:
         log(f"  seed {f['seed']} {f['id']} {f['kind']}" + (f" -> {f['shrunk']} ({f['triangles']} triangles)" if "shrunk" in f else ""))
 

@@ -321,6 +321,14 @@ TEST(ReferenceTracer, OccludedAndTransmission) {
     EXPECT_EQ(tracer.transmission({0.2f, 0.5f, -0.1f}, up, 10.0f), 0.5f); // inside one triangle
     EXPECT_EQ(tracer.transmission(o, up, 0.4f), 1.0f);
     EXPECT_EQ(tracer.transmission(o, -up, 10.0f), 0.0f); // the opaque ground
+    // Hits count on (0, tfar], as in the algorithms' test (common/watertight.glsl): a triangle whose
+    // plane holds the origin (t = 0) does not block (the exactness fuzzer: far from the origin, where
+    // coordinates fall on a coarse grid, an origin on a post's face was shadowed by the reference
+    // alone). Embree takes t >= tnear.
+    const glm::vec3 onPlane(0.2f, 1.0f, -0.1f);
+    EXPECT_FALSE(tracer.occluded(onPlane, up, 10.0f));
+    EXPECT_EQ(tracer.transmission(onPlane, up, 10.0f), 1.0f);
+    EXPECT_TRUE(tracer.occluded({0.2f, std::nextafter(1.0f, 0.0f), -0.1f}, up, 10.0f));
 }
 
 // A scene with a moving part: after moveTriangles + commitMoves the tracer answers for the moved

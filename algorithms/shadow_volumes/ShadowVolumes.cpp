@@ -251,6 +251,7 @@ public:
             volumePass_.set("uBorderMargin", borderMargin());
             volumePass_.set("uRayOffset", offset);
             volumePass_.set("uCloseCall", closeCallLength());
+            volumePass_.set("uCoordinateTolerance", coordinateTolerance(f.camera.position));
             volumePass_.set("uCountSign", zfail ? -1.0f : 1.0f);
             volumePass_.set("uCountBehind", zfail ? 1 : 0);
             volumePass_.set("uPass", 0);
@@ -368,6 +369,15 @@ private:
     float closeCallLength() const {
         const Bounds& b = scene_->bounds();
         return b.empty() ? 2e-6f : 2e-6f * std::max(b.radius(), glm::length(b.center()));
+    }
+
+    /// What the rounding of world coordinates does to a depth projected from them, in world units:
+    /// 32 float steps of the largest coordinate of the scene and the eye (volume.frag, hardware).
+    float coordinateTolerance(glm::vec3 eye) const {
+        const Bounds& b = scene_->bounds();
+        glm::vec3 largest = glm::abs(eye);
+        if (!b.empty()) largest = glm::max(largest, glm::max(glm::abs(b.min), glm::abs(b.max)));
+        return std::ldexp(32.0f * std::max(largest.x, std::max(largest.y, largest.z)), -23);
     }
 
     /// The two-sided count check (volume.frag): analytic ZFAIL, the only mode that draws every face

@@ -80,7 +80,7 @@ RTCRay makeRay(glm::vec3 o, glm::vec3 d, float tfar) {
     RTCRay r{};
     r.org_x = o.x, r.org_y = o.y, r.org_z = o.z;
     r.dir_x = d.x, r.dir_y = d.y, r.dir_z = d.z;
-    r.tnear = 0.0f;
+    r.tnear = std::numeric_limits<float>::min(); // hits count on (0, tfar], as in common/watertight.glsl: Embree takes t >= tnear
     r.tfar = tfar;
     r.time = 0.0f;
     r.mask = 0xFFFFFFFFu; // the geometry's default mask is all ones; a zero ray mask would hit nothing

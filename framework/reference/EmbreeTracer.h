@@ -12,7 +12,7 @@
 //                                                                the metrics ignore such pixels).
 //   * otherwise, for each sample point s of light.samplePoints() (a single point for point and spot
 //     lights; for a directional light one ray along -direction() with tfar = +inf), one occlusion
-//     ray: origin o = p + n * rayOffset, unit direction towards s, tnear = 0,
+//     ray: origin o = p + n * rayOffset, unit direction towards s, hits on (0, tfar] (tnear = FLT_MIN),
 //     tfar = max(0, |s - o| - rayOffset) (stops short of the light by the same offset, so a light
 //     sitting on geometry is not shadowed by it). Visibility = mean over the samples of the
 //     sample's transmission: 1 unoccluded, 0 blocked by an opaque triangle, and for scenes with

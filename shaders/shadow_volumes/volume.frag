@@ -48,6 +48,7 @@ uniform float uDepthScale; // (far - near) / (far * near): world depth per unit 
 uniform float uPixelAngle; // a pixel's angular size: 2 tan(fov / 2) / height
 uniform float uBorderMargin; // pixels: four steps of the rasteriser's subpixel grid (the host reads it)
 uniform mat4 uInverseViewProj; // a background pixel's view ray (markNeighbours)
+uniform float uCoordinateTolerance; // world units: the rounding of the scene's and the eye's coordinates
 layout(location = 0) out float oCount;
 
 #if SHADOWLAB_INSTRUMENTATION
@@ -184,14 +185,19 @@ void main() {
     float se = dot(vPlane.xyz, uEye) + vPlane.w;
     bool behind = farCap || own || (se > 0.0) == (sq > 0.0);
     bool close = false;
+    float tol = uCloseCall;
+    vec3 v = normalize(p - uEye);
+#if !SV_ANALYTIC
+    // The depth test compares depths projected from world coordinates: besides the depth buffer's
+    // own steps, the rounding of those coordinates (far from the origin, many depth steps).
+    float z = dot(p - uEye, uForward);
+    tol = max(max(tol, uCoordinateTolerance), float(SV_DEPTH_ULPS) * exp2(-24.0) * z * z * uDepthScale / max(dot(v, uForward), 1e-3));
+    // The own triangle counts as in front of q by the depth pass's nudge; where q lies within the
+    // tolerance of its plane that too is the depth test's coin, so the ray decides.
+    if (own && !farCap && abs(sq) <= tol) close = true;
+#endif
     if (!farCap && !own) {
         vec3 x = p + n * uRayOffset;
-        float tol = uCloseCall;
-        vec3 v = normalize(p - uEye);
-#if !SV_ANALYTIC
-        float z = dot(p - uEye, uForward);
-        tol = max(tol, float(SV_DEPTH_ULPS) * exp2(-24.0) * z * z * uDepthScale / max(dot(v, uForward), 1e-3));
-#endif
         float sp = dot(vPlane.xyz, p) + vPlane.w, sx = dot(vPlane.xyz, x) + vPlane.w;
         // The eye on the plane: the side test can flip.
         close = min(min(abs(sp), abs(sq)), min(abs(sx), abs(se))) <= tol || sign(sp) != sign(sx) || sign(sq) != sign(sx);
