@@ -371,13 +371,14 @@ private:
         return b.empty() ? 2e-6f : 2e-6f * std::max(b.radius(), glm::length(b.center()));
     }
 
-    /// What the rounding of world coordinates does to a depth projected from them, in world units:
-    /// 32 float steps of the largest coordinate of the scene and the eye (volume.frag, hardware).
+    /// The rounding of world coordinates that a depth projected from them carries, in world units:
+    /// 16 float steps of the largest coordinate of the scene and the eye (volume.frag, hardware,
+    /// magnifies it by the projection's z / near).
     float coordinateTolerance(glm::vec3 eye) const {
         const Bounds& b = scene_->bounds();
         glm::vec3 largest = glm::abs(eye);
         if (!b.empty()) largest = glm::max(largest, glm::max(glm::abs(b.min), glm::abs(b.max)));
-        return std::ldexp(32.0f * std::max(largest.x, std::max(largest.y, largest.z)), -23);
+        return std::ldexp(16.0f * std::max(largest.x, std::max(largest.y, largest.z)), -23);
     }
 
     /// The two-sided count check (volume.frag): analytic ZFAIL, the only mode that draws every face

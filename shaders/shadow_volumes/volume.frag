@@ -48,7 +48,7 @@ uniform float uDepthScale; // (far - near) / (far * near): world depth per unit 
 uniform float uPixelAngle; // a pixel's angular size: 2 tan(fov / 2) / height
 uniform float uBorderMargin; // pixels: four steps of the rasteriser's subpixel grid (the host reads it)
 uniform mat4 uInverseViewProj; // a background pixel's view ray (markNeighbours)
-uniform float uCoordinateTolerance; // world units: the rounding of the scene's and the eye's coordinates
+uniform float uCoordinateTolerance; // world units: 16 float steps of the scene's and the eye's largest coordinate
 layout(location = 0) out float oCount;
 
 #if SHADOWLAB_INSTRUMENTATION
@@ -189,9 +189,12 @@ void main() {
     vec3 v = normalize(p - uEye);
 #if !SV_ANALYTIC
     // The depth test compares depths projected from world coordinates: besides the depth buffer's
-    // own steps, the rounding of those coordinates (far from the origin, many depth steps).
+    // own steps, the rounding of those coordinates, which the projection magnifies by z / near
+    // along the view (far from the origin, many depth steps).
     float z = dot(p - uEye, uForward);
-    tol = max(max(tol, uCoordinateTolerance), float(SV_DEPTH_ULPS) * exp2(-24.0) * z * z * uDepthScale / max(dot(v, uForward), 1e-3));
+    float slant = max(dot(v, uForward), 1e-3);
+    tol = max(max(tol, uCoordinateTolerance * max(1.0, z * uDepthScale) / slant),
+              float(SV_DEPTH_ULPS) * exp2(-24.0) * z * z * uDepthScale / slant);
     // The own triangle counts as in front of q by the depth pass's nudge; where q lies within the
     // tolerance of its plane that too is the depth test's coin, so the ray decides.
     if (own && !farCap && abs(sq) <= tol) close = true;
