@@ -195,9 +195,6 @@ void main() {
     float slant = max(dot(v, uForward), 1e-3);
     tol = max(max(tol, uCoordinateTolerance * max(1.0, z * uDepthScale) / slant),
               float(SV_DEPTH_ULPS) * exp2(-24.0) * z * z * uDepthScale / slant);
-    // The own triangle counts as in front of q by the depth pass's nudge; where q lies within the
-    // tolerance of its plane that too is the depth test's coin, so the ray decides.
-    if (own && !farCap && abs(sq) <= tol) close = true;
 #endif
     if (!farCap && !own) {
         vec3 x = p + n * uRayOffset;
