@@ -269,6 +269,15 @@ TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
         {[](Json& s) { s["algorithms"]["psv"] = 7; }, "/algorithms/psv"},
         {[](Json& s) { s["renderer"] = 3; }, "/renderer"},
         {[](Json& s) { s["build"] = {{"commit", 5}}; }, "/build"},
+        // Ninth probe: counts that no run counts were read as 0 or wrapped to 2^64 - 1.
+        {[](Json& s) { s["algorithms"]["psv"]["overflow"] = 1e30; }, "/algorithms/psv/overflow"},
+        {[](Json& s) { s["algorithms"]["psv"]["overflow"] = -1; }, "/algorithms/psv/overflow"},
+        {[](Json& s) { s["algorithms"]["psv"]["overflow"] = 0.5; }, "/algorithms/psv/overflow"},
+        {[](Json& s) { s["algorithms"]["psv"]["memory_bytes"] = -100; }, "/algorithms/psv/memory_bytes"},
+        {[](Json& s) { s["algorithms"]["psv"]["accuracy"] = Json::array(); }, "/algorithms/psv/accuracy"},
+        {[](Json& s) { s["algorithms"]["psv"]["accuracy"]["mismatch_ratio_max"] = -1; }, "/algorithms/psv/accuracy/mismatch_ratio_max"},
+        {[](Json& s) { s["algorithms"]["psv"]["accuracy"]["per_frame_mismatch"] = Json::array({0.5, 2}); },
+         "/algorithms/psv/accuracy/per_frame_mismatch/1"},
     };
     for (const auto& [change, path] : edits) {
         SCOPED_TRACE(path);

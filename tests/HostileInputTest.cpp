@@ -37,6 +37,13 @@ std::vector<BadCase> badCases() {
         {"ConfigNestedTwentyThousandDeep", "c.json", configWith({{"name", deep}}), {"/name/", "nesting deeper than 64"}},
         {"LightBeyondFloat", "c.json", configWith({{"light", R"({"position": [1e39, 4, 2]})"}}), {"/light/position", "float"}},
         {"LightAt1e30", "c.json", configWith({{"light", R"({"position": [1e30, 4, 2]})"}}), {"/light/position", "1e15"}},
+        // Ninth probe: a 0.001-unit triangle of a moving mesh lost its area where its path took it
+        // (x = 1e5, frame 1), and the run went on without it; placed there statically it is refused.
+        {"MovingTriangleCollapses", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "plane", "size": [4, 4]},
+             {"procedural": "mesh", "vertices": [[-5, 1, -5], [5, 1, -5], [0, 1, 5], [0, 0.5, 0], [0.001, 0.5, 0], [0, 0.5, 0.001]],
+              "path": {"interpolation": "step", "keyframes": [{"time": 0, "translate": [0, 0, 0]}, {"time": 1, "translate": [100000, 0, 0]}]}}]})"}}),
+         {"/scene/objects/1/path", "triangle 1", "no area", "frame 1"}},
         {"DegenerateLightPath", "c.json",
          configWith({{"light", R"({"type": "directional", "path": {"keyframes": [
              {"time": 0, "position": [0, 5, 0], "target": [0, 0, 0]},

@@ -382,7 +382,11 @@ TEST(SceneConfigTest, MeshRefusesWhatItWouldHaveToChange) {
         // One large triangle beside a small one that float rounding changes by half its size: each
         // triangle is held to the 1 % rule (eighth probe).
         {R"({"objects": [{"procedural": "mesh", "vertices": [[-2e6, 0.5, -1], [0, 0.5, 2e6], [2e6, 0.5, -1],
-            [1000000, 1, 0], [1000000, 1, 0.04], [1000000.04, 1, 0]]}]})", {"/scene/objects/0/vertices/3", "triangle 1", "distorted"}},
+            [1000000, 1, 0], [1000000, 1, 0.04], [1000000.04, 1, 0]]}]})", {"/scene/objects/0/vertices/3", "triangle 1"}},
+        // A sliver 0.004 wide and 4 long at x = 1e5, where a float's spacing is 0.0078: its length
+        // keeps 1 %, its width doubles (ninth probe).
+        {R"({"objects": [{"procedural": "mesh", "vertices": [[1e5, 1, -2], [100000.004, 1, 2], [100000.004, 1, -2]]}]})",
+         {"/scene/objects/0/vertices/0", "triangle 0", "change its shape"}},
     };
     for (const auto& [text, fragments] : cases) {
         std::string msg = inputErrorOf([&] { build(text); });

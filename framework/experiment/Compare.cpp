@@ -48,6 +48,36 @@ void checkNumbersOnly(const Json& j, const std::string& file, const std::string&
     }
 }
 
+/// A count: an integer, 0 or more (1e30, -1 and 0.5 are no run's).
+void checkCount(const Json& j, const std::string& file, const std::string& path) {
+    if (!j.is_number_unsigned() && !(j.is_number_integer() && j.get<int64_t>() >= 0))
+        throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a count (an integer, 0 or more)");
+}
+
+/// accuracy: null, or an object of shares in [0, 1] and counts.
+void checkAccuracy(const Json& a, const std::string& file, const std::string& path) {
+    if (a.is_null()) return;
+    if (!a.is_object()) throw InputError(file, path, "is neither null nor an object, as a run writes it");
+    for (const char* key : {"mismatch_ratio", "mismatch_ratio_max", "false_lit", "false_shadowed", "rmse"})
+        if (a.contains(key) && !(a[key].is_number() && a[key].get<double>() >= 0 && a[key].get<double>() <= 1))
+            throw InputError(file, path + "/" + key, "holds " + shortText(a[key].dump(), 40) + " where a run writes a share in [0, 1]");
+    for (const char* key : {"frames_measured", "false_lit_pixels", "false_shadowed_pixels"})
+        if (a.contains(key)) checkCount(a[key], file, path + "/" + key);
+    for (const char* key : {"per_frame_mismatch", "per_frame_wrong_pixels"}) {
+        if (!a.contains(key)) continue;
+        if (!a[key].is_array()) throw InputError(file, path + "/" + key, "is not a list, as a run writes it");
+        for (size_t i = 0; i < a[key].size(); ++i) {
+            const Json& v = a[key][i];
+            const std::string where = path + "/" + key + "/" + std::to_string(i);
+            if (std::string(key) == "per_frame_wrong_pixels") {
+                if (!v.is_null()) checkCount(v, file, where);
+            } else if (!(v.is_number() && v.get<double>() >= 0 && v.get<double>() <= 1)) {
+                throw InputError(file, where, "holds " + shortText(v.dump(), 40) + " where a run writes a share in [0, 1]");
+            }
+        }
+    }
+}
+
 /// The fields compare and history read have the types a run writes (eighth probe: a time written
 /// as the string "NaN" stopped compare with a library's message and exit 1).
 void checkRunFieldTypes(const Json& s, const std::string& file) {
@@ -64,6 +94,10 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
         for (const char* key : {"accuracy", "counters", "cpu_time_ms", "time_ms", "memory_bytes", "overflow", "preprocess_ms",
                                 "resident_bytes", "statistics_pass", "total_ms_per_frame", "repetitions"})
             if (entry.contains(key)) checkNumbersOnly(entry[key], file, at + "/" + key);
+        // Counts are what a run counts (ninth probe: an overflow of 1e30 read as 0, -1 as 2^64 - 1).
+        for (const char* key : {"overflow", "memory_bytes", "resident_bytes"})
+            if (entry.contains(key)) checkCount(entry[key], file, at + "/" + key);
+        if (entry.contains("accuracy")) checkAccuracy(entry["accuracy"], file, at + "/accuracy");
     }
 }
 } // namespace

@@ -3,6 +3,7 @@
 #include "framework/core/Text.h"
 #include "framework/scene/Scene.h"
 #include "framework/scene/SceneConfig.h"
+#include "framework/scene/TriangleNormal.h"
 
 #include <algorithm>
 #include <cctype>
@@ -140,6 +141,24 @@ void checkPoseBounds(const ExperimentConfig& c, int frame, const Bounds& b) {
                                                frameText(c, frame) + " (check the paths' translate and scale)");
 }
 
+/// A moving part's triangles posed by `m` keep an area: a triangle that float rounding collapses
+/// there is an error, as it is where a static object is placed (ninth probe: a 0.001-unit triangle
+/// moved to x = 1e5 lost its area at that frame and the run went on without it).
+static void checkPosedTriangles(const MovingPart& part, const glm::mat4& m, const std::string& file, const std::string& path,
+                                const ExperimentConfig& c, int frame) {
+    for (size_t i = 0; i < part.triangleCount; ++i) {
+        glm::vec3 v[3], n;
+        poseTriangle(m, &part.local[3 * i], v, n);
+        if (!unitNormal(v[0], v[1], v[2], n)) {
+            Bounds b;
+            for (const glm::vec3& p : v) b.extend(p);
+            throw InputError(file, path, "triangle " + std::to_string(i) + " of the moving object has no area in float at " +
+                                             frameText(c, frame) + " (" + floatPrecisionAt(b) +
+                                             "): keep its path nearer the origin or make the object larger");
+        }
+    }
+}
+
 /// Every frame's pose, before anything is rendered: a pose that is not finite, or a part that leaves
 /// the coordinate range, is an error naming where its motion was given (the config's path, or the
 /// glTF file's node or animation channel) and the frame, instead of a part that silently vanishes.
@@ -148,6 +167,10 @@ static void checkPoses(const ExperimentConfig& c) {
     // frames spread over it here, and the runner checks each frame's pose again as it goes.
     const int step = std::max(1, c.frames / 10000);
     const Scene& scene = *c.scene;
+    // Each moving triangle posed at every frame visited, while that stays under 2e7 triangle poses
+    // (a second or two); beyond, the bounds above are still checked at every frame visited.
+    const double visits = double(c.frames / step + 1) * double(scene.movingTriangleCount());
+    const bool checkTriangles = visits <= 2e7;
     for (int f = 0;; f = std::min(f + step, c.frames - 1)) {
         std::vector<glm::mat4> pose;
         try {
@@ -173,6 +196,7 @@ static void checkPoses(const ExperimentConfig& c) {
             if (const std::string why = floatDistortion(b); !why.empty())
                 throw InputError(file, path, "the moving object, " + why + ", at " + frameText(c, f) +
                                                  ": keep its path nearer the origin or make the object larger");
+            if (checkTriangles) checkPosedTriangles(part, pose[p], file, path, c, f);
         }
         checkPoseBounds(c, f, scene.boundsAt(pose));
         if (f == c.frames - 1) break;

@@ -52,6 +52,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <array>
@@ -189,6 +190,39 @@ void overrideMaterials(Scene& s, const Material& m) {
 
 Builder parseObject(JsonNode node, int depth, int budget);
 
+/// A triangle's longest edge and its height over it, in double.
+std::pair<double, double> edgeAndHeight(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+    const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    return {longest, longest > 0.0 ? glm::length(glm::cross(b - a, c - a)) / longest : 0.0};
+}
+
+/// The floats a mesh's written coordinates become must keep each triangle's shape: its longest
+/// edge and its height over it within 1 % of the written ones (ninth probe: a sliver 0.004 wide
+/// written at x = 1e5 became 0.0078 wide, within the 1 % of its 4-unit length). Coordinates
+/// written as floats (as the exactness fuzzer writes them) change nothing.
+void checkWrittenShapes(JsonNode& node, const std::vector<glm::vec3>& vertices, const std::vector<glm::ivec3>& triangles, bool indexed) {
+    const Json& raw = node.raw().at("vertices");
+    auto written = [&](int v) {
+        const Json& p = raw[size_t(v)];
+        return glm::dvec3(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+    };
+    for (size_t t = 0; t < triangles.size(); ++t) {
+        const glm::ivec3 i = triangles[t];
+        const auto [edge, height] = edgeAndHeight(written(i.x), written(i.y), written(i.z));
+        const auto [edgeF, heightF] = edgeAndHeight(glm::dvec3(vertices[size_t(i.x)]), glm::dvec3(vertices[size_t(i.y)]),
+                                                    glm::dvec3(vertices[size_t(i.z)]));
+        const double change = std::max(std::abs(edgeF - edge) / edge, std::abs(heightF - height) / height);
+        if (!(change <= 0.01)) {
+            char text[200];
+            std::snprintf(text, sizeof text,
+                          "triangle %zu: its coordinates as floats change its shape by %.3g %% (at most 1 %%; its height %.3g becomes %.3g): "
+                          "move it nearer the origin or make it larger",
+                          t, 100.0 * change, height, heightF);
+            node.fail(indexed ? "indices/" + std::to_string(t) : "vertices/" + std::to_string(3 * t), text);
+        }
+    }
+}
+
 /// A mesh's triangles, as written (the exactness fuzzer's scenes and the cases it shrinks,
 /// docs/exactness_fuzzing.md): vertices and optional index triples. A triangle without area at
 /// float precision is refused, never dropped: a run does not succeed on a scene it changed.
@@ -217,6 +251,7 @@ Builder parseMesh(JsonNode& node, const Material& m, int budget) {
             node.fail(indexed ? "indices/" + std::to_string(t) : "vertices/" + std::to_string(3 * t),
                       "triangle " + std::to_string(t) + " has no area at float precision (its vertices are collinear or repeated)");
     }
+    checkWrittenShapes(node, vertices, triangles, indexed);
     const size_t count = triangles.size();
     return Builder{[=] { return makeMesh(vertices, triangles, m); }, [=] { return count; }};
 }

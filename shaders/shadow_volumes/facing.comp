@@ -4,8 +4,10 @@
 // of them: docs/architecture.md, rule 4). +1: the triangle faces the light and bounds its volume as
 // wound; -1: it faces away and bounds it flipped (every triangle casts, open meshes and soups
 // included); 0: no volume (SV_LIGHT_FACING_ONLY, the classic closed-mesh setting, for triangles
-// facing away). A triangle whose plane holds the light counts as facing it: its volume is flat
-// and its faces cancel, whichever way it is wound, as long as everyone reads the same sign.
+// facing away). A triangle whose plane holds the light (side exactly 0) has a flat volume, which
+// holds no point off that plane: it gets none (0). Its faces do not cancel when the light lies
+// inside the triangle (ninth probe: the faces around it, all in its plane, left 198 pixels behind
+// it counted as shadowed).
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "shadow_volumes/layout.glsl"
@@ -21,8 +23,8 @@ void main() {
     vec3 n = cross(b - a, c - a);
     float side = lightIsDirectional() ? -dot(n, uLightDirection) : dot(n, uLightPosition - a);
 #if SV_LIGHT_FACING_ONLY
-    facing[t] = side >= 0.0 ? 1 : 0;
+    facing[t] = side > 0.0 ? 1 : 0;
 #else
-    facing[t] = side >= 0.0 ? 1 : -1;
+    facing[t] = side > 0.0 ? 1 : (side < 0.0 ? -1 : 0);
 #endif
 }
