@@ -704,6 +704,28 @@ def print_stats(stats, log=print):
         log(f"  seed {f['seed']} {f['id']} {f['kind']}" + (f" -> {f['shrunk']} ({f['triangles']} triangles)" if "shrunk" in f else ""))
 
 
+MARK = ".exactness_fuzz"  # names a folder this script made, which a later run may write into again
+
+
+def check_run_args(args, sl):
+    """Why `run`'s arguments cannot be taken (None when they can): values out of range, unknown
+    algorithms, and an --out that is a file or a folder of someone else's (not empty, no mark)."""
+    if not args.seconds > 0:
+        return f"--seconds must be greater than 0, got {args.seconds}"
+    if args.cases < 0 or args.relations < 0 or args.shrinks_per_id < 0:
+        return "--cases, --relations and --shrinks-per-id must be 0 or more"
+    known = set(sl.exact()) | set(ONE_SIDED)
+    unknown = [a for a in args.only if a not in known]
+    if unknown:
+        return f"--only: not an exact algorithm: {unknown[0][:60]!r} (exact: {', '.join(sorted(known))})"
+    if os.path.lexists(args.out):
+        if not os.path.isdir(args.out) or os.path.islink(args.out):
+            return f"--out {args.out[:200]!r} is not a folder"
+        if os.listdir(args.out) and not os.path.exists(os.path.join(args.out, MARK)):
+            return f"--out {args.out[:200]!r} is a folder this script did not make and not empty: choose another"
+    return None
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--binary", default=os.environ.get("SHADOWLAB", DEFAULT_BINARY))
@@ -734,10 +756,18 @@ def main():
             return 0
         if args.command == "replay":
             return 1 if replay(sl, args.cases) else 0
+        problem = check_run_args(args, sl)
+        if problem:
+            print(f"exactness_fuzz.py: error: {problem}", file=sys.stderr)
+            return 2
         os.makedirs(args.out, exist_ok=True)
+        with open(os.path.join(args.out, MARK), "w") as f:
+            f.write("exactness_fuzz.py output\n")
         stats = campaign(args, sl)
-        with open(os.path.join(args.out, "report.json"), "w") as f:
+        tmp = os.path.join(args.out, "report.json.tmp")
+        with open(tmp, "w") as f:
             json.dump(stats, f, indent=1)
+        os.replace(tmp, os.path.join(args.out, "report.json"))
         print_stats(stats)
         if args.expect_failure:
             shrunk = [f for f in stats["failures"] if "shrunk" in f]

@@ -47,13 +47,14 @@ TEST_F(ExpectationsGLTest, APlantedWrongPixelFailsTheExactExpectation) {
 
 TEST_F(ExpectationsGLTest, APlantedSlowdownFailsARelativeTimeBound) {
     // The bound is set from a clean run of this machine: psv's total time over bvh_raytrace's,
-    // times 2.5 for the noise of a shared machine between runs a few seconds apart. The fault does
-    // psv's traverse stage 30 times more; its total grows far past that.
+    // times 5 for the noise of a shared machine between runs a few seconds apart (2.5 was passed
+    // by 2.96x with two more jobs beside a ctest -j2 on 2 cores). The fault does psv's traverse
+    // stage 30 times more; its total grows far past that.
     const Json probe = Json::parse(R"([{"id": "psv", "measure": "time_ms.total.median", "relative_to": "bvh_raytrace", "max": 1e9}])");
     const double ratio = records(plantedConfig(probe))[0]["value"].get<double>();
     ASSERT_GT(ratio, 0.0);
     Json bound = probe;
-    bound[0]["max"] = 2.5 * ratio;
+    bound[0]["max"] = 5.0 * ratio;
     Json slow;
     {
         test::ScopedShaderFaults fault(ShaderDefines{{"SHADOWLAB_FAULT_SLOW_TRAVERSE", "30"}});

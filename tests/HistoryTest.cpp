@@ -316,6 +316,21 @@ TEST(HistoryTest, NeitherHistoryNorCompareReplacesARunItReads) {
     }
     EXPECT_FALSE(fs::exists(a + "/cmp"));
     EXPECT_FALSE(fs::exists(dir + "/h"));
+    // Tenth probe: a run folder neither reads, given as --out with --force, was deleted and replaced
+    // by the report. Only an earlier report of the same command is replaced.
+    const std::string other = test::makeTempDir("history-other-run") + "/run";
+    fs::copy(a, other, fs::copy_options::recursive);
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"compare", a, b, "--out", other, "--force"}, {"history", dir, "--out", other, "--force"}}) {
+        std::vector<std::string> argv{SHADOWLAB_BINARY};
+        argv.insert(argv.end(), args.begin(), args.end());
+        const test::Ran ran = test::runArgs(argv);
+        EXPECT_EQ(ran.rc, 2) << ::testing::PrintToString(args) << ": " << ran.err;
+        EXPECT_NE(ran.err.find("another command's output"), std::string::npos) << ran.err;
+        EXPECT_TRUE(fs::is_regular_file(other + "/summary.json"));
+    }
+    const std::string report = test::makeTempDir("history-report") + "/cmp";
+    for (int i = 0; i < 2; ++i) EXPECT_EQ(test::runArgs({SHADOWLAB_BINARY, "compare", a, b, "--out", report, "--force"}).rc, 0);
 }
 
 } // namespace

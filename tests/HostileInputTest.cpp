@@ -39,6 +39,13 @@ std::vector<BadCase> badCases() {
         {"LightAt1e30", "c.json", configWith({{"light", R"({"position": [1e30, 4, 2]})"}}), {"/light/position", "1e15"}},
         // Ninth probe: a 0.001-unit triangle of a moving mesh lost its area where its path took it
         // (x = 1e5, frame 1), and the run went on without it; placed there statically it is refused.
+        // Tenth probe: exact algorithms drew opaque shadows under a caster of opacity 0, which the
+        // reference lets light through: 42 wrong pixels each, none counted.
+        {"TranslucentCasterForAnOpaqueExactAlgorithm", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "plane", "size": [4, 4]},
+             {"procedural": "mesh", "vertices": [[-0.5, 1, -0.5], [-0.5, 1, 0.5], [0.5, 1, -0.5]], "material": {"opacity": 0}}]})"},
+                     {"algorithms", R"([{"algorithm": "psv", "params": {"transparency": true, "traversal": "stack"}}, {"algorithm": "ptsv"}])"}}),
+         {"/algorithms/1", "ptsv draws opaque shadows", "opacity to 1"}},
         {"MovingTriangleCollapses", "c.json",
          configWith({{"scene", R"({"objects": [{"procedural": "plane", "size": [4, 4]},
              {"procedural": "mesh", "vertices": [[-5, 1, -5], [5, 1, -5], [0, 1, 5], [0, 0.5, 0], [0.001, 0.5, 0], [0, 0.5, 0.001]],

@@ -177,7 +177,9 @@ TEST(SweepInputTest, HugeNamesAndLabelsAreRefusedWithoutEchoingThem) {
 // formulas to a spreadsheet. A given label is refused; one made of a value becomes its JSON text.
 TEST(SweepInputTest, LabelsASpreadsheetWouldRunAreRefusedOrQuoted) {
     const std::string dir = test::makeTempDir("sweep-formula");
-    for (const char* label : {"=HYPERLINK(\"http://x\")", "@SUM(1)", "+1+2", "-x"}) {
+    // The last five read as numbers to strtod, as text or names to a spreadsheet (tenth probe).
+    for (const char* label : {"=HYPERLINK(\"http://x\")", "@SUM(1)", "+1+2", "-x", "-nan(HYPERLINK)", "+INF", "-infinity",
+                              "+0x1p3", "-1e"}) {
         Json given = test::smallSweep();
         given["axes"][1]["labels"] = {label, "b"};
         const Ran r = runArgs(sweep({"plan", test::writeJson(dir + "/given.sweep.json", given)}));
@@ -187,7 +189,7 @@ TEST(SweepInputTest, LabelsASpreadsheetWouldRunAreRefusedOrQuoted) {
         expectOneShortLine(r);
     }
     Json numbers = test::smallSweep();
-    numbers["axes"][1]["labels"] = {"-0.5", "+2"};
+    numbers["axes"][1]["labels"] = {"-0.5", "+2e-3"};
     EXPECT_EQ(runArgs(sweep({"plan", test::writeJson(dir + "/numbers.sweep.json", numbers)})).rc, 0);
     Json derived = test::smallSweep();
     derived["axes"] = Json::array({{{"name", "n"}, {"values", {{"name", {"=1+1", "plain"}}}}}});

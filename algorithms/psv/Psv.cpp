@@ -293,6 +293,7 @@ AlgorithmInfo psvInfo() {
                                     "partitioned shadow volumes: per-frame TOP tree of shadow frusta (compute), per-pixel stack, stackless or hybrid query",
                                     {LightType::Point, LightType::Spot, LightType::Directional}, true, &psvSchema);
     info.footprint = &psvFootprint;
+    info.takesOpacity = [](const ParamValues& params) { return std::get<bool>(params.get("transparency")); };
     return info;
 }
 

@@ -142,6 +142,7 @@ AlgorithmInfo referenceInfo() {
         {LightType::Point, LightType::Spot, LightType::Directional, LightType::Area}, true, &referenceSchema);
     info.motion = MotionHandling::Refit;
     info.footprint = &referenceFootprint;
+    info.takesOpacity = [](const ParamValues&) { return true; }; // the definition of a translucent shadow
     return info;
 }
 

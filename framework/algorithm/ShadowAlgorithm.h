@@ -151,6 +151,10 @@ struct AlgorithmInfo {
     /// setScene() would throw as SceneRefusal). nullptr: the footprint decides everything. Run by
     /// `validate`, so that what it accepts, run runs.
     std::string (*sceneCheck)(const Scene& scene, const ParamValues& params) = nullptr;
+    /// Whether it honours material opacity below 1 (translucent casters) with these parameters;
+    /// nullptr: never (its shadows are opaque). An exact algorithm that does not is refused a scene
+    /// with translucent triangles, whose reference shadows it could not match.
+    bool (*takesOpacity)(const ParamValues& params) = nullptr;
 
     bool supports(LightType t) const;
     /// "" when the algorithm can run on a scene that moves with these parameter values, else why not.

@@ -22,7 +22,8 @@ const char* kCompareUsage = R"(  shadowlab compare BASE NEW [--threshold PCT] [-
       (ratio, 95 % interval, faster / slower / within noise), accuracy, overflow, memory, counters
       and the saved images' changed pixels. A regression: total time slower past PCT (default 10) %
       with its whole interval above 1, accuracy worse past PCT %, or more overflow. Markdown on
-      standard output, or with --out: DIR/compare.md, compare.html, compare.junit.xml and images/.
+      standard output, or with --out: DIR/compare.md, compare.html, compare.junit.xml and images/
+      (--force replaces an earlier compare output there, never a run's or another command's).
       --relative-to ID divides every time by ID's total of the same pass first ("*": by the
       median over the ids of each one's total over its median in BASE): on a shared machine
       whose load changed between the runs, only what changed relative to it remains.
@@ -38,7 +39,8 @@ const char* kHistoryUsage = R"(  shadowlab history DIR [--threshold PCT] [--rela
       single run after it: with its whole interval; with fewer than 4 runs: compare's rule on the
       pooled passes); --relative-to as compare's.
       Markdown on standard output, or with --out: OUT/history.md, history.html, history.json,
-      history.junit.xml and the plots history_time.png, history_accuracy.png.
+      history.junit.xml and the plots history_time.png, history_accuracy.png (--force replaces an
+      earlier history output there, never a run's or another command's).
       Exit code 0, or 3 when the newest run starts a step for the worse (slower, less accurate).
 )";
 
@@ -133,6 +135,7 @@ int compareCommand(const std::vector<std::string>& args) {
         return c.regressions ? kRegressionExit : 0;
     }
     OutputPlace::refuseInputsInside(out, runs, "compare"); // --force would delete a run it compares
+    OutputPlace::refuseOtherKind(out, "compare.md", "compare");
     installInterruptHandlers();
     OutputPlace place = OutputPlace::open(out, force);
     const std::string dir = place.partialDir();
@@ -219,6 +222,7 @@ int historyCommand(const std::vector<std::string>& args) {
     }
     const History h = readHistory(dir, opt); // before the output folder: bad input leaves nothing behind
     OutputPlace::refuseInputsInside(out, {dir}, "history"); // --force would delete runs it reads
+    OutputPlace::refuseOtherKind(out, "history.md", "history");
     installInterruptHandlers();
     OutputPlace place = OutputPlace::open(out, force);
     const std::string outDir = place.partialDir();

@@ -145,7 +145,23 @@ InputError sceneRefusalError(const ExperimentConfig& cfg, const AlgorithmEntry& 
                                                           " triangles) with these parameters on this device: " + why);
 }
 
+/// The first material below full opacity that a triangle uses, or -1.
+long translucentMaterial(const Scene& s) {
+    for (uint32_t id : s.materialIds)
+        if (id < s.materials.size() && s.materials[id].opacity < 1.0f) return long(id);
+    return -1;
+}
+
 void checkAlgorithmsTakeScene(const ExperimentConfig& cfg) {
+    // Tenth probe: every exact algorithm but psv with transparency drew opaque shadows under
+    // translucent casters, which the reference lets light through: wrong pixels, none counted.
+    if (translucentMaterial(*cfg.scene) >= 0)
+        for (const AlgorithmEntry* e : planEntries(cfg))
+            if (e->info->exact && !(e->info->takesOpacity && e->info->takesOpacity(e->params)))
+                throw InputError(cfg.file, entryPath(cfg, *e),
+                                 e->info->name + " draws opaque shadows, but the scene has translucent triangles (opacity below 1), "
+                                                 "which the reference lets light through: set their opacity to 1 or leave " + e->id +
+                                                 " out" + (e->info->name == "psv" ? " (or give it \"transparency\": true)" : ""));
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         if (!e->info->sceneCheck) continue;
         const std::string why = e->info->sceneCheck(*cfg.scene, e->params);

@@ -396,6 +396,15 @@ void OutputPlace::checkReplaceable(const std::string& given) {
                                   " mark, nor a summary.json of a run); --force replaces only outputs");
 }
 
+void OutputPlace::refuseOtherKind(const std::string& given, const std::string& ownFile, const std::string& command) {
+    const fs::path dir(normalize(given));
+    std::error_code ec;
+    if (!fs::is_directory(fs::symlink_status(dir, ec)) || !isShadowlabOutput(dir) || isRegularFile(dir / ownFile)) return;
+    throw InputError(shortPath(dir.string()), "",
+                     "is another command's output (" + std::string(isRegularFile(dir / "summary.json") ? "a run's: it holds summary.json" : "not " + command + "'s") +
+                         "); --force replaces only an earlier " + command + " output: choose another --out");
+}
+
 void OutputPlace::check(const std::string& given, const std::string& runConfig) {
     const std::string dir = normalize(given);
     checkPlace(dir, runConfig, "results/run1");

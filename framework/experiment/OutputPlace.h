@@ -43,6 +43,10 @@ public:
     /// a sweep, not a shadowlab output, or holding another output or a run in progress. `validate`
     /// checks a config's output.dir with it, so that what it accepts a run can write.
     static void checkReplaceable(const std::string& dir);
+    /// For a command that writes `ownFile` (compare: compare.md; history: history.md): an existing
+    /// `dir` that holds another command's output (a run's, another report's) is not its to replace,
+    /// with or without --force (tenth probe: `compare A B --out RUN --force` deleted a run).
+    static void refuseOtherKind(const std::string& dir, const std::string& ownFile, const std::string& command);
     /// InputError when `dir`, once replaced with everything in it, would take an input with it: a
     /// file or folder the command reads that lies inside `dir`, is `dir`, or holds it (a command's
     /// output inside its input folder would land among the runs it reads). `what`: "this run",

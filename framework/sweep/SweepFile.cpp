@@ -18,13 +18,36 @@ namespace shadowlab {
 
 namespace {
 
+/// Whether `s` is a plain decimal number: sign, digits, an optional fraction and exponent. Not
+/// strtod's wider set, whose "-nan(HYPERLINK)", "+INF" and "-0x1p3" a spreadsheet reads as text
+/// or a name (tenth probe).
+bool plainDecimal(const std::string& s) {
+    size_t i = 0;
+    auto digits = [&] {
+        const size_t start = i;
+        while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+        return i > start;
+    };
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+    bool any = digits();
+    if (i < s.size() && s[i] == '.') {
+        ++i;
+        any = digits() || any;
+    }
+    if (!any) return false;
+    if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+        ++i;
+        if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+        if (!digits()) return false;
+    }
+    return i == s.size();
+}
+
 /// Text a spreadsheet would read as a formula in a CSV cell: it starts with =, +, - or @ and is not
-/// a plain number (a numeric axis's "-0.5" stays as it is).
+/// a plain decimal number (a numeric axis's "-0.5" stays as it is).
 bool looksLikeFormula(const std::string& s) {
     if (s.empty() || std::string("=+-@").find(s[0]) == std::string::npos) return false;
-    char* end = nullptr;
-    std::strtod(s.c_str(), &end);
-    return end != s.c_str() + s.size();
+    return !plainDecimal(s);
 }
 
 // A sweep beyond this is almost certainly a mistake (an axis of 1000 values times a few more), and
