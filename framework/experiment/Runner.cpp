@@ -16,6 +16,7 @@
 #include "framework/render/ShadingPass.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -69,6 +70,13 @@ uint64_t visibilityHash(const std::vector<float>& vis) {
         h = (h ^ w) * 1099511628211ull;
     }
     return h;
+}
+
+/// A hash as the 16 hex digits summary.json writes.
+std::string hexHash(uint64_t h) {
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    return hex;
 }
 
 /// `timeSource` is summary.json's stage_time_source: which column of frames.csv the stage plot uses.
@@ -211,7 +219,8 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"build", {{"commit", buildCommit()}, {"dirty", buildDirty()}}},
                     {"started_utc", startedUtc}};
 
-    std::vector<int> framesWithoutLit;  // accuracy is measured over lit pixels: none, nothing to measure
+    std::vector<int> framesWithoutLit;
+    Json gbufferHashes = Json::array();  // accuracy is measured over lit pixels: none, nothing to measure
     Progress progress(opt.progress,
                       size_t(cfg.frames * cfg.repeats + int(statFrames.size()) + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
     std::optional<CpuGBuffer> cpuG;
@@ -258,6 +267,11 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         if (sceneGpu.dynamic()) checkPoseBounds(cfg, frame, sceneGpu.bounds());
         renderFrame(cam);
         const CpuGBuffer& g = getCpuG();
+        // What every algorithm of this frame starts from: runs whose images must agree (a scene
+        // rewritten without changing it) compare images only where this agrees too.
+        std::vector<float> gbufferWords(g.position);
+        gbufferWords.insert(gbufferWords.end(), g.normal.begin(), g.normal.end());
+        gbufferHashes.push_back(hexHash(visibilityHash(gbufferWords)));
         std::vector<uint8_t> lit = litMask(g, light);
         std::vector<uint8_t> covered = coveredMask(g);
         const bool saveImages = isImageFrame(frame);
@@ -350,6 +364,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
     results.meta["wall_time_s"] = msSince(wallStart) / 1000.0;
     results.meta["memory"] = memoryRecord(cfg, sceneGpu, results, rssAfterSetup, opt.memoryPlan);
     results.meta["frames_without_lit_pixels"] = framesWithoutLit;
+    results.meta["gbuffer_hash_per_frame"] = gbufferHashes;
     results.meta["warnings"] = Json::array();
     const auto warn = [&](const std::string& w) {
         results.meta["warnings"].push_back(w);

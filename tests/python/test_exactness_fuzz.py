@@ -84,7 +84,12 @@ class SummaryPixels(unittest.TestCase):
                                text=True, stdin=subprocess.DEVNULL)
             self.assertEqual(r.returncode, 0, r.stderr[-2000:])
             with open(os.path.join(tmp, "out", "summary.json")) as f:
-                acc = json.load(f)["algorithms"]["sm"]["accuracy"]
+                summary = json.load(f)
+            acc = summary["algorithms"]["sm"]["accuracy"]
+        # One G-buffer hash per frame; the light moves, the camera does not: the same G-buffer.
+        self.assertEqual(len(summary["gbuffer_hash_per_frame"]), 2)
+        self.assertEqual(summary["gbuffer_hash_per_frame"][0], summary["gbuffer_hash_per_frame"][1])
+        self.assertEqual(len(summary["algorithms"]["sm"]["visibility_hash_per_frame"]), 2)
         self.assertEqual(acc["frames_measured"], 1)
         self.assertEqual(len(acc["per_frame_wrong_pixels"]), 2)
         self.assertIsNone(acc["per_frame_wrong_pixels"][0])
