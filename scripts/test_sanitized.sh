@@ -24,7 +24,9 @@ export LSAN_OPTIONS="suppressions=$PWD/scripts/sanitizers/lsan.supp:print_suppre
 # it checks the shipped configs (data, not code), and validating them builds every shipped scene up
 # to 74 M triangles and line_space's trees for 2 M, past ctest's 10 minutes when instrumented; the
 # same validate code runs here on every hostile input (HostileInputTest, UserTextTest, CliTest).
-(cd build-asan && ctest --output-on-failure -j"$(nproc)" -E "GLTest|GuiTest|gl_tests|EglRunner|EglInfo|SweepMemoryTest|EveryShippedConfigValidates" "$@")
+# And the exactness fuzzer's tests: they run the binary on hundreds of scenes, whose work is Mesa's
+# (not instrumented); the smoke runs below take the same binary's paths under the sanitizers.
+(cd build-asan && ctest --output-on-failure -j"$(nproc)" -E "GLTest|GuiTest|gl_tests|EglRunner|EglInfo|SweepMemoryTest|EveryShippedConfigValidates|ExactnessFuzz" "$@")
 
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
