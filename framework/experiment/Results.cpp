@@ -200,6 +200,12 @@ Json wrongPixelJson(const FrameRecord& f, int width) {
 }
 } // namespace
 
+std::string hexHash(uint64_t h) {
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    return hex;
+}
+
 int ExperimentResults::imageWidth() const {
     const Json res = meta.value("resolution", Json());
     return res.is_array() && !res.empty() && res[0].is_number_integer() ? res[0].get<int>() : 1;
@@ -248,11 +254,7 @@ Json ExperimentResults::summary() const {
         // Each frame's visibility image as a hash (hex): two runs that must give the same image
         // (a scene rewritten without changing what it is, docs/exactness_fuzzing.md) compare these.
         Json hashes = Json::array();
-        for (const auto& f : a.frames) {
-            char hex[17];
-            std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(f.visibilityHash));
-            hashes.push_back(hex);
-        }
+        for (const auto& f : a.frames) hashes.push_back(hexHash(f.visibilityHash));
         j["visibility_hash_per_frame"] = hashes;
         if (!mismatch.empty()) {
             Stats m = computeStats(mismatch);

@@ -13,6 +13,9 @@
 
 namespace shadowlab {
 
+/// A 64-bit hash as the 16 hex digits summary.json writes.
+std::string hexHash(uint64_t h);
+
 struct FrameRecord {
     int frame = 0;
     std::vector<StageTime> stages; ///< the algorithm's stages, then "total"

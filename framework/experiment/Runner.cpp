@@ -72,13 +72,6 @@ uint64_t visibilityHash(const std::vector<float>& vis) {
     return h;
 }
 
-/// A hash as the 16 hex digits summary.json writes.
-std::string hexHash(uint64_t h) {
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-    return hex;
-}
-
 /// `timeSource` is summary.json's stage_time_source: which column of frames.csv the stage plot uses.
 void runPlots(const std::string& dir, const std::string& finalDir, const std::string& timeSource) {
     // SHADOWLAB_PYTHON picks another interpreter (one with matplotlib) than the one found at build time.
@@ -219,8 +212,8 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"build", {{"commit", buildCommit()}, {"dirty", buildDirty()}}},
                     {"started_utc", startedUtc}};
 
-    std::vector<int> framesWithoutLit;
-    Json gbufferHashes = Json::array();  // accuracy is measured over lit pixels: none, nothing to measure
+    std::vector<int> framesWithoutLit;  // accuracy is measured over lit pixels: none, nothing to measure
+    Json gbufferHashes = Json::array();
     Progress progress(opt.progress,
                       size_t(cfg.frames * cfg.repeats + int(statFrames.size()) + (cfg.warmupFrames > 0 ? 1 : 0)) * instances.size());
     std::optional<CpuGBuffer> cpuG;
