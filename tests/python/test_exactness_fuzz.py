@@ -63,6 +63,26 @@ class Pieces(unittest.TestCase):
         self.assertIsNone(ef.exact_midpoint([0.0, 1.0, 0.0], [1.0, ef.f32(1 + 2 ** -23), 0.0]))
 
 
+class RunArguments(unittest.TestCase):
+    def test_bad_arguments_and_someone_elses_folder_are_refused(self):
+        """Tenth probe: --out overwrote a user's report.json; --only nope and --seconds -5 ran
+        nothing and exited 0."""
+        with tempfile.TemporaryDirectory() as tmp:
+            mine = os.path.join(tmp, "notes")
+            os.makedirs(mine)
+            with open(os.path.join(mine, "report.json"), "w") as f:
+                f.write("my notes")
+            for extra in (["--out", mine], ["--out", os.path.join(mine, "report.json")], ["--only", "nope"],
+                          ["--seconds", "-5"], ["--cases", "-1"]):
+                r = subprocess.run([sys.executable, FUZZ, "--binary", BINARY, "run", "--seconds", "5",
+                                    "--out", os.path.join(tmp, "o")] + extra, capture_output=True, text=True,
+                                   stdin=subprocess.DEVNULL)
+                self.assertEqual(r.returncode, 2, (extra, r.stderr))
+                self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+            with open(os.path.join(mine, "report.json")) as f:
+                self.assertEqual(f.read(), "my notes")
+
+
 class SummaryPixels(unittest.TestCase):
     def test_wrong_pixels_are_listed_per_frame_and_located(self):
         """Frame 0 has no lit pixel (the light under the plane): its entry is null, so frame 1's
