@@ -644,7 +644,7 @@ def replay(sl, paths, log=print):
             shutil.rmtree(d, ignore_errors=True)
         ok = r.returncode == 0
         bad += not ok
-        log(f"{'ok  ' if ok else 'FAIL'} {os.path.relpath(p, ROOT)} (exit {r.returncode})"
+        log(f"{'ok  ' if ok else 'FAIL'} {p} (exit {r.returncode})"
             + ("" if ok else "\n" + r.stderr.strip()[-600:]))
     return bad
 
@@ -729,8 +729,8 @@ MARK = ".exactness_fuzz"  # names a folder this script made, which a later run m
 def check_run_args(args, sl):
     """Why `run`'s arguments cannot be taken (None when they can): values out of range, unknown
     algorithms, and an --out that is a file or a folder of someone else's (not empty, no mark)."""
-    if not args.seconds > 0:
-        return f"--seconds must be greater than 0, got {args.seconds}"
+    if not (args.seconds > 0 and math.isfinite(args.seconds)):  # inf with --cases 0 would never end
+        return f"--seconds must be a finite number greater than 0, got {args.seconds}"
     if args.cases < 0 or args.relations < 0 or args.shrinks_per_id < 0:
         return "--cases, --relations and --shrinks-per-id must be 0 or more"
     known = set(sl.exact()) | set(ONE_SIDED)
@@ -766,6 +766,16 @@ def main():
     g.add_argument("seed", type=int)
     args = p.parse_args()
 
+    def refuse(problem):
+        print(f"exactness_fuzz.py: error: {problem}", file=sys.stderr)
+        return 2
+
+    if not (os.path.isfile(args.binary) and os.access(args.binary, os.X_OK)):
+        return refuse(f"--binary {args.binary[:200]!r} is not an executable file (build it, or give its path)")
+    if args.command == "replay":
+        for c in args.cases:
+            if not os.path.isfile(c):
+                return refuse(f"replay: {c[:200]!r} is not a file")
     work = tempfile.mkdtemp(prefix="exactness_fuzz.")
     try:
         sl = Shadowlab(args.binary, work)
@@ -777,8 +787,7 @@ def main():
             return 1 if replay(sl, args.cases) else 0
         problem = check_run_args(args, sl)
         if problem:
-            print(f"exactness_fuzz.py: error: {problem}", file=sys.stderr)
-            return 2
+            return refuse(problem)
         os.makedirs(args.out, exist_ok=True)
         with open(os.path.join(args.out, MARK), "w") as f:
             f.write("exactness_fuzz.py output\n")

@@ -182,5 +182,29 @@ TEST(ConfigOverrideTest, ArrayIndicesAreDigitsWithinTheArray) {
     EXPECT_EQ(cfg["algorithms"][1]["id"], "second");
 }
 
+// Eleventh probe: a list holding a number past a double (1e400) did not parse, was taken as bare
+// text, and was reported as "expected a list". Text that starts as JSON must be JSON: its parse
+// error is the cause; bare words stay strings.
+TEST(ConfigOverrideTest, AValueThatStartsAsJsonMustParseAndNamesItsCause) {
+    Json cfg = {{"expect", Json::array()}};
+    for (const char* bad : {"expect=[{\"id\": \"psv\", \"max\": 1e400}]", "frames=1e400", "name=\"open", "resolution=[64,"}) {
+        try {
+            applyOverride(cfg, bad);
+            ADD_FAILURE() << bad << " accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.file(), "--set") << bad;
+            EXPECT_EQ(e.cause().find("expected a list"), std::string::npos) << bad << ": " << e.what();
+        }
+    }
+    try {
+        applyOverride(cfg, "frames=1e400");
+    } catch (const InputError& e) {
+        EXPECT_NE(e.cause().find("does not fit in a double"), std::string::npos) << e.what();
+        EXPECT_EQ(e.jsonPath(), "frames");
+    }
+    applyOverride(cfg, "light.type=directional");
+    EXPECT_EQ(cfg["light"]["type"], "directional");
+}
+
 } // namespace
 } // namespace shadowlab

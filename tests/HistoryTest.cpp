@@ -223,6 +223,8 @@ TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"history"}, {"history", dir, "--window", "0"}, {"history", dir, "--window", "x"},
           {"history", dir, "--threshold", "-1"}, {"history", dir, dir}, {"history", dir, "--bogus"},
+          // Eleventh probe: 0x10 was read as 16 %, " 5" as 5 %.
+          {"history", dir, "--threshold", "0x10"}, {"history", dir, "--threshold", " 5"}, {"history", dir, "--threshold", "inf"},
           {"history", dir + "/missing", "--out", out}, {"history", dir, "--relative-to", "nope", "--out", out}}) {
         std::vector<std::string> argv{SHADOWLAB_BINARY};
         argv.insert(argv.end(), args.begin(), args.end());
@@ -278,6 +280,12 @@ TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
         {[](Json& s) { s["algorithms"]["psv"]["accuracy"]["mismatch_ratio_max"] = -1; }, "/algorithms/psv/accuracy/mismatch_ratio_max"},
         {[](Json& s) { s["algorithms"]["psv"]["accuracy"]["per_frame_mismatch"] = Json::array({0.5, 2}); },
          "/algorithms/psv/accuracy/per_frame_mismatch/1"},
+        // Eleventh probe: ids no run writes (control characters and U+FFFE made compare.junit.xml
+        // unreadable), and a time that does not exist sorted as the newest run.
+        {[](Json& s) { s["algorithms"]["ev\u0001\u001b[31m\uFFFEx"] = s["algorithms"]["psv"]; }, "/algorithms"},
+        {[](Json& s) { s["algorithms"]["=HYPERLINK(\"x\")"] = s["algorithms"]["psv"]; }, "/algorithms"},
+        {[](Json& s) { s["started_utc"] = "2026-13-45T99:99:99Z"; }, "/started_utc"},
+        {[](Json& s) { s["started_utc"] = "2025-02-29T10:00:00Z"; }, "/started_utc"},
     };
     for (const auto& [change, path] : edits) {
         SCOPED_TRACE(path);

@@ -318,6 +318,39 @@ TEST(OutputPlaceTest, ACommitKeepsWhatAppearedAtThePlaceAfterOpenAndKeepsItsOwnR
     EXPECT_EQ(slurp(forced + "/summary.json"), "old");
 }
 
+// Eleventh probe: a user's notes.txt and folder put into a run's output were deleted with it by the
+// next run --force. A committed output lists what it wrote in its mark; --force replaces only an
+// output that holds nothing else, and a file that appears in it during the run keeps it.
+TEST(OutputPlaceTest, ForceReplacesOnlyWhatTheOutputWroteNeverAFileAddedToIt) {
+    std::string base = test::makeTempDir("place-foreign"), out = base + "/out";
+    {
+        OutputPlace p = OutputPlace::open(out, false);
+        std::ofstream(p.partialDir() + "/summary.json") << "first";
+        p.commit();
+    }
+    {
+        OutputPlace p = OutputPlace::open(out, true);  // only its own entries: replaced
+        std::ofstream(p.partialDir() + "/summary.json") << "second";
+        p.commit();
+    }
+    EXPECT_EQ(slurp(out + "/summary.json"), "second");
+    std::ofstream(out + "/notes.txt") << "mine";
+    const std::string err = errorOf(out, true);
+    EXPECT_NE(err.find("holds \"notes.txt\", which it did not write"), std::string::npos) << err;
+    fs::remove(out + "/notes.txt");
+    fs::create_directories(out + "/mydata");
+    EXPECT_NE(errorOf(out, true).find("\"mydata\""), std::string::npos);
+    fs::remove(out + "/mydata");
+
+    OutputPlace p = OutputPlace::open(out, true);
+    std::ofstream(p.partialDir() + "/summary.json") << "third";
+    std::ofstream(out + "/late.txt") << "mine too";
+    const std::string late = commitError(p);
+    EXPECT_NE(late.find("it now holds \"late.txt\", which the output there did not write"), std::string::npos) << late;
+    EXPECT_EQ(slurp(out + "/late.txt"), "mine too");
+    EXPECT_EQ(slurp(out + "/summary.json"), "second");
+}
+
 TEST(OutputPlaceTest, AnAbsurdlyLongPathIsEchoedShort) {
     std::string base = test::makeTempDir("place-long");
     std::string deep = base;

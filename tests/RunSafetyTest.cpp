@@ -169,6 +169,27 @@ TEST(RunSafetyTest, ForceNeverReplacesAFolderTheRunReadsItsInputsFrom) {
     f.expectPreviousKept();
 }
 
+// Eleventh probe: a glTF file beside the config whose buffer file lay inside the output was fine
+// for the check (it looked at the .gltf only), and --force deleted the buffer with the old results.
+TEST(RunSafetyTest, ForceNeverReplacesAFolderHoldingAGltfsBufferFile) {
+    Fixture f("buffer-inside", 1);
+    const float pos[9] = {-1, 0.5f, -1, -1, 0.5f, 1, 1, 0.5f, -1};
+    std::ofstream(f.out + "/tri.bin", std::ios::binary).write(reinterpret_cast<const char*>(pos), sizeof pos);
+    std::ofstream(f.base + "/tri.gltf") << test::triangleGltf(
+        {{"buffers", R"([{"byteLength": 36, "uri": "out/tri.bin"}])"},
+         {"accessors", R"([{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3, "min": [-1, 0.5, -1], "max": [1, 0.5, 1]}])"}});
+    std::ofstream(f.config) << test::configWith({{"resolution", "[32, 32]"}, {"frames", "1"},
+                                                 {"scene", R"({"objects": [{"procedural": "plane", "size": [4, 4]}, {"gltf": "tri.gltf"}]})"},
+                                                 {"output", R"({"plots": false})"}});
+    std::string log;
+    EXPECT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + f.config + " --out " + f.out + " --force --no-progress", log), 2)
+        << log;
+    EXPECT_NE(log.find("this run reads"), std::string::npos) << log;
+    EXPECT_NE(log.find("tri.bin"), std::string::npos) << log;
+    EXPECT_TRUE(fs::exists(f.out + "/tri.bin"));
+    f.expectPreviousKept();
+}
+
 // Sixth probe: validate accepted an output.dir run could not make (/proc/x); a plotter that exits
 // 0 without writing anything (SHADOWLAB_PYTHON=/bin/true) left a run without report.html, unsaid.
 TEST(RunSafetyTest, ValidateTriesTheOutputPlaceAndASilentPlotterIsNamed) {

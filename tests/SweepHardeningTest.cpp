@@ -408,6 +408,25 @@ TEST(SweepStateTest, BrokenSummariesAreFailedRunsAndTheGoodOnesAreMerged) {
     }
 }
 
+// Eleventh probe: a summary.json whose psv results were renamed =HYPERLINK("http://evil","x") was
+// taken as complete and its id written into sweep.csv, where a spreadsheet runs it. Results under
+// an id the run's config does not give are no run's: a failed run, its rows not merged.
+TEST(SweepStateTest, ResultsUnderAnIdTheConfigDoesNotGiveAreAFailedRun) {
+    const std::string dir = test::makeTempDir("merge-forged-id"), out = dir + "/out";
+    const Json plan = test::fakeSweepRuns(kBin, smallFile(dir), out);
+    ASSERT_EQ(plan["runs"].size(), 4u);
+    const std::string summary = out + "/runs/" + plan["runs"][1]["id"].get<std::string>() + "/summary.json";
+    Json forged = JsonNode::parseFile(summary);
+    forged["algorithms"]["=HYPERLINK(\"http://evil\",\"x\")"] = forged["algorithms"]["psv"];
+    forged["algorithms"].erase("psv");
+    std::ofstream(summary, std::ios::trunc) << forged.dump();
+    const Ran r = runArgs(sweep({"merge", out, "--no-plots"}));
+    EXPECT_EQ(r.rc, 1) << r.err;
+    EXPECT_NE(r.err.find("which its config.resolved.json does not give"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("3 of 4 runs merged (1 failed)"), std::string::npos) << r.err;
+    EXPECT_EQ(test::readText(out + "/sweep.csv").find("HYPERLINK"), std::string::npos);
+}
+
 TEST(SweepStateTest, AStaleErrorRecordBesideACompleteRunIsIgnoredAndRemoved) {
     const std::string dir = test::makeTempDir("stale-error"), file = smallFile(dir), out = dir + "/out";
     const Json plan = test::fakeSweepRuns(kBin, file, out);

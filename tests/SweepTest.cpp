@@ -41,6 +41,8 @@ const BadSweep kBadSweeps[] = {
     {"AxisNameTwice", R"({"axes": [{"name": "a", "values": {"frames": [1, 2]}}, {"name": "a", "values": {"resolution": [[8, 8]]}}]})",
      "/axes/1/name|two axes are named \"a\""},
     {"AxisNameIsAColumn", R"({"axes": [{"name": "measure", "values": {"frames": [1, 2]}}]})", "/axes/0/name|column"},
+    // Eleventh probe: its plot sweep_stages.png replaced the stages figure.
+    {"AxisNameIsTheStagesFigure", R"({"axes": [{"name": "stages", "values": {"frames": [1, 2]}}]})", "/axes/0/name|sweep_stages.png"},
     {"IndexPastTheArray", R"({"axes": [{"name": "pcf", "values": {"algorithms.5.params.pcf": [0, 1]}}]})",
      "axis \"pcf\"|path algorithms.5.params.pcf|no element 5 in an array of 2"},
     {"DescendIntoANumber", R"({"axes": [{"name": "f", "values": {"frames.x": [1, 2]}}]})", "axis \"f\"|path frames.x|cannot descend"},

@@ -185,7 +185,9 @@ void refuseInputsInsideReplacedOutput(const std::string& config, const std::vect
     const std::vector<std::string> gltf = gltfPathsOf(j.value("scene", Json()));
     std::vector<std::string> inputs = {config};
     const fs::path folder = fs::absolute(config).parent_path();
-    for (const std::string& g : gltf) inputs.push_back(fs::path(g).is_absolute() ? g : (folder / g).string());
+    // Each glTF file with the buffer files it names (eleventh probe: a buffer inside DIR was deleted).
+    for (const std::string& g : gltf)
+        for (const std::string& file : gltfFiles(fs::path(g).is_absolute() ? g : (folder / g).string())) inputs.push_back(file);
     OutputPlace::refuseInputsInside(dir, inputs, "this run");
 }
 

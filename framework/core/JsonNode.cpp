@@ -37,6 +37,11 @@ Json parseJsonOrString(const std::string& text) {
     try {
         return parseJson(text, "--set");
     } catch (const InputError&) {
+        // Text that starts as a list, an object, a quoted string or a number was meant as JSON: its
+        // parse error is the cause (eleventh probe: a list holding 1e400 was taken as bare text and
+        // reported as "expected a list").
+        const size_t first = text.find_first_not_of(" \t");
+        if (first != std::string::npos && std::string("[{\"-0123456789").find(text[first]) != std::string::npos) throw;
         return Json(text);  // bare text; whatever reads it checks its type
     }
 }

@@ -20,7 +20,8 @@ namespace shadowlab {
 using Json = nlohmann::json;
 
 /// A command-line value ("[64,64]", "3", "true", "\"x\"", or bare text): JSON when it parses as
-/// JSON, else the text as a JSON string. Shared by every --set, so they all accept the same input.
+/// JSON, else the text as a JSON string. Text starting with [ { " - or a digit must parse (its
+/// InputError is thrown). Shared by every --set, so they all accept the same input.
 Json parseJsonOrString(const std::string& text);
 
 /// The largest finite float.

@@ -56,7 +56,8 @@ std::string shortNumber(double v, int digits = 6);
 std::string utcTimestamp();
 
 /// `text` as XML character data or an attribute value (JUnit files): & < > " ' escaped, bytes that
-/// are not well-formed UTF-8 and C0 controls but tab and newline (which XML 1.0 cannot hold) as '?'.
+/// are not well-formed UTF-8, C0 controls but tab and newline, U+FFFE and U+FFFF (which XML 1.0
+/// cannot hold) as '?'.
 std::string xmlText(const std::string& text);
 
 /// `text` for one line of output: control characters and invalid bytes shown as '?', cut to
@@ -66,5 +67,10 @@ std::string shortText(const std::string& text, size_t maxChars = kMaxEchoChars);
 /// `text` with every byte that is not part of well-formed UTF-8 replaced by '?' (a log's tail, say,
 /// before it goes into a JSON file), newlines kept.
 std::string validUtf8(const std::string& text);
+
+/// Whether `s` is a plain decimal number: sign, digits, an optional fraction and exponent; not
+/// strtod's wider set (hex, inf, nan(...), leading spaces), which a spreadsheet or a reader takes
+/// for a formula, a name or another number.
+bool plainDecimal(const std::string& s);
 
 } // namespace shadowlab

@@ -31,7 +31,13 @@ bool isUtcTimestamp(const Json& j) {
     if (t.size() != std::strlen(kShape)) return false;
     for (size_t k = 0; k < t.size(); ++k)
         if (kShape[k] == 'd' ? !(t[k] >= '0' && t[k] <= '9') : t[k] != kShape[k]) return false;
-    return true;
+    // And a time that exists (eleventh probe: "2026-13-45T99:99:99Z" sorted as the newest run).
+    auto field = [&](size_t at, size_t n) { return std::stoi(t.substr(at, n)); };
+    const int year = field(0, 4), month = field(5, 2), day = field(8, 2);
+    const bool leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+    const int days[12] = {31, leap ? 29 : 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+    return month >= 1 && month <= 12 && day >= 1 && day <= days[month - 1] && field(11, 2) < 24 && field(14, 2) < 60 &&
+           field(17, 2) <= 60;  // 60: a leap second
 }
 
 } // namespace
@@ -90,6 +96,11 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
     }
     for (const auto& [id, entry] : s["algorithms"].items()) {
         const std::string at = "/algorithms/" + shortText(id, 60);
+        // Ids reach file names, tables and JUnit classnames (eleventh probe: control characters
+        // and U+FFFE in one made compare.junit.xml unreadable).
+        if (!isAlgorithmId(id))
+            throw InputError(file, "/algorithms", "holds the id \"" + shortText(id, 60) +
+                                                      "\", which no run writes (ids are 1 to 64 letters, digits, '_', '-' or '.', neither of the last two first)");
         if (!entry.is_object()) throw InputError(file, at, "is not an object, as a run writes each algorithm's results");
         for (const char* key : {"accuracy", "counters", "cpu_time_ms", "time_ms", "memory_bytes", "overflow", "preprocess_ms",
                                 "resident_bytes", "statistics_pass", "total_ms_per_frame", "repetitions"})

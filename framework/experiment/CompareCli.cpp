@@ -51,7 +51,8 @@ double parseThreshold(const std::string& text) {
     if (!t.empty() && t.back() == '%') t.pop_back();
     char* end = nullptr;
     const double v = t.empty() ? NAN : std::strtod(t.c_str(), &end);
-    if (!(v >= 0 && v <= 1000) || end != t.c_str() + t.size())
+    // Plain decimals only (eleventh probe: "0x10" was read as 16 %, " 5" as 5 %).
+    if (!plainDecimal(t) || !(v >= 0 && v <= 1000) || end != t.c_str() + t.size())
         throw InputError("--threshold", "", "expected a percentage from 0 to 1000, e.g. 5 or 5%, got \"" + shortText(text, 40) + "\"");
     return v / 100.0;
 }

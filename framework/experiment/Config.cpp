@@ -1,4 +1,5 @@
 #include "framework/experiment/Config.h"
+#include "framework/experiment/LightClearance.h"
 
 #include "framework/core/Text.h"
 #include "framework/scene/Scene.h"
@@ -96,8 +97,8 @@ AlgorithmEntry parseEntry(JsonNode node, const std::string& defaultName) {
         }
         e.id = node.getString("id", name);
         // Ids name result files (images/ID_f0000_shaded.png) and columns: no separators or spaces.
-        if (e.id.empty() || e.id.size() > 64 || e.id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") != std::string::npos || e.id[0] == '.')
-            node.fail("id", "an id is 1 to 64 letters, digits, '_', '-' or '.' (not first), got \"" +
+        if (!isAlgorithmId(e.id))
+            node.fail("id", "an id is 1 to 64 letters, digits, '_', '-' or '.' (neither of the last two first), got \"" +
                                 (e.id.size() > 40 ? e.id.substr(0, 37) + "..." : e.id) + "\"");
     } else {
         e.info = findAlgorithm(name);
@@ -126,7 +127,12 @@ static bool withinCoordinates(const Bounds& b) {
     return true;
 }
 
-static std::string frameText(const ExperimentConfig& c, int frame) {
+bool isAlgorithmId(const std::string& id) {
+    return !id.empty() && id.size() <= 64 && id[0] != '.' && id[0] != '-' &&
+           id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") == std::string::npos;
+}
+
+std::string frameText(const ExperimentConfig& c, int frame) {
     char time[32];
     std::snprintf(time, sizeof time, "%.6g", c.sceneTimeAt(frame));
     return "frame " + std::to_string(frame) + " (time " + time + " s)";
@@ -143,18 +149,29 @@ void checkPoseBounds(const ExperimentConfig& c, int frame, const Bounds& b) {
 
 /// A moving part's triangles posed by `m` keep an area: a triangle that float rounding collapses
 /// there is an error, as it is where a static object is placed (ninth probe: a 0.001-unit triangle
-/// moved to x = 1e5 lost its area at that frame and the run went on without it).
+/// moved to x = 1e5 lost its area at that frame and the run went on without it). A mesh's triangles
+/// keep their shape within 1 % of the pose in double, as where they are placed statically.
 static void checkPosedTriangles(const MovingPart& part, const glm::mat4& m, const std::string& file, const std::string& path,
                                 const ExperimentConfig& c, int frame) {
+    const glm::dmat4 dm(m);
     for (size_t i = 0; i < part.triangleCount; ++i) {
         glm::vec3 v[3], n;
         poseTriangle(m, &part.local[3 * i], v, n);
-        if (!unitNormal(v[0], v[1], v[2], n)) {
-            Bounds b;
-            for (const glm::vec3& p : v) b.extend(p);
+        Bounds b;
+        for (const glm::vec3& p : v) b.extend(p);
+        if (!unitNormal(v[0], v[1], v[2], n))
             throw InputError(file, path, "triangle " + std::to_string(i) + " of the moving object has no area in float at " +
                                              frameText(c, frame) + " (" + floatPrecisionAt(b) +
                                              "): keep its path nearer the origin or make the object larger");
+        if (!part.heldEachTriangle) continue;
+        glm::dvec3 exact[3];
+        for (size_t k = 0; k < 3; ++k) exact[k] = glm::dvec3(dm * glm::dvec4(glm::dvec3(part.local[3 * i + k]), 1.0));
+        if (const double change = shapeChange(v, exact); !(change <= 0.01)) {
+            char text[96];
+            std::snprintf(text, sizeof text, "%.3g %%", 100.0 * change);
+            throw InputError(file, path, "triangle " + std::to_string(i) + " of the moving mesh changes its shape by " + text +
+                                             " (at most 1 %) in float at " + frameText(c, frame) + " (" + floatPrecisionAt(b) +
+                                             "): keep its path nearer the origin or make the mesh larger");
         }
     }
 }
@@ -327,6 +344,7 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     }
     if (c.algorithms.empty() && !c.reference) root.fail("algorithms", "nothing to run: no algorithms and no reference");
 
+    checkLightClearance(c);
     c.expectations = parseExpectations(root, c.expectationIds());
 
     JsonNode out = root.child("output");
@@ -356,7 +374,12 @@ void applyOverride(Json& config, const std::string& assignment) {
     if (eq == std::string::npos || eq == 0)
         throw InputError("--set", assignment, "expected PATH=VALUE, e.g. resolution=[64,64] or algorithms.0.params.pcf=0");
     const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
-    const Json value = parseJsonOrString(text); // e.g. resolution=[64,64], light.type=directional
+    Json value;
+    try {
+        value = parseJsonOrString(text); // e.g. resolution=[64,64], light.type=directional
+    } catch (const InputError& e) {
+        throw InputError("--set", path, e.cause());
+    }
     Json* node = &config;
     std::string walked;
     size_t start = 0;

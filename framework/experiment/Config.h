@@ -68,6 +68,15 @@ struct ExperimentConfig {
 };
 const char* toString(ExperimentConfig::Statistics s);
 
+/// Whether `id` can label an algorithm's results: 1 to 64 letters, digits, '_', '-' or '.', neither
+/// of the last two first. Ids name result files (images/ID_f0000_shaded.png) and columns (a '-'
+/// first would make "-A1" a formula in sweep.csv), so a summary.json whose ids break it is no
+/// run's (compare, history and sweep merge refuse it).
+bool isAlgorithmId(const std::string& id);
+
+/// "frame F (time T s)", as errors about one frame name it.
+std::string frameText(const ExperimentConfig& config, int frame);
+
 /// InputError unless the scene posed for `frame` (its bounds `b`) lies within ±1e15 scene units.
 void checkPoseBounds(const ExperimentConfig& config, int frame, const Bounds& b);
 

@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/JsonNode.h"
+#include "framework/core/Text.h"
 
 #include <cerrno>
 #include <cstdio>
@@ -139,6 +140,49 @@ bool writeMark(const fs::path& path) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
     if (fd < 0) return false;
     return ::close(fd) == 0;
+}
+
+/// What an output wrote at its top level, listed in its mark when it is committed: --force then
+/// replaces only an output that holds nothing else (eleventh probe: a user's notes.txt and folder
+/// put into a run's output were deleted with it by the next run --force).
+constexpr const char* kManifestHeader = "shadowlab-output, entries:";
+
+void writeManifest(const fs::path& dir) {
+    std::string text = std::string(kManifestHeader) + "\n";
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name != kOutputMark && name != kPartialMark) text += name + "\n";
+    }
+    const int fd = ::open((dir / kOutputMark).c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) return;  // the mark stays empty: the output is then replaced whole, as before the list
+    (void)!::write(fd, text.data(), text.size());
+    ::close(fd);
+}
+
+/// The first top-level entry of the output `dir` that its mark does not list: "" when there is
+/// none, or when the mark lists nothing (an output from before the list is replaced whole).
+std::string foreignEntry(const fs::path& dir) {
+    std::string text;
+    try {
+        text = readInputFile((dir / kOutputMark).string(), 1 << 20);
+    } catch (const std::exception&) {
+        return "";
+    }
+    const std::string header = std::string(kManifestHeader) + "\n";
+    if (text.compare(0, header.size(), header) != 0) return "";
+    std::set<std::string> listed;
+    for (size_t at = header.size(); at < text.size();) {
+        const size_t end = text.find('\n', at);
+        listed.insert(text.substr(at, end == std::string::npos ? std::string::npos : end - at));
+        at = end == std::string::npos ? text.size() : end + 1;
+    }
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+        const std::string name = entry.path().filename().string();
+        if (name != kOutputMark && !listed.count(name)) return name;
+    }
+    return "";
 }
 
 /// `path` is PREFIX + digits, a real directory (no link) holding the regular file `mark`.
@@ -394,6 +438,9 @@ void OutputPlace::checkReplaceable(const std::string& given) {
     if (!output)
         throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no " + std::string(kOutputMark) +
                                   " mark, nor a summary.json of a run); --force replaces only outputs");
+    if (const std::string foreign = foreignEntry(finalPath); !foreign.empty())
+        throw InputError(shortPath(dir), "", "the output holds \"" + shortText(foreign, 80) +
+                                                 "\", which it did not write; --force would delete it with the rest: move it out first");
 }
 
 void OutputPlace::refuseOtherKind(const std::string& given, const std::string& ownFile, const std::string& command) {
@@ -581,6 +628,10 @@ void OutputPlace::commit() {
     if (exists)
         if (const std::string inside = nestedInside(final_); !inside.empty())
             refuseCommit("it now holds " + inside);
+    if (exists)
+        if (const std::string foreign = foreignEntry(fs::path(final_)); !foreign.empty())
+            refuseCommit("it now holds \"" + shortText(foreign, 80) + "\", which the output there did not write");
+    writeManifest(fs::path(partial_));
     if (exists) {
         if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, final_.c_str(), RENAME_EXCHANGE) == 0) {
             committed_ = true;

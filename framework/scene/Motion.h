@@ -80,6 +80,8 @@ struct MovingPart {
     glm::vec3 localMin{0.0f}, localMax{0.0f}; ///< box of `local` (setLocal() keeps it)
     /// Where its motion was given (a config's path, a glTF node), named by errors about its pose.
     std::string sourceFile, sourcePath;
+    /// Its triangles are a mesh's: each keeps its shape within 1 % at every pose, not just an area.
+    bool heldEachTriangle = false;
 
     /// Sets the local copy and its box.
     void setLocal(std::vector<glm::vec3> vertices);

@@ -264,6 +264,19 @@ Scene makeMesh(const std::vector<glm::vec3>& vertices, const std::vector<glm::iv
     return scene;
 }
 
+glm::mat4 gridCopyTransform(glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg, size_t copy) {
+    count = glm::max(count, glm::ivec3(1));
+    const size_t x = copy % size_t(count.x), z = copy / size_t(count.x) % size_t(count.z);
+    const size_t y = copy / size_t(count.x) / size_t(count.z);
+    // Centred in X and Z, stacked upwards from the object's own height in Y.
+    const glm::vec3 first(-0.5f * float(count.x - 1) * spacing.x, 0.0f, -0.5f * float(count.z - 1) * spacing.z);
+    const glm::vec3 offset = first + glm::vec3(float(x), float(y), float(z)) * spacing;
+    const glm::mat4 turn = rotateStepDeg == glm::vec3(0.0f)
+                               ? glm::mat4(1.0f)
+                               : composeTransform(glm::vec3(0.0f), float(copy) * rotateStepDeg, glm::vec3(1.0f));
+    return glm::translate(glm::mat4(1.0f), offset) * turn;
+}
+
 Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg) {
     count = glm::max(count, glm::ivec3(1));
     Scene scene;
@@ -271,24 +284,15 @@ Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::ve
     scene.positions.reserve(copies * object.positions.size() + 1); // + 1: see Scene::append
     scene.normals.reserve(copies * object.normals.size());
     scene.materialIds.reserve(copies * object.materialIds.size());
-    // Centred in X and Z, stacked upwards from the object's own height in Y.
-    glm::vec3 first(-0.5f * float(count.x - 1) * spacing.x, 0.0f, -0.5f * float(count.z - 1) * spacing.z);
-    for (int y = 0; y < count.y; ++y)
-        for (int z = 0; z < count.z; ++z)
-            for (int x = 0; x < count.x; ++x) {
-                glm::vec3 offset = first + glm::vec3(x, y, z) * spacing;
-                size_t matBase = scene.materials.size(), triBase = scene.triangleCount();
-                const float copy = float((size_t(y) * size_t(count.z) + size_t(z)) * size_t(count.x) + size_t(x));
-                const glm::mat4 turn = rotateStepDeg == glm::vec3(0.0f)
-                                           ? glm::mat4(1.0f)
-                                           : composeTransform(glm::vec3(0.0f), copy * rotateStepDeg, glm::vec3(1.0f));
-                scene.append(object, glm::translate(glm::mat4(1.0f), offset) * turn);
-                // The copies share the object's materials: drop the duplicates append() made.
-                if (matBase > 0) {
-                    scene.materials.resize(matBase);
-                    for (size_t t = triBase; t < scene.triangleCount(); ++t) scene.materialIds[t] -= uint32_t(matBase);
-                }
-            }
+    for (size_t copy = 0; copy < copies; ++copy) {
+        size_t matBase = scene.materials.size(), triBase = scene.triangleCount();
+        scene.append(object, gridCopyTransform(count, spacing, rotateStepDeg, copy));
+        // The copies share the object's materials: drop the duplicates append() made.
+        if (matBase > 0) {
+            scene.materials.resize(matBase);
+            for (size_t t = triBase; t < scene.triangleCount(); ++t) scene.materialIds[t] -= uint32_t(matBase);
+        }
+    }
     return scene;
 }
 

@@ -68,6 +68,8 @@ Scene makeTriangleSoup(int triangles, glm::vec3 extent, float triangleSize, uint
 /// The triangles `triangles` (indices into `vertices`, counter-clockwise seen from the front), as
 /// given; a degenerate one (no unit normal) is left out, so callers refuse those first.
 Scene makeMesh(const std::vector<glm::vec3>& vertices, const std::vector<glm::ivec3>& triangles, const Material& m);
+/// Where makeGrid() places copy `copy` (x fastest, then z, then y): its offset and rotation step.
+glm::mat4 gridCopyTransform(glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg, size_t copy);
 /// `count.x × count.y × count.z` copies of `object`, spaced by `spacing`, grid centred on the origin in X and Z.
 Scene makeGrid(const Scene& object, glm::ivec3 count, glm::vec3 spacing, glm::vec3 rotateStepDeg = glm::vec3(0.0f));
 

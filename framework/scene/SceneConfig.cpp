@@ -97,6 +97,9 @@ struct Builder {
     /// other in the built scene, however the grids nest); 0 when not set (not a grid).
     std::function<size_t()> leaf = {};
     size_t leafCount() const { return leaf ? leaf() : 0; }
+    /// Its triangles are a mesh's (or a grid's of a mesh), each held to the 1 % shape rule
+    /// wherever it is placed: by a transform, a grid's copy or a path's pose.
+    bool written = false;
     Scene operator()() const { return make(); }
 };
 
@@ -190,12 +193,6 @@ void overrideMaterials(Scene& s, const Material& m) {
 
 Builder parseObject(JsonNode node, int depth, int budget);
 
-/// A triangle's longest edge and its height over it, in double.
-std::pair<double, double> edgeAndHeight(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-    const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
-    return {longest, longest > 0.0 ? glm::length(glm::cross(b - a, c - a)) / longest : 0.0};
-}
-
 /// The floats a mesh's written coordinates become must keep each triangle's shape: its longest
 /// edge and its height over it within 1 % of the written ones (ninth probe: a sliver 0.004 wide
 /// written at x = 1e5 became 0.0078 wide, within the 1 % of its 4-unit length). Coordinates
@@ -208,10 +205,11 @@ void checkWrittenShapes(JsonNode& node, const std::vector<glm::vec3>& vertices, 
     };
     for (size_t t = 0; t < triangles.size(); ++t) {
         const glm::ivec3 i = triangles[t];
-        const auto [edge, height] = edgeAndHeight(written(i.x), written(i.y), written(i.z));
-        const auto [edgeF, heightF] = edgeAndHeight(glm::dvec3(vertices[size_t(i.x)]), glm::dvec3(vertices[size_t(i.y)]),
-                                                    glm::dvec3(vertices[size_t(i.z)]));
-        const double change = std::max(std::abs(edgeF - edge) / edge, std::abs(heightF - height) / height);
+        const glm::dvec3 exact[3] = {written(i.x), written(i.y), written(i.z)};
+        const glm::vec3 f[3] = {vertices[size_t(i.x)], vertices[size_t(i.y)], vertices[size_t(i.z)]};
+        const double change = shapeChange(f, exact);
+        const double height = edgeAndHeight(exact[0], exact[1], exact[2]).second;
+        const double heightF = edgeAndHeight(glm::dvec3(f[0]), glm::dvec3(f[1]), glm::dvec3(f[2])).second;
         if (!(change <= 0.01)) {
             char text[320];
             std::snprintf(text, sizeof text,
@@ -253,7 +251,34 @@ Builder parseMesh(JsonNode& node, const Material& m, int budget) {
     }
     checkWrittenShapes(node, vertices, triangles, indexed);
     const size_t count = triangles.size();
-    return Builder{[=] { return makeMesh(vertices, triangles, m); }, [=] { return count; }};
+    Builder b{[=] { return makeMesh(vertices, triangles, m); }, [=] { return count; }};
+    b.written = true;
+    return b;
+}
+
+/// Each triangle of `placed` (the triangles of `object`, copy after copy, each copy placed by
+/// `matrixOf(copy)`) keeps, as floats, the shape of the object's floats placed in double within 1 %
+/// (tenth probe: a mesh's sliver in a grid copy 2 units away lost 20 % of its height). A placement
+/// that dropped triangles is refused by checkBuilt() instead.
+void checkPlacedShapes(const JsonNode& node, const Scene& object, const Scene& placed, const char* what,
+                       const std::function<glm::mat4(size_t)>& matrixOf) {
+    const size_t n = object.triangleCount();
+    if (n == 0 || placed.triangleCount() % n != 0) return;
+    for (size_t copy = 0; copy < placed.triangleCount() / n; ++copy) {
+        const glm::dmat4 m(matrixOf(copy));
+        for (size_t t = 0; t < n; ++t) {
+            glm::dvec3 exact[3];
+            for (size_t k = 0; k < 3; ++k) exact[k] = glm::dvec3(m * glm::dvec4(glm::dvec3(object.positions[3 * t + k]), 1.0));
+            const double change = shapeChange(&placed.positions[3 * (copy * n + t)], exact);
+            if (!(change <= 0.01)) {
+                char text[320];
+                std::snprintf(text, sizeof text, "triangle %zu of the mesh %s %zu: placed there, its float coordinates change its "
+                                                 "shape by %.3g %% (at most 1 %%): place it nearer the origin or make it larger",
+                              t, what, copy + 1, 100.0 * change);
+                node.failHere(text);
+            }
+        }
+    }
 }
 
 /// Reads a procedural object's generator keys; returns the generator (run later). `budget` is the
@@ -317,10 +342,14 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
     glm::vec3 spacing = node.getVec3("spacing", glm::vec3(2.0f));
     glm::vec3 rotateStep = node.getVec3("rotate_step_deg", glm::vec3(0.0f));
     const size_t copies = gridCopies(count);
-    return Builder{[=] {
+    Builder grid{[=] {
         Scene object = (*inner)();
         gridTriangles(node, object.triangleCount(), copies, budget);
-        return makeGrid(object, count, spacing, rotateStep);
+        Scene made = makeGrid(object, count, spacing, rotateStep);
+        if (inner->written)
+            checkPlacedShapes(node, object, made, "in the grid's copy",
+                              [&](size_t copy) { return gridCopyTransform(count, spacing, rotateStep, copy); });
+        return made;
     }, [=] { return gridTriangles(node, inner->count(), copies, budget); }, inner->moves,
                    [=] { return saturatingMul(inner->materialCount(), copies); },
                    [=] {
@@ -328,6 +357,8 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
                        return std::pair{saturatingMul(triangles, copies), saturatingMul(parts, copies)};
                    },
                    [=] { return inner->leafCount() ? inner->leafCount() : inner->count(); }};
+    grid.written = inner->written;
+    return grid;
 }
 
 /// Refuses `what` (lying in `b`) where a float's spacing exceeds 1 % of its size.
@@ -359,10 +390,11 @@ void checkEachTriangle(const Scene& s, JsonNode& node, const glm::mat4& m) {
         if (const std::string why = floatDistortion(b); !why.empty())
             node.fail(where, "triangle " + std::to_string(t) + ", " + why + ": move the scene nearer the origin or make the triangle larger");
         if (m == glm::mat4(1.0f)) continue; // as written: checkWrittenShapes
-        const auto [edge, height] = edgeAndHeight(placed(t, 0), placed(t, 1), placed(t, 2));
-        const auto [edgeF, heightF] = edgeAndHeight(glm::dvec3(s.positions[3 * t]), glm::dvec3(s.positions[3 * t + 1]),
-                                                    glm::dvec3(s.positions[3 * t + 2]));
-        const double change = std::max(std::abs(edgeF - edge) / edge, std::abs(heightF - height) / height);
+        const glm::dvec3 exact[3] = {placed(t, 0), placed(t, 1), placed(t, 2)};
+        const double change = shapeChange(&s.positions[3 * t], exact);
+        const double height = edgeAndHeight(exact[0], exact[1], exact[2]).second;
+        const double heightF = edgeAndHeight(glm::dvec3(s.positions[3 * t]), glm::dvec3(s.positions[3 * t + 1]),
+                                             glm::dvec3(s.positions[3 * t + 2])).second;
         if (!(change <= 0.01)) {
             char text[320];
             std::snprintf(text, sizeof text, "triangle %zu: placed by its transform, its float coordinates change its shape by %.3g %% "
@@ -497,6 +529,7 @@ Builder parseObject(JsonNode node, int depth, int budget) {
     placed.materials = [built] { return built->materialCount(); };
     placed.moves = built->moves || path != nullptr;
     placed.leaf = [built] { return built->leafCount(); };
+    placed.written = built->written;
     // A path moves the whole object: its static runs (at most one more than its parts) become parts.
     placed.moving = [built, moves = path != nullptr] {
         if (!moves) return built->movingCount();
@@ -518,11 +551,17 @@ Builder parseObject(JsonNode node, int depth, int budget) {
             glm::vec3 anchor(s.bounds.center().x, s.bounds.min.y, s.bounds.center().z);
             m = m * glm::scale(glm::mat4(1.0f), glm::vec3(k)) * glm::translate(glm::mat4(1.0f), -anchor);
         }
+        // A grid of meshes placed by a transform: its triangles against the grid's, placed in double.
+        std::optional<Scene> before;
+        if (built->written && kind != "mesh" && m != glm::mat4(1.0f)) before = s;
         if (m != glm::mat4(1.0f)) transformInPlace(s, m);
         // The path moves the placed object: world(t) = path(t) · transform · object.
         if (path) s.attachMotion(motion, path->startTime(), path->endTime(), path->file, path->jsonPath);
+        if (built->written)
+            for (MovingPart& part : s.moving) part.heldEachTriangle = true;  // checked at every pose (Config.cpp)
         checkBuilt(s, node, expected, built->leafCount());
         if (kind == "mesh") checkEachTriangle(s, node, m);
+        if (before) checkPlacedShapes(node, *before, s, "in the transformed grid's copy", [&](size_t) { return m; });
         return s;
     };
     return placed;
@@ -646,6 +685,22 @@ std::vector<std::string> gltfPathsOf(const Json& scene) {
     };
     walk(scene);
     return out;
+}
+
+/// The files a glTF file's geometry comes from: itself and, for a .gltf, the buffer files its
+/// buffers name (relative, not data: URIs). A file that cannot be read names no buffers.
+std::vector<std::string> gltfFiles(const std::string& gltf) {
+    std::vector<std::string> files = {gltf};
+    try {
+        if (gltf.size() < 5 || gltf.compare(gltf.size() - 5, 5, ".gltf") != 0) return files;
+        const Json doc = JsonNode::parseFile(gltf);
+        if (doc.is_object() && doc.contains("buffers") && doc["buffers"].is_array())
+            for (const Json& b : doc["buffers"])
+                if (b.is_object() && b.contains("uri") && b["uri"].is_string() && !b["uri"].get<std::string>().starts_with("data:"))
+                    files.push_back(resolvePath(parentDir(gltf), b["uri"].get<std::string>()));
+    } catch (const InputError&) {
+    }
+    return files;
 }
 
 } // namespace shadowlab

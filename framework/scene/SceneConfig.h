@@ -16,6 +16,9 @@ Scene buildScene(JsonNode sceneNode);
 /// Every "gltf" path of a scene's JSON (its objects, a grid's object, nested), as written there:
 /// the files a run reads besides its config.
 std::vector<std::string> gltfPathsOf(const Json& scene);
+/// The files a glTF file's geometry comes from: itself and, for a .gltf, the buffer files its
+/// buffers name (relative, not data: URIs). A file that cannot be read names no buffers.
+std::vector<std::string> gltfFiles(const std::string& gltf);
 /// The same checks as buildScene (keys, values, glTF files present, triangle limits) without
 /// generating or loading anything, so thousands of scenes can be checked in a moment. A malformed
 /// glTF file is found only when it is loaded.

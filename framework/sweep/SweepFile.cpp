@@ -16,32 +16,17 @@
 
 namespace shadowlab {
 
+
+/// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
+void collectIds(const Json& resolved, std::set<std::string>& ids) {
+    if (resolved.value("reference", Json(true)) != Json(false)) ids.insert("reference");
+    if (resolved.contains("algorithms") && resolved["algorithms"].is_array())
+        for (const Json& a : resolved["algorithms"])
+            if (a.is_object() && a.contains("id") && a["id"].is_string()) ids.insert(a["id"].get<std::string>());
+}
+
 namespace {
 
-/// Whether `s` is a plain decimal number: sign, digits, an optional fraction and exponent. Not
-/// strtod's wider set, whose "-nan(HYPERLINK)", "+INF" and "-0x1p3" a spreadsheet reads as text
-/// or a name (tenth probe).
-bool plainDecimal(const std::string& s) {
-    size_t i = 0;
-    auto digits = [&] {
-        const size_t start = i;
-        while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
-        return i > start;
-    };
-    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
-    bool any = digits();
-    if (i < s.size() && s[i] == '.') {
-        ++i;
-        any = digits() || any;
-    }
-    if (!any) return false;
-    if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
-        ++i;
-        if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
-        if (!digits()) return false;
-    }
-    return i == s.size();
-}
 
 /// Text a spreadsheet would read as a formula in a CSV cell: it starts with =, +, - or @ and is not
 /// a plain decimal number (a numeric axis's "-0.5" stays as it is).
@@ -147,6 +132,8 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
         node.fail("name", "\"" + shortText(axis.name, 80) + "\" is not a name of 1 to " + std::to_string(kMaxAxisNameChars) +
                               " letters, digits and _ (it becomes a column name)");
     if (kReservedNames.count(axis.name)) node.fail("name", "\"" + axis.name + "\" is a column of sweep.csv already; choose another name");
+    // Its plot would be sweep_stages.png, the stages figure's file (eleventh probe: one replaced the other).
+    if (axis.name == "stages") node.fail("name", "\"stages\" would name its plot sweep_stages.png, the stages figure's file; choose another name");
     if (names.count(axis.name)) node.fail("name", "two axes are named \"" + axis.name + "\"");
     const std::string where = axisWhere(a, axis);
 
@@ -263,13 +250,6 @@ Json resolveRun(const Json& config, const std::string& file) {
 }
 
 
-/// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
-void collectIds(const Json& resolved, std::set<std::string>& ids) {
-    if (resolved.value("reference", Json(true)) != Json(false)) ids.insert("reference");
-    if (resolved.contains("algorithms") && resolved["algorithms"].is_array())
-        for (const Json& a : resolved["algorithms"])
-            if (a.is_object() && a.contains("id") && a["id"].is_string()) ids.insert(a["id"].get<std::string>());
-}
 
 std::string idList(const std::set<std::string>& ids) {
     std::string list;
@@ -329,21 +309,6 @@ std::string fileFingerprint(const std::string& path) {
     return text;
 }
 
-/// The files a glTF file's geometry comes from: itself and, for a .gltf, the buffer files its
-/// buffers name (relative, not data: URIs). A file that cannot be read names no buffers.
-std::vector<std::string> gltfFiles(const std::string& gltf) {
-    std::vector<std::string> files = {gltf};
-    try {
-        if (gltf.size() < 5 || gltf.compare(gltf.size() - 5, 5, ".gltf") != 0) return files;
-        const Json doc = JsonNode::parseFile(gltf);
-        if (doc.is_object() && doc.contains("buffers") && doc["buffers"].is_array())
-            for (const Json& b : doc["buffers"])
-                if (b.is_object() && b.contains("uri") && b["uri"].is_string() && !b["uri"].get<std::string>().starts_with("data:"))
-                    files.push_back(resolvePath(parentDir(gltf), b["uri"].get<std::string>()));
-    } catch (const InputError&) {
-    }
-    return files;
-}
 
 } // namespace
 

@@ -5,6 +5,7 @@
 #include "framework/core/Interrupt.h"
 #include "framework/experiment/Expectations.h"
 #include "framework/experiment/OutputPlace.h"
+#include "framework/sweep/SweepFile.h"
 #include "framework/sweep/SweepProcess.h"
 #include "framework/sweep/SweepText.h"
 
@@ -112,12 +113,28 @@ bool RunPaths::complete(std::string* why) const {
     } catch (const InputError& e) {
         return fail("summary.json " + e.cause());
     }
+    Json resolved;
     try {
         // The results are this run's only if the config they were made from is this run's config.
-        const std::string made = runId(JsonNode::parseFile(dir + "/config.resolved.json"));
+        resolved = JsonNode::parseFile(dir + "/config.resolved.json");
+        const std::string made = runId(resolved);
         if (made != id) return fail("the folder holds the results of another config (run " + made + "), not of this run");
     } catch (const InputError& e) {
         return fail("config.resolved.json " + e.cause());
+    }
+    // And under the ids that config gives them (eleventh probe: an id rewritten as a formula,
+    // =HYPERLINK(...), reached sweep.csv from a summary.json that was taken as complete).
+    std::set<std::string> ids;
+    collectIds(resolved, ids);
+    try {
+        const Json s = JsonNode::parseFile(summary);
+        if (s.contains("algorithms") && s["algorithms"].is_object())
+            for (const auto& [name, entry] : s["algorithms"].items())
+                if (!ids.count(name))
+                    return fail("summary.json has results under the id \"" + shortText(name, 60) +
+                                "\", which its config.resolved.json does not give");
+    } catch (const InputError& e) {
+        return fail("summary.json " + e.cause());
     }
     return true;
 }

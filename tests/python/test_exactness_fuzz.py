@@ -73,7 +73,7 @@ class RunArguments(unittest.TestCase):
             with open(os.path.join(mine, "report.json"), "w") as f:
                 f.write("my notes")
             for extra in (["--out", mine], ["--out", os.path.join(mine, "report.json")], ["--only", "nope"],
-                          ["--seconds", "-5"], ["--cases", "-1"]):
+                          ["--seconds", "-5"], ["--cases", "-1"], ["--seconds", "inf", "--cases", "0"]):
                 r = subprocess.run([sys.executable, FUZZ, "--binary", BINARY, "run", "--seconds", "5",
                                     "--out", os.path.join(tmp, "o")] + extra, capture_output=True, text=True,
                                    stdin=subprocess.DEVNULL)
@@ -81,6 +81,13 @@ class RunArguments(unittest.TestCase):
                 self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
             with open(os.path.join(mine, "report.json")) as f:
                 self.assertEqual(f.read(), "my notes")
+            # Eleventh probe: a missing binary was a traceback and exit 1, a missing replay case a
+            # failed case (exit 1), and --seconds inf with --cases 0 ran until killed (above).
+            for argv in (["--binary", os.path.join(tmp, "nope"), "run", "--seconds", "5"],
+                         ["--binary", BINARY, "replay", os.path.join(tmp, "missing.json")]):
+                r = subprocess.run([sys.executable, FUZZ] + argv, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+                self.assertEqual(r.returncode, 2, (argv, r.stderr))
+                self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
 
 
 class SummaryPixels(unittest.TestCase):
