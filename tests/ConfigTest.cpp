@@ -182,6 +182,19 @@ TEST(ConfigOverrideTest, ArrayIndicesAreDigitsWithinTheArray) {
     EXPECT_EQ(cfg["algorithms"][1]["id"], "second");
 }
 
+// Twelfth probe: "cone_deg": 0.1 was out of its own range [0.1, 89] (the bound was the float
+// 0.100000001); the bounds a message prints can be entered.
+TEST(ConfigOverrideTest, TheBoundsOfARangeAreInIt) {
+    Json cfg = {{"scene", {{"objects", Json::array({{{"procedural", "plane"}}})}}},
+                {"light", {{"type", "spot"}, {"cone_deg", 0.1}, {"position", {0, 4, 0}}}},
+                {"camera", {{"fov_y_deg", 1}}}};
+    const ExperimentConfig c = parseConfig(cfg, "c.json", false);
+    EXPECT_FLOAT_EQ(c.light.coneDeg, 0.1f);
+    cfg["light"]["cone_deg"] = 89;
+    cfg["camera"]["fov_y_deg"] = 179;
+    EXPECT_NO_THROW(parseConfig(cfg, "c.json", false));
+}
+
 // Eleventh probe: a list holding a number past a double (1e400) did not parse, was taken as bare
 // text, and was reported as "expected a list". Text that starts as JSON must be JSON: its parse
 // error is the cause; bare words stay strings.

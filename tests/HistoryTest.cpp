@@ -286,6 +286,9 @@ TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
         {[](Json& s) { s["algorithms"]["=HYPERLINK(\"x\")"] = s["algorithms"]["psv"]; }, "/algorithms"},
         {[](Json& s) { s["started_utc"] = "2026-13-45T99:99:99Z"; }, "/started_utc"},
         {[](Json& s) { s["started_utc"] = "2025-02-29T10:00:00Z"; }, "/started_utc"},
+        // Twelfth probe: a 200,000-character stage name was written whole into compare.md.
+        {[](Json& s) { s["algorithms"]["psv"]["time_ms"][std::string(200000, 'A')] = {{"mean", 1.0}}; }, "/algorithms/psv/time_ms"},
+        {[](Json& s) { s["algorithms"]["psv"]["counters"]["<img onerror=x>"] = {{"mean", 1.0}}; }, "/algorithms/psv/counters"},
     };
     for (const auto& [change, path] : edits) {
         SCOPED_TRACE(path);

@@ -73,7 +73,7 @@ std::vector<BadCase> badCases() {
          configWith({{"scene", R"({"objects": [{"procedural": "plane", "size": [4, 4]},
              {"procedural": "mesh", "vertices": [[-1, 0, -0.5], [1, 0, -0.5], [1, 1.5, -0.5], [-1, 0, -0.5], [1, 1.5, -0.5], [-1, 1.5, -0.5]]}]})"},
                      {"light", R"({"position": [0.3, 1.0, -0.5000001]})"}}),
-         {"/light/position", "from triangle 3", "frame 0", "under 1.25 x the ray offset"}},
+         {"/light/position", "from triangle 3", "frame 0", "1.25 x the ray offset"}},
         {"LightPathOntoTheGround", "c.json",
          configWith({{"light", R"({"type": "spot", "target": [0, 0, 0], "path": {"keyframes": [
              {"time": 0, "position": [0, 4, 0]}, {"time": 1, "position": [0.5, 0, 0.5]}]}})"},
@@ -85,6 +85,8 @@ std::vector<BadCase> badCases() {
               "path": {"interpolation": "step", "keyframes": [{"time": 0, "translate": [0, 0, -1]}, {"time": 1, "translate": [0, 0, 0.5]}]}}]})"},
                      {"light", R"({"position": [0, 1, 0.50001]})"}, {"frames", "2"}}),
          {"/light/position", "from triangle 2", "frame 1"}},
+        // Twelfth probe: the parser stopped at a NUL byte, so a file with garbage after one passed.
+        {"NulThenGarbage", "c.json", configWith({}) + std::string("\0 {{{ garbage", 13), {"NUL byte at byte"}},
         {"DegenerateLightPath", "c.json",
          configWith({{"light", R"({"type": "directional", "path": {"keyframes": [
              {"time": 0, "position": [0, 5, 0], "target": [0, 0, 0]},

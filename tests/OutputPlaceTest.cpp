@@ -341,6 +341,11 @@ TEST(OutputPlaceTest, ForceReplacesOnlyWhatTheOutputWroteNeverAFileAddedToIt) {
     fs::create_directories(out + "/mydata");
     EXPECT_NE(errorOf(out, true).find("\"mydata\""), std::string::npos);
     fs::remove(out + "/mydata");
+    // Twelfth probe: inside the output's own folders too.
+    std::ofstream(out + "/images/mine.txt") << "mine";
+    EXPECT_NE(errorOf(out, true).find("\"images/mine.txt\""), std::string::npos);
+    EXPECT_EQ(slurp(out + "/images/mine.txt"), "mine");
+    fs::remove(out + "/images/mine.txt");
 
     OutputPlace p = OutputPlace::open(out, true);
     std::ofstream(p.partialDir() + "/summary.json") << "third";

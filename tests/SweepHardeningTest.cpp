@@ -420,11 +420,19 @@ TEST(SweepStateTest, ResultsUnderAnIdTheConfigDoesNotGiveAreAFailedRun) {
     forged["algorithms"]["=HYPERLINK(\"http://evil\",\"x\")"] = forged["algorithms"]["psv"];
     forged["algorithms"].erase("psv");
     std::ofstream(summary, std::ios::trunc) << forged.dump();
+    // Twelfth probe: a 100,000-character stage name reached sweep.csv and crashed the plots.
+    const std::string other = out + "/runs/" + plan["runs"][2]["id"].get<std::string>() + "/summary.json";
+    Json longStage = JsonNode::parseFile(other);
+    longStage["algorithms"]["psv"]["time_ms"][std::string(100000, 'S')] = {{"mean", 1.0}};
+    std::ofstream(other, std::ios::trunc) << longStage.dump();
     const Ran r = runArgs(sweep({"merge", out, "--no-plots"}));
     EXPECT_EQ(r.rc, 1) << r.err;
     EXPECT_NE(r.err.find("which its config.resolved.json does not give"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("3 of 4 runs merged (1 failed)"), std::string::npos) << r.err;
-    EXPECT_EQ(test::readText(out + "/sweep.csv").find("HYPERLINK"), std::string::npos);
+    EXPECT_NE(r.err.find("/algorithms/psv/time_ms: the name \"SSSS"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("2 of 4 runs merged (2 failed)"), std::string::npos) << r.err;
+    const std::string csv = test::readText(out + "/sweep.csv");
+    EXPECT_EQ(csv.find("HYPERLINK"), std::string::npos);
+    EXPECT_EQ(csv.find("SSSSSSSS"), std::string::npos);
 }
 
 TEST(SweepStateTest, AStaleErrorRecordBesideACompleteRunIsIgnoredAndRemoved) {

@@ -135,6 +135,10 @@ private:
 } // namespace
 
 Json parseJson(const std::string& text, const std::string& file, const JsonLimits& limits) {
+    // nlohmann's lexer ends the input at a NUL byte (twelfth probe: a config, sweep file, glTF or
+    // summary.json with a NUL and garbage after it was read up to the NUL and accepted).
+    if (const size_t nul = text.find('\0'); nul != std::string::npos)
+        throw InputError(file, "", "holds a NUL byte at byte " + std::to_string(nul) + " (JSON is text; the file is cut or not JSON)");
     StrictSax sax(file, limits);
     bool ok = Json::sax_parse(text, &sax, nlohmann::detail::input_format_t::json, true, false);
     if (!ok || !sax.errorCause.empty())

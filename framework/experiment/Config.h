@@ -73,6 +73,9 @@ const char* toString(ExperimentConfig::Statistics s);
 /// first would make "-A1" a formula in sweep.csv), so a summary.json whose ids break it is no
 /// run's (compare, history and sweep merge refuse it).
 bool isAlgorithmId(const std::string& id);
+/// Whether `name` can be a stage's or a counter's name in summary.json: the same rule as an id
+/// (they are columns, table rows and measure names; the algorithms' own are lower-case words).
+inline bool isMeasureName(const std::string& name) { return isAlgorithmId(name); }
 
 /// "frame F (time T s)", as errors about one frame name it.
 std::string frameText(const ExperimentConfig& config, int frame);
@@ -83,8 +86,10 @@ void checkPoseBounds(const ExperimentConfig& config, int frame, const Bounds& b)
 /// Limits of camera and light values, shared by the parser and the GUI's widgets (so whatever the
 /// widgets allow can be saved as a config).
 namespace configlimits {
-constexpr float kFovMinDeg = 1.0f, kFovMaxDeg = 179.0f;
-constexpr float kConeMinDeg = 0.1f, kConeMaxDeg = 89.0f;
+// Doubles, as the parser reads numbers: a float 0.1 is 0.100000001, and "cone_deg": 0.1 was out of
+// its own range [0.1, 89] (twelfth probe).
+constexpr double kFovMinDeg = 1.0, kFovMaxDeg = 179.0;
+constexpr double kConeMinDeg = 0.1, kConeMaxDeg = 89.0;
 constexpr int kAreaSamplesMin = 1, kAreaSamplesMax = 1024;
 constexpr int kResolutionMin = 8, kResolutionMax = 8192; ///< each side of a frame, pixels
 } // namespace configlimits

@@ -149,9 +149,9 @@ void checkLightClearance(const ExperimentConfig& c) {
             throw InputError(c.file, c.lightPath.empty() ? "/light/position" : "/light/path",
                              "the light is " + number(closest.distance) + " from triangle " + std::to_string(closest.triangle) +
                                  " (nearest point [" + number(closest.point.x) + ", " + number(closest.point.y) + ", " +
-                                 number(closest.point.z) + "]) at " + frameText(c, f) + ", under 1.25 x the ray offset (" +
-                                 number(clearance / kClearance) + "), where the reference's shadow rays end and the "
-                                 "volume algorithms' do not: move it off the surface or lower ray_offset");
+                                 number(closest.point.z) + "]) at " + frameText(c, f) + ": keep it 1.25 x the ray offset (" +
+                                 number(clearance / kClearance) + ") from every surface or lower ray_offset (the "
+                                 "reference's shadow rays end that short of the light, the volume algorithms' do not)");
         if (!changes || f == c.frames - 1) break;
     }
 }

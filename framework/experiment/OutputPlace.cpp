@@ -11,6 +11,7 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <set>
+#include <vector>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -142,30 +143,38 @@ bool writeMark(const fs::path& path) {
     return ::close(fd) == 0;
 }
 
-/// What an output wrote at its top level, listed in its mark when it is committed: --force then
-/// replaces only an output that holds nothing else (eleventh probe: a user's notes.txt and folder
-/// put into a run's output were deleted with it by the next run --force).
+/// What an output wrote, every file and folder in it, listed in its mark when it is committed:
+/// --force then replaces only an output that holds nothing else (eleventh and twelfth probes: a
+/// user's notes.txt, folder, or file in images/ put into a run's output were deleted with it by
+/// the next run --force).
 constexpr const char* kManifestHeader = "shadowlab-output, entries:";
+
+/// The paths inside `dir`, relative to it, its marks left out (links are listed, not followed).
+std::vector<std::string> entriesOf(const fs::path& dir) {
+    std::vector<std::string> out;
+    std::error_code ec;
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+        const std::string name = it->path().lexically_relative(dir).string();
+        if (name != kOutputMark && name != kPartialMark) out.push_back(name);
+    }
+    return out;
+}
 
 void writeManifest(const fs::path& dir) {
     std::string text = std::string(kManifestHeader) + "\n";
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(dir, ec)) {
-        const std::string name = entry.path().filename().string();
-        if (name != kOutputMark && name != kPartialMark) text += name + "\n";
-    }
+    for (const std::string& name : entriesOf(dir)) text += name + "\n";
     const int fd = ::open((dir / kOutputMark).c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC | O_NOFOLLOW);
     if (fd < 0) return;  // the mark stays empty: the output is then replaced whole, as before the list
     (void)!::write(fd, text.data(), text.size());
     ::close(fd);
 }
 
-/// The first top-level entry of the output `dir` that its mark does not list: "" when there is
-/// none, or when the mark lists nothing (an output from before the list is replaced whole).
+/// The first path in the output `dir` that its mark does not list: "" when there is none, or when
+/// the mark lists nothing (an output from before the list is replaced whole).
 std::string foreignEntry(const fs::path& dir) {
     std::string text;
     try {
-        text = readInputFile((dir / kOutputMark).string(), 1 << 20);
+        text = readInputFile((dir / kOutputMark).string(), size_t(64) << 20);
     } catch (const std::exception&) {
         return "";
     }
@@ -177,11 +186,8 @@ std::string foreignEntry(const fs::path& dir) {
         listed.insert(text.substr(at, end == std::string::npos ? std::string::npos : end - at));
         at = end == std::string::npos ? text.size() : end + 1;
     }
-    std::error_code ec;
-    for (const auto& entry : fs::directory_iterator(dir, ec)) {
-        const std::string name = entry.path().filename().string();
-        if (name != kOutputMark && !listed.count(name)) return name;
-    }
+    for (const std::string& name : entriesOf(dir))
+        if (!listed.count(name)) return name;
     return "";
 }
 

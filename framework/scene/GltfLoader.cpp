@@ -1139,6 +1139,10 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
     bool binary = magic;  // a .gltf that is really binary loads too
 
     std::string jsonText = binary ? glbJson(file, bytes) : std::string(bytes.begin(), bytes.end());
+    // The GLB spec pads the JSON chunk with spaces; some exporters pad it with NULs, which parseJson
+    // refuses anywhere else (it would end the text there): trailing ones are padding.
+    if (binary)
+        while (!jsonText.empty() && jsonText.back() == '\0') jsonText.pop_back();
     // Depth and size are checked before tinygltf sees the text: its reader recurses into "extras"
     // and would overflow the stack on a document nested tens of thousands deep.
     JsonLimits limits;

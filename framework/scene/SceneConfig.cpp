@@ -299,7 +299,9 @@ Builder parseGenerator(JsonNode& node, const std::string& kind, const Material& 
     if (kind == "torus") {
         float major = positive(node, "major_radius", 1.0), minor = positive(node, "minor_radius", 0.3);
         // A tube reaching the axis (horn or spindle torus) is not a closed surface any more.
-        if (!(minor < major)) node.fail("minor_radius", "must be smaller than major_radius");
+        if (!(minor < major))
+            node.fail("minor_radius", "must be smaller than major_radius (as floats they are " + shortNumber(minor, 9) + " and " +
+                                          shortNumber(major, 9) + ")");
         int n = triangles(2000);
         return Builder{[=] { return makeTorus(major, minor, n, m); },
                        [=] { return torusTessellation(major, minor, n).triangles(); }};
