@@ -7,13 +7,48 @@ Text drawn from user text (ids, names, labels, stages, units) is drawn as writte
 module turns off matplotlib's math parser (plain_text()), so that a '$' in a name neither renders
 as math nor fails the plot ("Expected \\frac{num}{den}").
 """
+import math
+
 import matplotlib
 import matplotlib.colors as mcolors
+import matplotlib.scale
+import matplotlib.ticker
+
+_SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
+
+
+def plain_number(x):
+    """A log axis's tick as plain text: 10 to a power as 10³, 10⁻², others as %g."""
+    if x > 0:
+        k = round(math.log10(x))
+        if abs(math.log10(x) - k) < 1e-9:
+            return {0: "1", 1: "10"}.get(k, "10" + str(k).translate(_SUPERSCRIPT))
+    return f"{x:g}"
+
+
+class PlainLogFormatter(matplotlib.ticker.LogFormatter):
+    """Matplotlib's log tick labels are mathtext ($\\mathdefault{10^{2}}$), which plain_text()
+    turns off, so they were drawn as that source (thirteenth probe): these are plain text. Which
+    ticks get a label is LogFormatter's choice; only the text differs."""
+
+    def _num_to_string(self, x, vmin, vmax):
+        return plain_number(x)
+
+
+class PlainLogScale(matplotlib.scale.LogScale):
+    """The log scale ("log"), its tick labels plain text."""
+
+    def set_default_locators_and_formatters(self, axis):
+        super().set_default_locators_and_formatters(axis)
+        axis.set_major_formatter(PlainLogFormatter(self.base))
+        axis.set_minor_formatter(PlainLogFormatter(self.base, labelOnlyBase=(self.subs is not None)))
 
 
 def plain_text():
-    """Every text made from now on is plain text: '$...$' is not mathtext (matplotlib >= 3.5)."""
+    """Every text made from now on is plain text: '$...$' is not mathtext (matplotlib >= 3.5), and
+    log axes label their ticks in plain text too."""
     matplotlib.rcParams["text.parse_math"] = False
+    matplotlib.scale.register_scale(PlainLogScale)
 
 
 plain_text()

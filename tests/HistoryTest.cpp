@@ -210,6 +210,22 @@ TEST(HistoryTest, AFolderNameIsShownAsTextWhenItNamesARun) {
     EXPECT_NE(md.find("\\[x\\]\\(javascript\\:alert\\(1\\)\\)"), std::string::npos) << md;
 }
 
+// Thirteenth probe: a tampered commit (100,000 characters and a bidi override) and renderer were
+// written whole into history.json. A commit that is not hex is no build's; text is bounded.
+TEST(HistoryTest, ACommitOrRendererNoRunWritesIsNotCopied) {
+    const std::string dir = test::makeTempDir("history-commit");
+    writeRuns(dir, {20, 20}, {0, 0}, kSpread);
+    Json s = summaryOf(20, 0, kSpread, 3, std::string(100000, 'c') + "\u202E<script>", "2026-12-09T10:00:00Z");
+    s["renderer"] = std::string(300000, 'R');
+    fs::create_directories(dir + "/tampered");
+    std::ofstream(dir + "/tampered/summary.json") << s.dump();
+    const History h = readHistory(dir, {});
+    ASSERT_EQ(h.runs.size(), 3u);
+    EXPECT_EQ(h.runs[2]["commit"], "unknown");
+    EXPECT_LE(h.runs[2]["renderer"].get<std::string>().size(), 110u);
+    EXPECT_EQ(h.runs[2]["label"], "tampered");
+}
+
 TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
     const std::string dir = test::makeTempDir("history-bad");
     writeRuns(dir, {20}, {0}, kSpread);
@@ -331,6 +347,7 @@ TEST(HistoryTest, NeitherHistoryNorCompareReplacesARunItReads) {
     // by the report. Only an earlier report of the same command is replaced.
     const std::string other = test::makeTempDir("history-other-run") + "/run";
     fs::copy(a, other, fs::copy_options::recursive);
+    std::ofstream(other + "/.shadowlab-output");  // as a run marks its output
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"compare", a, b, "--out", other, "--force"}, {"history", dir, "--out", other, "--force"}}) {
         std::vector<std::string> argv{SHADOWLAB_BINARY};

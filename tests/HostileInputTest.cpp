@@ -236,6 +236,23 @@ std::vector<BadCase> badCases() {
         // Sixth probe: a skinned mesh was drawn in its bind pose, morph targets with weights were dropped.
         {"GltfSkinnedMesh", "m.gltf", test::triangleGltf({{"nodes", R"([{"mesh": 0, "skin": 0}])"}, {"skins", R"([{"joints": [0]}])"}}),
          {"m.gltf", "/nodes/0/skin", "skinned meshes are not supported"}},
+        // Thirteenth probe: a vertex placed at 1e20 overflowed its triangle's cross product and the
+        // triangle was dropped as degenerate, silently (1e16 to 1e19 were refused).
+        {"GltfVertexPlacedAt1e20", "m.gltf", test::triangleGltf({{"nodes", R"([{"mesh": 0, "scale": [1e20, 1, 1]}])"}}),
+         {"m.gltf", "/meshes/0/primitives/0", "beyond ±1e15"}},
+        // Thirteenth probe: a sparse object without values got tinygltf's message, without a path; a
+        // repeated sparse index let a later value hide an infinite one.
+        {"GltfSparseWithoutValues", "m.gltf",
+         test::triangleGltf({{"accessors", R"([{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3,
+             "sparse": {"count": 1, "indices": {"bufferView": 0, "componentType": 5125}}}])"}}),
+         {"m.gltf", "/accessors/0/sparse/values"}},
+        {"GltfSparseIndexRepeated", "m.gltf",
+         test::triangleGltf({{"buffers", R"([{"byteLength": 68, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAQAAAAEAAAAAAIB/AAAAAAAAAAAAAABAAAAAAAAAAAA="}])"},
+                             {"bufferViews", R"([{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 8},
+                                                 {"buffer": 0, "byteOffset": 44, "byteLength": 24}])"},
+                             {"accessors", R"([{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3, "min": [0, 0, 0], "max": [2, 1, 0],
+                                 "sparse": {"count": 2, "indices": {"bufferView": 1, "componentType": 5125}, "values": {"bufferView": 2}}}])"}}),
+         {"m.gltf", "/accessors/0/sparse/indices", "strictly increase"}},
         {"GltfMorphWeightsOnTheMesh", "m.gltf",
          test::triangleGltf({{"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": 0}]}], "weights": [0.5]}])"}}),
          {"m.gltf", "/meshes/0/weights", "non-zero weight"}},

@@ -188,6 +188,33 @@ TEST(RunSafetyTest, ForceNeverReplacesAFolderHoldingAGltfsBufferFile) {
     EXPECT_NE(log.find("tri.bin"), std::string::npos) << log;
     EXPECT_TRUE(fs::exists(f.out + "/tri.bin"));
     f.expectPreviousKept();
+    // Thirteenth probe: the same buffer named percent-encoded (out%2Ftri.bin), as the reader decodes it.
+    std::ofstream(f.base + "/tri.gltf", std::ios::trunc) << test::triangleGltf(
+        {{"buffers", R"([{"byteLength": 36, "uri": "out%2Ftri.bin"}])"},
+         {"accessors", R"([{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3, "min": [-1, 0.5, -1], "max": [1, 0.5, 1]}])"}});
+    EXPECT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " run " + f.config + " --out " + f.out + " --force --no-progress", log), 2)
+        << log;
+    EXPECT_NE(log.find("tri.bin"), std::string::npos) << log;
+    EXPECT_TRUE(fs::exists(f.out + "/tri.bin"));
+    f.expectPreviousKept();
+}
+
+// Thirteenth probe: run --force replaced a compare or history output with a run, and deleted the
+// user's files in a run's output whose mark was gone (copied without its dot files). Each refused.
+TEST(RunSafetyTest, ForceReplacesOnlyAMarkedRunOutput) {
+    Fixture f("force-kind", 1);
+    const std::string bin = SHADOWLAB_BINARY, cmp = f.base + "/cmp";
+    std::string log;
+    ASSERT_EQ(test::runCommand(bin + " compare " + f.out + " " + f.out + " --out " + cmp, log), 0) << log;
+    EXPECT_EQ(test::runCommand(bin + " run " + f.config + " --out " + cmp + " --force --no-progress", log), 2) << log;
+    EXPECT_NE(log.find("another command's output (compare's"), std::string::npos) << log;
+    EXPECT_TRUE(fs::exists(cmp + "/compare.md"));
+    EXPECT_EQ(test::runCommand(bin + " validate " + f.config + " --set output.dir=" + cmp + " >/dev/null", log), 2) << log;
+    fs::remove(f.out + "/.shadowlab-output");
+    std::ofstream(f.out + "/notes.txt") << "mine\n";
+    EXPECT_EQ(test::runCommand(bin + " run " + f.config + " --out " + f.out + " --force --no-progress", log), 2) << log;
+    EXPECT_NE(log.find("not a shadowlab output"), std::string::npos) << log;
+    EXPECT_EQ(slurp(f.out + "/notes.txt"), "mine\n");
 }
 
 // Sixth probe: validate accepted an output.dir run could not make (/proc/x); a plotter that exits

@@ -231,7 +231,10 @@ int run(const std::vector<std::string>& args) {
     // A place from the config is named as validate names it: the config and /output/dir.
     OutputPlace place = [&] {
         try {
-            if (opt.force) refuseInputsInsideReplacedOutput(config, overrides, opt.outputDir.empty() ? cfg.outputDir : opt.outputDir);
+            const std::string dir = opt.outputDir.empty() ? cfg.outputDir : opt.outputDir;
+            if (opt.force) refuseInputsInsideReplacedOutput(config, overrides, dir);
+            // A compare or history output is not a run's to replace (thirteenth probe).
+            if (opt.force) OutputPlace::refuseOtherKind(dir, "summary.json", "run");
             return OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes,
                                      overrides.empty() ? config : std::string());
         } catch (const InputError& e) {
@@ -321,6 +324,7 @@ int validate(const std::string& config, const std::vector<std::string>& override
     try {
         OutputPlace::check(cfg.outputDir, overrides.empty() ? config : std::string());
         OutputPlace::checkReplaceable(cfg.outputDir);
+        OutputPlace::refuseOtherKind(cfg.outputDir, "summary.json", "run");
         refuseInputsInsideReplacedOutput(config, overrides, cfg.outputDir);
     } catch (const InputError& e) {
         throw InputError(config, "/output/dir", e.cause());

@@ -81,12 +81,14 @@ Json runRecord(const RunRecord& r) {
     const bool dirty = build.is_object() && build.value("dirty", false);
     const bool known = commit.size() >= 7 && commit.size() <= 64 && commit.find_first_not_of("0123456789abcdef") == std::string::npos;
     return {{"folder", validUtf8(r.folder)},
-            {"commit", validUtf8(commit)},
+            // A commit is hex; anything else is no build's (thirteenth probe: 100,000 characters and a
+            // bidi override were written whole into history.json).
+            {"commit", known ? commit : std::string("unknown")},
             {"dirty", dirty},
             // The commit names a run when the build knew it; a folder name otherwise.
             {"label", known ? commit.substr(0, 10) + (dirty ? "+" : "") : shortText(r.folder, 40)},
             {"started_utc", validUtf8(r.summary.value("started_utc", std::string()))},
-            {"renderer", validUtf8(r.summary.value("renderer", std::string()))}};
+            {"renderer", shortText(r.summary.value("renderer", std::string()), 100)}};
 }
 
 double mismatchOf(const Json& entry) {

@@ -66,23 +66,14 @@ bool isRegularFile(const fs::path& path) {
     return ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-/// An output written before the mark existed: its summary.json a regular file holding a JSON object
-/// with the "complete" and "algorithms" keys every run's summary has (`{}` is nobody's summary).
-bool isLegacyOutput(const fs::path& dir) {
-    if (!isRegularFile(dir / "summary.json")) return false;
-    try {
-        const Json j = JsonNode::parseFile((dir / "summary.json").string());
-        return j.is_object() && j.contains("complete") && j.contains("algorithms");
-    } catch (const std::exception&) {
-        return false;
-    }
-}
 
-/// A run's output (or an empty directory, which holds nothing to lose).
+/// A run's output (or an empty directory, which holds nothing to lose). One without the mark (an
+/// older build's, or one copied without its dot files) is not: what it holds beyond a run's files
+/// cannot be told, and --force deleted a user's files in it (thirteenth probe).
 bool isShadowlabOutput(const fs::path& dir) {
     std::error_code ec;
     if (fs::is_empty(dir, ec) && !ec) return true;
-    return isRegularFile(dir / kOutputMark) || isLegacyOutput(dir);
+    return isRegularFile(dir / kOutputMark);
 }
 
 /// Whether another run holds `lockPath` now: its holder keeps an exclusive flock for the whole run,
@@ -443,7 +434,7 @@ void OutputPlace::checkReplaceable(const std::string& given) {
         throw InputError(shortPath(dir), "", "the directory holds " + inside + "; --force replaces only a single run's output");
     if (!output)
         throw InputError(shortPath(dir), "", "the directory exists and is not a shadowlab output (no " + std::string(kOutputMark) +
-                                  " mark, nor a summary.json of a run); --force replaces only outputs");
+                                  " mark: a folder of yours, or an output copied without it); --force replaces only outputs");
     if (const std::string foreign = foreignEntry(finalPath); !foreign.empty())
         throw InputError(shortPath(dir), "", "the output holds \"" + shortText(foreign, 80) +
                                                  "\", which it did not write; --force would delete it with the rest: move it out first");
@@ -452,10 +443,16 @@ void OutputPlace::checkReplaceable(const std::string& given) {
 void OutputPlace::refuseOtherKind(const std::string& given, const std::string& ownFile, const std::string& command) {
     const fs::path dir(normalize(given));
     std::error_code ec;
-    if (!fs::is_directory(fs::symlink_status(dir, ec)) || !isShadowlabOutput(dir) || isRegularFile(dir / ownFile)) return;
+    if (!fs::is_directory(fs::symlink_status(dir, ec)) || fs::is_empty(dir, ec) || !isShadowlabOutput(dir) ||
+        isRegularFile(dir / ownFile))
+        return;
+    std::string whose = "not " + command + "'s";
+    for (const auto& [file, kind] : {std::pair<const char*, const char*>{"summary.json", "a run's"}, {"compare.md", "compare's"},
+                                     {"history.md", "history's"}})
+        if (isRegularFile(dir / file)) whose = std::string(kind) + ": it holds " + file;
     throw InputError(shortPath(dir.string()), "",
-                     "is another command's output (" + std::string(isRegularFile(dir / "summary.json") ? "a run's: it holds summary.json" : "not " + command + "'s") +
-                         "); --force replaces only an earlier " + command + " output: choose another --out");
+                     "is another command's output (" + whose + "); --force replaces only an earlier " + command +
+                         " output: choose another --out");
 }
 
 void OutputPlace::check(const std::string& given, const std::string& runConfig) {

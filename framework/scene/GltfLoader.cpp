@@ -59,10 +59,13 @@ const Schema kNodeS{{"camera", Kind::Uint}, {"skin", Kind::Uint}, {"mesh", Kind:
 const Schema kPrimitiveS{{"attributes", Kind::UintMap, nullptr, kRequired}, {"indices", Kind::Uint}, {"material", Kind::Uint},
                          {"mode", Kind::Uint}, {"targets", Kind::UintMapArray}};
 const Schema kMeshS{{"primitives", Kind::ObjectArray, &kPrimitiveS}, {"weights", Kind::NumberArray}};
-const Schema kSparseIndicesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint}};
-const Schema kSparseValuesS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}};
-const Schema kSparseS{{"count", Kind::Uint}, {"indices", Kind::Object, &kSparseIndicesS},
-                      {"values", Kind::Object, &kSparseValuesS}};
+// What the spec requires of a sparse object is required here, named by its path (thirteenth probe:
+// one without "values" got tinygltf's message, without a path).
+const Schema kSparseIndicesS{{"bufferView", Kind::Uint, nullptr, kRequired}, {"byteOffset", Kind::Uint},
+                             {"componentType", Kind::Uint, nullptr, kRequired}};
+const Schema kSparseValuesS{{"bufferView", Kind::Uint, nullptr, kRequired}, {"byteOffset", Kind::Uint}};
+const Schema kSparseS{{"count", Kind::Uint, nullptr, kRequired}, {"indices", Kind::Object, &kSparseIndicesS, kRequired},
+                      {"values", Kind::Object, &kSparseValuesS, kRequired}};
 const Schema kAccessorS{{"bufferView", Kind::Uint}, {"byteOffset", Kind::Uint}, {"componentType", Kind::Uint, nullptr, kRequired},
                         {"normalized", Kind::Bool}, {"count", Kind::Uint, nullptr, kRequired}, {"type", Kind::String, nullptr, kRequired},
                         {"max", Kind::NumberArray}, {"min", Kind::NumberArray}, {"sparse", Kind::Object, &kSparseS}};
@@ -259,22 +262,6 @@ size_t glbBinLength(const std::vector<unsigned char>& bytes) {
     return size_t(readU32(bytes, json));
 }
 
-/// A uri's percent-encoded characters decoded, as the reader decodes a buffer file's name (tinygltf's
-/// urldecode: "%XX" is a byte, "+" a space).
-std::string percentDecoded(const std::string& uri) {
-    auto hex = [](char c) { // a non-hex digit counts 0, as there
-        if (c >= '0' && c <= '9') return c - '0';
-        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-        return c >= 'A' && c <= 'F' ? c - 'A' + 10 : 0;
-    };
-    std::string out;
-    for (size_t i = 0; i < uri.size(); ++i) {
-        if (uri[i] == '+') out += ' ';
-        else if (uri[i] == '%' && i + 2 < uri.size()) out += char((hex(uri[i + 1]) << 4) | hex(uri[i + 2])), i += 2;
-        else out += uri[i];
-    }
-    return out;
-}
 
 /// The largest buffer file read (what readInputFileBytes is given below: a glTF byteLength is a uint32 in practice).
 constexpr size_t kMaxBufferFileBytes = 0xFFFFFFF0u;
@@ -850,8 +837,8 @@ void Loader::validateAccessor(size_t i) {
     }
     if (!a.sparse.isSparse) return;
     const auto& s = a.sparse;
-    if (s.count < 1 || size_t(s.count) > a.count)
-        fail(path + "/sparse/count", "sparse count " + std::to_string(s.count) + " is outside [1, count]");
+    if (s.count < 1 || size_t(s.count) > a.count)  // tinygltf's int: a count past 2^31 reads negative, so not echoed
+        fail(path + "/sparse/count", "the sparse count is outside [1, " + std::to_string(a.count) + "] (the accessor's count)");
     checkIndex(s.indices.bufferView, m_.bufferViews, path + "/sparse/indices/bufferView", "bufferView");
     checkIndex(s.values.bufferView, m_.bufferViews, path + "/sparse/values/bufferView", "bufferView");
     int isz = tinygltf::GetComponentSizeInBytes(uint32_t(s.indices.componentType));
@@ -941,12 +928,19 @@ std::vector<unsigned char> Loader::gather(int index) const {
         const unsigned char* ib = m_.buffers[size_t(ibv.buffer)].data.data() + ibv.byteOffset + size_t(s.indices.byteOffset);
         const unsigned char* vb = m_.buffers[size_t(vbv.buffer)].data.data() + vbv.byteOffset + size_t(s.values.byteOffset);
         size_t isz = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(s.indices.componentType)));
-        for (size_t k = 0; k < size_t(s.count); ++k) {
+        for (size_t k = 0, previous = 0; k < size_t(s.count); ++k) {
             uint32_t target = 0;
             std::memcpy(&target, ib + k * isz, isz);  // little-endian: low bytes first
             if (target >= a.count)
                 fail(at("accessors", size_t(index)) + "/sparse/indices",
                      "sparse index " + std::to_string(target) + " is out of range");
+            // Strictly increasing, as the spec requires (thirteenth probe: a repeated index let a later
+            // value replace an infinite one, which was never reported).
+            if (k > 0 && target <= previous)
+                fail(at("accessors", size_t(index)) + "/sparse/indices",
+                     "sparse index " + std::to_string(target) + " at element " + std::to_string(k) + " does not follow " +
+                         std::to_string(previous) + " (sparse indices strictly increase)");
+            previous = target;
             std::memcpy(out.data() + target * elem, vb + k * elem, elem);
         }
     }
@@ -1047,7 +1041,15 @@ size_t Loader::emitPrimitive(Scene& scene, size_t mi, size_t pi, const glm::mat4
     tri.reserve(triCount * 3);
     for (size_t k = 0; k < triCount; ++k) {
         glm::vec3 v[3];
-        for (int c = 0; c < 3; ++c) v[c] = glm::vec3(world * glm::vec4(pos[corner(k, c)], 1.0f));
+        for (int c = 0; c < 3; ++c) {
+            v[c] = glm::vec3(world * glm::vec4(pos[corner(k, c)], 1.0f));
+            // Beyond the coordinates every input is held to, a triangle's cross product overflows and
+            // it was dropped as degenerate, silently (thirteenth probe: a vertex at 1e20).
+            for (int a = 0; a < 3; ++a)
+                if (!(std::abs(double(v[c][a])) <= kMaxCoordinate))
+                    fail(path, "triangle " + std::to_string(k) + " has a vertex at " + shortNumber(double(v[c][a])) +
+                                   " once placed by its nodes, beyond ±1e15 scene units");
+        }
         if (mirrored) std::swap(v[1], v[2]);
         tri.insert(tri.end(), {v[0], v[1], v[2]});
     }
@@ -1126,6 +1128,23 @@ Scene Loader::run(GltfStats* stats) {
 }
 
 } // namespace
+
+/// A uri's percent-encoded characters decoded, as the reader decodes a buffer file's name (tinygltf's
+/// urldecode: "%XX" is a byte, "+" a space).
+std::string percentDecoded(const std::string& uri) {
+    auto hex = [](char c) { // a non-hex digit counts 0, as there
+        if (c >= '0' && c <= '9') return c - '0';
+        if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+        return c >= 'A' && c <= 'F' ? c - 'A' + 10 : 0;
+    };
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '+') out += ' ';
+        else if (uri[i] == '%' && i + 2 < uri.size()) out += char((hex(uri[i + 1]) << 4) | hex(uri[i + 2])), i += 2;
+        else out += uri[i];
+    }
+    return out;
+}
 
 Scene loadGltf(const std::string& file) { return loadGltf(file, nullptr); }
 

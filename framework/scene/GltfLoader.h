@@ -47,4 +47,8 @@ struct GltfMotion {
 /// big mesh can ask for billions).
 Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles = 200'000'000, const GltfMotion& motion = {});
 
+/// A buffer or image uri's percent-encoded characters decoded, as the reader decodes a file's name
+/// (tinygltf's urldecode: "%XX" is a byte, "+" a space): the file it names, relative to the glTF's folder.
+std::string percentDecoded(const std::string& uri);
+
 } // namespace shadowlab

@@ -699,7 +699,7 @@ std::vector<std::string> gltfFiles(const std::string& gltf) {
         if (doc.is_object() && doc.contains("buffers") && doc["buffers"].is_array())
             for (const Json& b : doc["buffers"])
                 if (b.is_object() && b.contains("uri") && b["uri"].is_string() && !b["uri"].get<std::string>().starts_with("data:"))
-                    files.push_back(resolvePath(parentDir(gltf), b["uri"].get<std::string>()));
+                    files.push_back(resolvePath(parentDir(gltf), percentDecoded(b["uri"].get<std::string>())));
     } catch (const InputError&) {
     }
     return files;
