@@ -363,6 +363,27 @@ TEST(SweepTest, EditingAGltfFileGivesItsRunsNewIds) {
     EXPECT_EQ(countOf(log, "] skip"), 0u) << log;
 }
 
+// Thirteenth probe: a buffer file named percent-encoded ("my%20buf.bin") was left out of the run's
+// id, so a model edited between two sweep runs kept its stale results.
+TEST(SweepTest, EditingAPercentEncodedBufferFileGivesItsRunsNewIds) {
+    const std::string dir = test::makeTempDir("sweep-buffer-edit");
+    auto writeBuffer = [&](float y) {
+        const float pos[9] = {-1, y, -1, -1, y, 1, 1, y, -1};
+        std::ofstream(dir + "/my buf.bin", std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(pos), sizeof pos);
+    };
+    writeBuffer(0.5f);
+    std::ofstream(dir + "/m.gltf") << test::triangleGltf(
+        {{"buffers", R"([{"byteLength": 36, "uri": "my%20buf.bin"}])"},
+         {"accessors", R"([{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3, "min": [-1, 0, -1], "max": [1, 1, 1]}])"}});
+    Json sweep = test::twoRunSweep();
+    sweep["base"]["scene"]["objects"][1] = Json::parse(R"({"gltf": "m.gltf"})");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", sweep);
+    const Json before = plan(file);
+    writeBuffer(0.75f);
+    const Json after = plan(file);
+    for (size_t k = 0; k < 2; ++k) EXPECT_NE(before["runs"][k]["id"], after["runs"][k]["id"]) << k;
+}
+
 TEST(SweepTest, SigtermStopsTheRunsInFlightAndTheSweepResumes) {
     const std::string dir = test::makeTempDir("sweep-term");
     const std::string file = test::writeJson(dir + "/s.sweep.json", test::smallSweep()), out = dir + "/out";
