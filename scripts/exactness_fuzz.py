@@ -737,6 +737,11 @@ def check_run_args(args, sl):
     unknown = [a for a in args.only if a not in known]
     if unknown:
         return f"--only: not an exact algorithm: {unknown[0][:60]!r} (exact: {', '.join(sorted(known))})"
+    if not args.out:
+        return "--out must name a folder"
+    parent = os.path.dirname(os.path.abspath(args.out))
+    if not os.path.lexists(args.out) and not os.path.isdir(parent):
+        return f"--out {args.out[:200]!r}: its parent {parent[:200]!r} is not a folder"
     if os.path.lexists(args.out):
         if not os.path.isdir(args.out) or os.path.islink(args.out):
             return f"--out {args.out[:200]!r} is not a folder"
@@ -778,7 +783,11 @@ def main():
                 return refuse(f"replay: {c[:200]!r} is not a file")
     work = tempfile.mkdtemp(prefix="exactness_fuzz.")
     try:
-        sl = Shadowlab(args.binary, work)
+        try:
+            sl = Shadowlab(args.binary, work)
+        except (subprocess.CalledProcessError, ValueError, KeyError, TypeError, OSError):
+            # Fourteenth probe: /bin/true as --binary ended in a JSON traceback.
+            return refuse(f"--binary {args.binary[:200]!r} does not answer `list --json` as shadowlab does")
         if args.command == "generate":
             case = generate(args.seed)
             print(json.dumps(to_config(case, entries_for(sl, case, random.Random(args.seed * 7919 + 1))), indent=1))
@@ -788,9 +797,12 @@ def main():
         problem = check_run_args(args, sl)
         if problem:
             return refuse(problem)
-        os.makedirs(args.out, exist_ok=True)
-        with open(os.path.join(args.out, MARK), "w") as f:
-            f.write("exactness_fuzz.py output\n")
+        try:
+            os.makedirs(args.out, exist_ok=True)
+            with open(os.path.join(args.out, MARK), "w") as f:
+                f.write("exactness_fuzz.py output\n")
+        except OSError as e:  # fourteenth probe: an --out under a file was a traceback
+            return refuse(f"--out {args.out[:200]!r}: {e.strerror}")
         stats = campaign(args, sl)
         tmp = os.path.join(args.out, "report.json.tmp")
         with open(tmp, "w") as f:

@@ -34,6 +34,10 @@ class PlainLogFormatter(matplotlib.ticker.LogFormatter):
     def _num_to_string(self, x, vmin, vmax):
         return plain_number(x)
 
+    def __call__(self, x, pos=None):
+        text = super().__call__(x, pos)  # of |x|: LogFormatter drops the sign a symlog axis has
+        return "\u2212" + text if x < 0 and text else text
+
 
 class PlainLogScale(matplotlib.scale.LogScale):
     """The log scale ("log"), its tick labels plain text."""
@@ -44,11 +48,21 @@ class PlainLogScale(matplotlib.scale.LogScale):
         axis.set_minor_formatter(PlainLogFormatter(self.base, labelOnlyBase=(self.subs is not None)))
 
 
+class PlainSymlogScale(matplotlib.scale.SymmetricalLogScale):
+    """The symmetrical log scale ("symlog"), its tick labels plain text (fourteenth probe: history's
+    accuracy plot still showed the mathtext source)."""
+
+    def set_default_locators_and_formatters(self, axis):
+        super().set_default_locators_and_formatters(axis)
+        axis.set_major_formatter(PlainLogFormatter(self.base))
+
+
 def plain_text():
     """Every text made from now on is plain text: '$...$' is not mathtext (matplotlib >= 3.5), and
-    log axes label their ticks in plain text too."""
+    log and symlog axes label their ticks in plain text too."""
     matplotlib.rcParams["text.parse_math"] = False
     matplotlib.scale.register_scale(PlainLogScale)
+    matplotlib.scale.register_scale(PlainSymlogScale)
 
 
 plain_text()

@@ -286,6 +286,9 @@ TEST(CliTest, CompareTwoRunsAndRefuseBadArguments) {
 TEST(CliTest, UnknownCommandIsBadInput) {
     std::string out;
     EXPECT_EQ(test::runCommand(bin() + " frobnicate", out), 2);
+    // Fourteenth probe: an empty name printed every algorithm's table.
+    EXPECT_EQ(test::runCommand(bin() + " list --markdown ''", out), 2) << out;
+    EXPECT_NE(out.find("the name is empty"), std::string::npos) << out;
 }
 
 TEST(CliTest, EveryShippedConfigValidates) {

@@ -253,6 +253,21 @@ std::vector<BadCase> badCases() {
                              {"accessors", R"([{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3, "min": [0, 0, 0], "max": [2, 1, 0],
                                  "sparse": {"count": 2, "indices": {"bufferView": 1, "componentType": 5125}, "values": {"bufferView": 2}}}])"}}),
          {"m.gltf", "/accessors/0/sparse/indices", "strictly increase"}},
+        // Fourteenth probe: a primitive's missing indices accessor was refused without a path; a root
+        // listed twice was built twice; alphaMode "blend" was read as opaque; a triangle a node's
+        // scale flattened was dropped silently.
+        {"GltfIndicesAccessorMissing", "m.gltf",
+         test::triangleGltf({{"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "indices": 9}]}])"}}),
+         {"m.gltf", "/meshes/0/primitives/0/indices", "accessor index 9 is out of range"}},
+        {"GltfRootListedTwice", "m.gltf", test::triangleGltf({{"scenes", R"([{"nodes": [0, 0]}])"}}),
+         {"m.gltf", "/scenes/0/nodes/1", "listed twice"}},
+        {"GltfAlphaModeNotInTheEnumeration", "m.gltf",
+         test::triangleGltf({{"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}])"},
+                             {"materials", R"([{"alphaMode": "blend", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.2]}}])"}}),
+         {"m.gltf", "/materials/0/alphaMode", "not OPAQUE, MASK or BLEND"}},
+        {"GltfTriangleFlattenedByItsNode", "m.gltf",
+         test::triangleGltf({{"nodes", R"([{"mesh": 0}, {"mesh": 0, "scale": [1e-30, 1, 1]}])"}, {"scenes", R"([{"nodes": [0, 1]}])"}}),
+         {"m.gltf", "/meshes/0/primitives/0", "none in float once placed by its nodes"}},
         {"GltfMorphWeightsOnTheMesh", "m.gltf",
          test::triangleGltf({{"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": 0}]}], "weights": [0.5]}])"}}),
          {"m.gltf", "/meshes/0/weights", "non-zero weight"}},

@@ -425,11 +425,17 @@ TEST(SweepStateTest, ResultsUnderAnIdTheConfigDoesNotGiveAreAFailedRun) {
     Json longStage = JsonNode::parseFile(other);
     longStage["algorithms"]["psv"]["time_ms"][std::string(100000, 'S')] = {{"mean", 1.0}};
     std::ofstream(other, std::ios::trunc) << longStage.dump();
+    // Fourteenth probe: an overflow of 1e300 (and a mismatch of 500 %, negative memory) was merged.
+    const std::string third = out + "/runs/" + plan["runs"][3]["id"].get<std::string>() + "/summary.json";
+    Json huge = JsonNode::parseFile(third);
+    huge["algorithms"]["psv"]["overflow"] = 1e300;
+    std::ofstream(third, std::ios::trunc) << huge.dump();
     const Ran r = runArgs(sweep({"merge", out, "--no-plots"}));
     EXPECT_EQ(r.rc, 1) << r.err;
     EXPECT_NE(r.err.find("which its config.resolved.json does not give"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("/algorithms/psv/time_ms: the name \"SSSS"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("2 of 4 runs merged (2 failed)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("at /algorithms/psv/time_ms: holds the name \"SSSS"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("at /algorithms/psv/overflow"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("1 of 4 runs merged (3 failed)"), std::string::npos) << r.err;
     const std::string csv = test::readText(out + "/sweep.csv");
     EXPECT_EQ(csv.find("HYPERLINK"), std::string::npos);
     EXPECT_EQ(csv.find("SSSSSSSS"), std::string::npos);

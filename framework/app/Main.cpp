@@ -418,6 +418,8 @@ static int dispatch(std::vector<std::string> args) {
             if (std::any_of(args.begin() + 1, args.end(), isHelp)) return commandUsage(kListUsage);
             if (args.size() > 1 && args[1] == "--markdown") {
                 if (args.size() > 3) usageError("list --markdown takes at most one algorithm name");
+                // An empty name is no algorithm's (fourteenth probe: it printed every table).
+                if (args.size() == 3 && args[2].empty()) throw InputError("list", "", "--markdown NAME: the name is empty");
                 return printMarkdown(args.size() == 3 ? args[2] : "");
             }
             bool json = args.size() > 1 && args[1] == "--json";

@@ -94,6 +94,7 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
         if (!b.is_object() || (b.contains("commit") && !b["commit"].is_string()) || (b.contains("dirty") && !b["dirty"].is_boolean()))
             throw InputError(file, "/build", "is not a run's build record ({\"commit\": text, \"dirty\": true or false})");
     }
+    if (s.contains("triangles")) checkCount(s["triangles"], file, "/triangles");
     for (const auto& [id, entry] : s["algorithms"].items()) {
         const std::string at = "/algorithms/" + shortText(id, 60);
         // Ids reach file names, tables and JUnit classnames (eleventh probe: control characters
@@ -117,6 +118,10 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
         for (const char* key : {"overflow", "memory_bytes", "resident_bytes"})
             if (entry.contains(key)) checkCount(entry[key], file, at + "/" + key);
         if (entry.contains("accuracy")) checkAccuracy(entry["accuracy"], file, at + "/accuracy");
+        // A time a run measured is finite and not negative (fourteenth probe: sweep merge tabulated -3).
+        if (entry.contains("preprocess_ms") &&
+            !(entry["preprocess_ms"].is_number() && entry["preprocess_ms"].get<double>() >= 0 && std::isfinite(entry["preprocess_ms"].get<double>())))
+            throw InputError(file, at + "/preprocess_ms", "is not a time a run writes (finite, 0 or more)");
     }
 }
 } // namespace

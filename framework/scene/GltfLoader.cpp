@@ -355,6 +355,18 @@ void checkNodeTransforms(const Json& doc, const std::string& file) {
 /// longer, its padding); a skin without inverseBindMatrices (optional in glTF 2.0, but required by
 /// the reader).
 void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool binary, size_t binLength) {
+    // A primitive's indices accessor, which the reader refuses with no path (fourteenth probe).
+    const size_t accessors = doc.contains("accessors") ? doc["accessors"].size() : 0;
+    if (doc.contains("meshes"))
+        for (size_t m = 0; m < doc["meshes"].size(); ++m)
+            if (doc["meshes"][m].contains("primitives"))
+                for (size_t p = 0; p < doc["meshes"][m]["primitives"].size(); ++p) {
+                    const Json& prim = doc["meshes"][m]["primitives"][p];
+                    if (prim.contains("indices") && prim["indices"].get<uint64_t>() >= accessors)
+                        throw InputError(file, "/meshes/" + std::to_string(m) + "/primitives/" + std::to_string(p) + "/indices",
+                                         "accessor index " + std::to_string(prim["indices"].get<uint64_t>()) +
+                                             " is out of range (the file has " + std::to_string(accessors) + ")");
+                }
     if (doc.contains("bufferViews"))
         for (size_t i = 0; i < doc["bufferViews"].size(); ++i) {
             const Json& v = doc["bufferViews"][i];
@@ -778,6 +790,10 @@ void Loader::validateStructure() {
     }
     for (size_t i = 0; i < m_.accessors.size(); ++i) validateAccessor(i);
     for (size_t i = 0; i < m_.materials.size(); ++i) {
+        // The spec's enumeration (fourteenth probe: "blend" was read as opaque, its translucency lost).
+        const std::string& mode = m_.materials[i].alphaMode;
+        if (mode != "OPAQUE" && mode != "MASK" && mode != "BLEND")
+            fail(at("materials", i) + "/alphaMode", "\"" + shortText(mode, 40) + "\" is not OPAQUE, MASK or BLEND");
         const auto& f = m_.materials[i].pbrMetallicRoughness.baseColorFactor;
         bool ok = f.size() == 4;
         for (double c : f) ok = ok && std::isfinite(c) && c >= 0.0 && c <= 1.0;
@@ -1041,6 +1057,11 @@ size_t Loader::emitPrimitive(Scene& scene, size_t mi, size_t pi, const glm::mat4
     tri.reserve(triCount * 3);
     for (size_t k = 0; k < triCount; ++k) {
         glm::vec3 v[3];
+        // A triangle with an area in the file keeps it where its nodes place it (fourteenth probe: a
+        // node's scale of 1e-30 dropped it silently); one without is the file's own, dropped as documented.
+        glm::vec3 local[3], n;
+        for (int c = 0; c < 3; ++c) local[c] = pos[corner(k, c)];
+        const bool hasArea = unitNormal(local[0], local[1], local[2], n);
         for (int c = 0; c < 3; ++c) {
             v[c] = glm::vec3(world * glm::vec4(pos[corner(k, c)], 1.0f));
             // Beyond the coordinates every input is held to, a triangle's cross product overflows and
@@ -1051,6 +1072,9 @@ size_t Loader::emitPrimitive(Scene& scene, size_t mi, size_t pi, const glm::mat4
                                    " once placed by its nodes, beyond ±1e15 scene units");
         }
         if (mirrored) std::swap(v[1], v[2]);
+        if (hasArea && !unitNormal(v[0], v[1], v[2], n))
+            fail(path, "triangle " + std::to_string(k) + " has an area in the file but none in float once placed by its nodes "
+                                                          "(a scale too small, or coordinates too large for its size)");
         tri.insert(tri.end(), {v[0], v[1], v[2]});
     }
     scene.addTriangles(tri, material(p.material));
@@ -1068,6 +1092,9 @@ Scene Loader::run(GltfStats* stats) {
         for (size_t k = 0; k < nodes.size(); ++k) {
             std::string path = at("scenes", si) + "/nodes/" + std::to_string(k);
             checkIndex(nodes[k], m_.nodes, path, "node");
+            // glTF makes a scene's nodes unique (fourteenth probe: a root listed twice was built twice).
+            if (std::find(nodes.begin(), nodes.begin() + long(k), nodes[k]) != nodes.begin() + long(k))
+                fail(path, "node " + std::to_string(nodes[k]) + " is listed twice (a scene's nodes are unique)");
             // Keeps traversal a forest walk: each node is visited (and instanced) once per root.
             if (parent_[size_t(nodes[k])] != -1)
                 fail(path, "node " + std::to_string(nodes[k]) + " is not a root node (its parent is node " +

@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/Interrupt.h"
+#include "framework/experiment/Compare.h"
 #include "framework/experiment/Config.h"
 #include "framework/sweep/SweepFile.h"
 #include "framework/sweep/SweepRunner.h"
@@ -180,10 +181,13 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
         Json s;
         std::string rows;
         try {
-            s = JsonNode::parseFile(p.dir + "/summary.json");
+            // Held to what compare holds a run's summary to (fourteenth probe: a mismatch of 500 %,
+            // an overflow of 1e300 and negative memory were merged and tabulated).
+            s = readRunSummary(p.dir);
             rows = runRows(sweep, run, s, measured);
         } catch (const InputError& e) {
-            fail("failed", "results unreadable: " + e.cause());
+            fail("failed", shortText(p.dir, 200) + "/summary.json: " + (e.jsonPath().empty() ? "" : "at " + shortText(e.jsonPath(), 120) + ": ") +
+                               e.cause());
             continue;
         } catch (const BadSummary& b) {
             fail("failed", shortText(p.dir, 200) + "/summary.json: at " + shortText(b.path, 120) + ": " + b.cause);

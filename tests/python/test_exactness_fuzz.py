@@ -83,8 +83,13 @@ class RunArguments(unittest.TestCase):
                 self.assertEqual(f.read(), "my notes")
             # Eleventh probe: a missing binary was a traceback and exit 1, a missing replay case a
             # failed case (exit 1), and --seconds inf with --cases 0 ran until killed (above).
+            # Fourteenth probe: an --out under a file or empty, and a binary that is not shadowlab,
+            # were tracebacks and exit 1.
             for argv in (["--binary", os.path.join(tmp, "nope"), "run", "--seconds", "5"],
-                         ["--binary", BINARY, "replay", os.path.join(tmp, "missing.json")]):
+                         ["--binary", BINARY, "replay", os.path.join(tmp, "missing.json")],
+                         ["--binary", BINARY, "run", "--seconds", "5", "--out", os.path.join(mine, "report.json", "x")],
+                         ["--binary", BINARY, "run", "--seconds", "5", "--out", ""],
+                         ["--binary", "/bin/true", "run", "--seconds", "5", "--out", os.path.join(tmp, "t")]):
                 r = subprocess.run([sys.executable, FUZZ] + argv, capture_output=True, text=True, stdin=subprocess.DEVNULL)
                 self.assertEqual(r.returncode, 2, (argv, r.stderr))
                 self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)

@@ -540,7 +540,8 @@ class RunReportTest(unittest.TestCase):
 
 class LogAxisTest(unittest.TestCase):
     """Thirteenth probe: with mathtext off for user text, matplotlib's log tick labels were drawn as
-    their source, $\\mathdefault{10^{2}}$, on every sweep and history plot with a log axis."""
+    their source, $\\mathdefault{10^{2}}$, on every sweep and history plot with a log axis; the
+    fourteenth found history's symlog axis still did."""
 
     def test_log_ticks_are_plain_text(self):
         python = python_with_matplotlib()
@@ -548,12 +549,14 @@ class LogAxisTest(unittest.TestCase):
             self.skipTest("no python3 with matplotlib")
         code = ("import sys; sys.path.insert(0, sys.argv[1]); import matplotlib; matplotlib.use('Agg'); import plot_style; "
                 "import matplotlib.pyplot as plt; fig, ax = plt.subplots(); ax.loglog([0.01, 3e5], [1, 2]); "
-                "fig.canvas.draw(); print('|'.join(t.get_text() for t in ax.get_xticklabels() + ax.get_xticklabels(minor=True)))")
+                "ax2 = fig.add_subplot(2, 1, 2); ax2.plot([0, 1], [-0.5, 2]); ax2.set_yscale('symlog', linthresh=1e-3); "
+                "fig.canvas.draw(); print('|'.join(t.get_text() for t in ax.get_xticklabels() + ax.get_xticklabels(minor=True) + "
+                "ax2.get_yticklabels()))")
         r = subprocess.run([python, "-c", code, SCRIPTS], capture_output=True, text=True, timeout=120)
         self.assertEqual(r.returncode, 0, r.stderr)
         labels = r.stdout.strip().split("|")
         self.assertNotIn("$", r.stdout)
-        for want in ("10\u207b\u00b2", "1", "10", "10\u00b2", "10\u2075"):
+        for want in ("10\u207b\u00b2", "1", "10", "10\u00b2", "10\u2075", "0", "\u221210\u207b\u00b9"):
             self.assertIn(want, labels)
 
 
