@@ -46,6 +46,22 @@ TEST(CompareTest, FramesOfOnePassGetNoTimeVerdict) {
     EXPECT_EQ(c.regressions, 0u);
 }
 
+// Fifteenth probe: a base time of 0 gave a ratio of 0, read as an infinite speed-up. New over 0 is
+// no number: no ratio, and no verdict either way; with repetitions too.
+TEST(CompareTest, ABaseTimeOfZeroGivesNoRatio) {
+    const std::string dir = test::makeTempDir("compare-zero");
+    Json zero = entryAround(10, 1);
+    zero["time_ms"]["total"]["mean"] = 0.0;
+    zero.erase("total_ms_per_frame");
+    Json some = entryAround(10, 1);
+    some.erase("total_ms_per_frame");
+    const Comparison c = compareRuns(runFolder(dir + "/base", {{"psv", zero}}), runFolder(dir + "/new", {{"psv", some}}), {});
+    EXPECT_TRUE(totalOf(c, "psv")["ratio"].is_null()) << totalOf(c, "psv");
+    EXPECT_EQ(totalOf(c, "psv")["verdict"], "no ratio (base time 0)");
+    EXPECT_EQ(c.regressions, 0u);
+    EXPECT_NE(comparisonMarkdown(c, dir + "/base", dir + "/new", {}).find("undefined (base 0)"), std::string::npos);
+}
+
 // The reference's time swung 3.5x between two runs of one build; as a geometric mean of five ids,
 // the '*' yardstick moved by 28 % and every other id looked 22 % faster. As a median it stays.
 TEST(CompareTest, OneSwingingIdDoesNotMoveTheMachinesYardstick) {

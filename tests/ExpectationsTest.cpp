@@ -57,6 +57,24 @@ TEST(ExpectationsTest, BoundsAreCheckedPerIdWithHowFarTheyMissed) {
 }
 
 // Seventh probe: a negative bound printed a meaningless ratio, "above max -1 (-0×)".
+// Fifteenth probe: "*exact" in a run without an exact algorithm was "all 0 met" (a CI guard that
+// checks nothing), and "*" relative to psv passed psv against itself with 1.
+TEST(ExpectationsTest, AWildcardStandsForAtLeastOneIdAndNeverItsRelativeTo) {
+    ExpectationIds only = ids();
+    only.all = {"shadow_map"};
+    only.exact = {};
+    try {
+        parse(R"([{"id": "*exact", "measure": "accuracy.mismatch_ratio_max", "max": 0}])", only);
+        ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.jsonPath(), "/expect/0/id");
+        EXPECT_NE(e.cause().find("stands for no algorithm"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(parse(R"([{"id": "*", "measure": "time_ms.total.mean", "relative_to": "shadow_map", "max": 2}])", only), InputError);
+    const auto e = parse(R"([{"id": "*", "measure": "time_ms.total.mean", "relative_to": "psv", "max": 2}])", ids());
+    EXPECT_EQ(idsOf(e[0], ids()), (std::vector<std::string>{"shadow_map", "bvh_raytrace"}));
+}
+
 TEST(ExpectationsTest, ARatioToTheBoundOnlyWhereBothArePositive) {
     const auto e = parse(R"([{"id": "psv", "measure": "overflow", "max": -1}])", ids());
     const Json r = checkExpectations(e, ids(), summaryWith(0.0, 3.0, 2.5));

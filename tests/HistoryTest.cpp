@@ -241,6 +241,8 @@ TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
           {"history", dir, "--threshold", "-1"}, {"history", dir, dir}, {"history", dir, "--bogus"},
           // Eleventh probe: 0x10 was read as 16 %, " 5" as 5 %.
           {"history", dir, "--threshold", "0x10"}, {"history", dir, "--threshold", " 5"}, {"history", dir, "--threshold", "inf"},
+          // Fifteenth probe: a window of 1 could never find a step.
+          {"history", dir, "--window", "1"},
           {"history", dir + "/missing", "--out", out}, {"history", dir, "--relative-to", "nope", "--out", out}}) {
         std::vector<std::string> argv{SHADOWLAB_BINARY};
         argv.insert(argv.end(), args.begin(), args.end());

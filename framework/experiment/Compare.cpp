@@ -221,13 +221,17 @@ Json compareStage(const Json& a, const Json& b, const std::string& stage, double
         method = "means only";
     }
     if (ya) method += ", over the yardstick";
-    r["ratio"] = ci.median;
+    // New over a base of 0 is no number (fifteenth probe: it was written 0, an infinite speed-up).
+    const bool defined = r["base"].get<double>() > 0 || r["new"].get<double>() == 0;
+    if (r["base"].get<double>() == 0 && r["new"].get<double>() == 0) ci.median = 1;
+    r["ratio"] = defined && std::isfinite(ci.median) ? Json(ci.median) : Json();
     r["low"] = ci.valid ? Json(ci.low) : Json();
     r["high"] = ci.valid ? Json(ci.high) : Json();
     r["method"] = method;
     // Frames paired or means only say nothing about how two runs of one build differ (false calls
     // in results/reference/compare_noise_llvmpipe.md), so they get no verdict.
     r["verdict"] = r.contains("p") ? timeVerdict(ci, r["p"].get<double>(), threshold) : ci.valid ? "too few passes" : "no interval";
+    if (r["ratio"].is_null()) r["verdict"] = "no ratio (base time 0)";
     return r;
 }
 
@@ -501,7 +505,7 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
         }
         for (const Json& t : r["time"]) {
             os << "| " << markdownLiteral(r["id"].get<std::string>()) << " | " << markdownLiteral(t["stage"].get<std::string>()) << " | "
-               << shortNumber(t["base"].get<double>(), 4) << " | " << shortNumber(t["new"].get<double>(), 4) << " | " << shortNumber(t["ratio"].get<double>(), 4) << " | "
+               << shortNumber(t["base"].get<double>(), 4) << " | " << shortNumber(t["new"].get<double>(), 4) << " | " << (t["ratio"].is_number() ? shortNumber(t["ratio"].get<double>(), 4) : std::string("undefined (base 0)")) << " | "
                << (t["low"].is_null() ? std::string() : shortNumber(t["low"].get<double>(), 4) + " – " + shortNumber(t["high"].get<double>(), 4)) << " | "
                << (t.contains("p") ? shortNumber(t["p"].get<double>(), 4) : std::string()) << " | " << t["method"].get<std::string>() << " | "
                << (t["verdict"] == "slower" ? "**slower**" : t["verdict"].get<std::string>()) << " |\n";

@@ -192,8 +192,11 @@ int historyCommand(const std::vector<std::string>& args) {
         } else if (a == "--window") {
             if (windowGiven) throw InputError(a, "", "is given twice");
             const std::string v = optionValue(args, i, "a number of runs");
-            if (v.size() > 3 || v.find_first_not_of("0123456789") != std::string::npos || std::stoi(v) < 1 || std::stoi(v) > 100)
-                throw InputError("--window", "", "expected a number of runs from 1 to 100, got \"" + shortText(v, 40) + "\"");
+            // At least 2: a step needs 2 runs before it inside the window (fifteenth probe: 1 was
+            // accepted and no step could ever be found).
+            if (v.empty() || v.size() > 3 || v.find_first_not_of("0123456789") != std::string::npos || std::stoi(v) < 2 || std::stoi(v) > 100)
+                throw InputError("--window", "", "expected a number of runs from 2 to 100 (a step needs 2 runs before it), got \"" +
+                                                      shortText(v, 40) + "\"");
             opt.window = size_t(std::stoi(v));
             windowGiven = true;
         } else if (a == "--by-name") {

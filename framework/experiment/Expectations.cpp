@@ -44,17 +44,6 @@ std::string measureProblem(const std::string& m) {
            "(STAT: mean, median, min or max)";
 }
 
-/// The ids an expectation's id stands for.
-std::vector<std::string> idsOf(const Expectation& e, const ExpectationIds& ids) {
-    if (e.id == "*") return ids.all;
-    if (e.id == "*exact") {
-        std::vector<std::string> out;
-        for (const auto& id : ids.all)
-            if (ids.exact.count(id)) out.push_back(id);
-        return out;
-    }
-    return {e.id};
-}
 
 /// The measure of `id` in summary.json, or why there is none.
 std::optional<double> measured(const Json& summary, const std::string& id, const std::string& measure, std::string& why) {
@@ -86,6 +75,16 @@ std::optional<double> measured(const Json& summary, const std::string& id, const
 }
 
 } // namespace
+
+/// The ids an expectation's id stands for: a wildcard's never include its relative_to id, which
+/// is 1 relative to itself (fifteenth probe: "*" relative to psv passed psv with 1).
+std::vector<std::string> idsOf(const Expectation& e, const ExpectationIds& ids) {
+    if (e.id != "*" && e.id != "*exact") return {e.id};
+    std::vector<std::string> out;
+    for (const auto& id : ids.all)
+        if ((e.id == "*" || ids.exact.count(id)) && id != e.relativeTo) out.push_back(id);
+    return out;
+}
 
 std::vector<Expectation> parseExpectations(JsonNode& root, const ExpectationIds& ids) {
     std::vector<Expectation> out;
@@ -119,6 +118,11 @@ std::vector<Expectation> parseExpectations(JsonNode& root, const ExpectationIds&
                 node.fail("relative_to", "\"" + shortText(e.relativeTo, 60) + "\" is not an algorithm id of this experiment");
             if (e.relativeTo == e.id) node.fail("relative_to", "an id relative to itself is always 1: name another id");
         }
+        // A wildcard that stands for no id would pass without checking anything (fifteenth probe:
+        // "*exact" in a run of shadow_map alone was "all 0 met").
+        if (idsOf(e, ids).empty())
+            node.fail("id", "\"" + e.id + "\" stands for no algorithm of this experiment" +
+                                (e.relativeTo.empty() ? "" : " but its relative_to") + ": the check would pass without checking anything");
         if (node.has("min")) e.min = node.getFloat("min", 0);
         if (node.has("max")) e.max = node.getFloat("max", 0);
         if (!e.min && !e.max) node.fail("max", "an expectation needs \"max\", \"min\" or both");

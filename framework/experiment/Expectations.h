@@ -33,6 +33,8 @@ struct ExpectationIds {
 /// Reads `expect` (a list; InputError naming the entry's path for an unknown id or measure, a
 /// missing or inverted bound, an accuracy measure without the reference, a time ratio to itself).
 std::vector<Expectation> parseExpectations(JsonNode& root, const ExpectationIds& ids);
+/// The ids an expectation's id stands for: itself, or a wildcard's ("*", "*exact") ids but its relative_to.
+std::vector<std::string> idsOf(const Expectation& e, const ExpectationIds& ids);
 
 /// Checks each expectation for each id it names on summary.json's content: one record per (entry,
 /// id) with {where, id, measure, relative_to, min, max, value, passed, why}; `why` says what failed
