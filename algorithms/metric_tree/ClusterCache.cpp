@@ -123,6 +123,15 @@ std::optional<Clustering> loadCache(const std::string& path, uint64_t sceneHash,
         if (seen[t]) return bad("a triangle is listed twice");
         seen[t] = true;
     }
+    // And every place of `order` in exactly one cluster (fifteenth probe: clusters whose counts were
+    // set to 0, checksums recomputed, left every triangle out: 5.98 % of pixels lit, no overflow).
+    std::vector<bool> covered(triangles, false);
+    for (const ClusterGpu& cl : c.clusters)
+        for (uint64_t k = cl.first; k < uint64_t(cl.first) + cl.count; ++k) {
+            if (covered[k]) return bad("two clusters hold one triangle");
+            covered[k] = true;
+        }
+    if (std::find(covered.begin(), covered.end(), false) != covered.end()) return bad("a triangle is in no cluster");
     if (const char* wrong = boundsWrong(c, scene)) return bad(std::string(wrong) + ": the file was built from other content");
     return c;
 }
