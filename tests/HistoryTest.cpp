@@ -226,6 +226,20 @@ TEST(HistoryTest, ACommitOrRendererNoRunWritesIsNotCopied) {
     EXPECT_EQ(h.runs[2]["label"], "tampered");
 }
 
+// Fifteenth probe: a newest run at another resolution was called a regression with no word that
+// its config changed (compare says so); history names where the config changed.
+TEST(HistoryTest, AChangeOfConfigBetweenRunsIsNoted) {
+    const std::string dir = test::makeTempDir("history-config");
+    writeRuns(dir, {20, 20, 20}, {0, 0, 0}, kSpread);
+    const std::vector<std::string> folders = {"run-98", "run-99", "run-100"};
+    for (const std::string& f : folders)
+        std::ofstream(dir + "/" + f + "/config.resolved.json") << Json{{"resolution", {64, f == "run-98" ? 128 : 64}}}.dump();
+    const History h = readHistory(dir, {});
+    ASSERT_EQ(h.notes.size(), 1u);
+    // run-98 is the newest (writeRuns dates run-100 first).
+    EXPECT_NE(h.notes[0].find("the config changed between run-99 and run-98 in: resolution"), std::string::npos) << h.notes[0];
+}
+
 TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
     const std::string dir = test::makeTempDir("history-bad");
     writeRuns(dir, {20}, {0}, kSpread);

@@ -323,6 +323,9 @@ Json compareImages(const std::string& baseDir, const std::string& newDir, const 
 }
 
 /// The resolved configs' differences, as the top-level keys that differ (output.dir left out).
+
+} // namespace
+
 std::vector<std::string> configDifferences(const std::string& baseDir, const std::string& newDir) {
     std::vector<std::string> keys;
     try {
@@ -339,8 +342,6 @@ std::vector<std::string> configDifferences(const std::string& baseDir, const std
     }
     return keys;
 }
-
-} // namespace
 
 std::string timeVerdict(const Interval& ci, double p, double threshold) {
     // A change counts when it exceeds the threshold, its whole interval lies on one side of 1 and

@@ -32,6 +32,9 @@ struct Comparison {
 
 /// DIR/summary.json, which must be a complete run's (InputError naming the file otherwise).
 Json readRunSummary(const std::string& dir);
+/// The top-level keys in which two runs' config.resolved.json differ (output.dir aside), or one
+/// entry saying a file cannot be read.
+std::vector<std::string> configDifferences(const std::string& baseDir, const std::string& newDir);
 
 /// What `--relative-to ID` divides by in `summary`: ID's entry, or for "*" an entry made of the
 /// median over the ids of each one's total time over its scale (`scales`: id → ms, the same for

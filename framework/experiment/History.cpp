@@ -245,6 +245,20 @@ History readHistory(const std::string& dir, const HistoryOptions& opt) {
     const Json scales = yardstickScales(runs.front().summary);
     if (renderers.size() > 1)
         h.notes.push_back("the runs ran on " + std::to_string(renderers.size()) + " different renderers: a step there may be the machine's");
+    // A step where the config changed may be the config's, as compare says (fifteenth probe: a
+    // newest run at another resolution was a REGRESSION with no word of it).
+    // Runs without a readable config.resolved.json (made by hand, or older) are not compared.
+    size_t changes = 0;
+    for (size_t k = 1; k < runs.size(); ++k) {
+        const auto keys = configDifferences((fs::path(dir) / runs[k - 1].folder).string(), (fs::path(dir) / runs[k].folder).string());
+        if (keys.empty() || keys.front().starts_with("(")) continue;
+        if (++changes > 3) continue;
+        std::string list;
+        for (const auto& key : keys) list += (list.empty() ? "" : ", ") + key;
+        h.notes.push_back("the config changed between " + shortText(runs[k - 1].folder, 60) + " and " + shortText(runs[k].folder, 60) +
+                          " in: " + shortText(list, 200) + " (a step there may be the config's, not the code's)");
+    }
+    if (changes > 3) h.notes.push_back("the config changed " + std::to_string(changes - 3) + " more times between consecutive runs");
     for (const std::string& id : ids) {
         Json time = Json::array(), mismatch = Json::array();
         std::vector<size_t> present;
