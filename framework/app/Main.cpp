@@ -235,7 +235,7 @@ int run(const std::vector<std::string>& args) {
             if (opt.force) refuseInputsInsideReplacedOutput(config, overrides, dir);
             // A compare or history output is not a run's to replace (thirteenth probe).
             if (opt.force) OutputPlace::refuseOtherKind(dir, "summary.json", "run");
-            return OutputPlace::open(opt.outputDir.empty() ? cfg.outputDir : opt.outputDir, opt.force, &notes,
+            return OutputPlace::open(dir, opt.force, &notes,
                                      overrides.empty() ? config : std::string());
         } catch (const InputError& e) {
             if (!opt.outputDir.empty()) throw;

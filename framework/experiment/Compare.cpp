@@ -322,8 +322,6 @@ Json compareImages(const std::string& baseDir, const std::string& newDir, const 
     return out;
 }
 
-/// The resolved configs' differences, as the top-level keys that differ (output.dir left out).
-
 } // namespace
 
 std::vector<std::string> configDifferences(const std::string& baseDir, const std::string& newDir) {

@@ -197,12 +197,7 @@ static void checkPoses(const ExperimentConfig& c) {
         }
         for (size_t p = 0; p < scene.moving.size(); ++p) {
             const MovingPart& part = scene.moving[p];
-            Bounds b;
-            for (int k = 0; k < 8; ++k) {
-                const glm::vec3 corner((k & 1) ? part.localMax.x : part.localMin.x, (k & 2) ? part.localMax.y : part.localMin.y,
-                                       (k & 4) ? part.localMax.z : part.localMin.z);
-                b.extend(glm::vec3(pose[p] * glm::vec4(corner, 1.0f)));
-            }
+            const Bounds b = partBoundsAt(part, pose[p]);
             const std::string file = part.sourceFile.empty() ? c.file : part.sourceFile;
             const std::string path = part.sourcePath.empty() ? "/scene" : part.sourcePath;
             if (!withinCoordinates(b))

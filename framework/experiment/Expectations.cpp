@@ -44,7 +44,6 @@ std::string measureProblem(const std::string& m) {
            "(STAT: mean, median, min or max)";
 }
 
-
 /// The measure of `id` in summary.json, or why there is none.
 std::optional<double> measured(const Json& summary, const std::string& id, const std::string& measure, std::string& why) {
     if (!summary.contains("algorithms") || !summary["algorithms"].contains(id)) {
@@ -189,7 +188,6 @@ std::string expectationLine(const Json& r) {
     return r["id"].get<std::string>() + ": " + r["measure"].get<std::string>() + rel + " = " + shortNumber(r["value"].get<double>()) + " (" +
            bound + "; " + where + ")";
 }
-
 
 std::string expectationsJUnit(const std::string& experiment, const Json& records, double wallSeconds) {
     std::vector<JUnitCase> cases;

@@ -133,12 +133,7 @@ void checkLightClearance(const ExperimentConfig& c) {
         });
         for (size_t p = 0; p < scene.moving.size(); ++p) {
             const MovingPart& part = scene.moving[p];
-            Bounds box;
-            for (int k = 0; k < 8; ++k)
-                box.extend(glm::vec3(pose[p] * glm::vec4((k & 1) ? part.localMax.x : part.localMin.x,
-                                                         (k & 2) ? part.localMax.y : part.localMin.y,
-                                                         (k & 4) ? part.localMax.z : part.localMin.z, 1.0f)));
-            if (!nearBox(light, box, clearance)) continue;
+            if (!nearBox(light, partBoundsAt(part, pose[p]), clearance)) continue;
             for (size_t i = 0; i < part.triangleCount; ++i) {
                 glm::vec3 v[3], n;
                 poseTriangle(pose[p], &part.local[3 * i], v, n);

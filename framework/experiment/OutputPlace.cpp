@@ -66,7 +66,6 @@ bool isRegularFile(const fs::path& path) {
     return ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-
 /// A run's output (or an empty directory, which holds nothing to lose). One without the mark (an
 /// older build's, or one copied without its dot files) is not: what it holds beyond a run's files
 /// cannot be told, and --force deleted a user's files in it (thirteenth probe).
@@ -589,7 +588,6 @@ OutputPlace::~OutputPlace() {
     release();
     if (!committed_ && !kept_) removeEmptyFolders(madeParents_);
 }
-
 
 void OutputPlace::release() {
     if (oldFd_ >= 0) ::close(oldFd_);

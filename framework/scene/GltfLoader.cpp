@@ -262,7 +262,6 @@ size_t glbBinLength(const std::vector<unsigned char>& bytes) {
     return size_t(readU32(bytes, json));
 }
 
-
 /// The largest buffer file read (what readInputFileBytes is given below: a glTF byteLength is a uint32 in practice).
 constexpr size_t kMaxBufferFileBytes = 0xFFFFFFF0u;
 
@@ -1063,7 +1062,7 @@ size_t Loader::emitPrimitive(Scene& scene, size_t mi, size_t pi, const glm::mat4
         for (int c = 0; c < 3; ++c) local[c] = pos[corner(k, c)];
         const bool hasArea = unitNormal(local[0], local[1], local[2], n);
         for (int c = 0; c < 3; ++c) {
-            v[c] = glm::vec3(world * glm::vec4(pos[corner(k, c)], 1.0f));
+            v[c] = glm::vec3(world * glm::vec4(local[c], 1.0f));
             // Beyond the coordinates every input is held to, a triangle's cross product overflows and
             // it was dropped as degenerate, silently (thirteenth probe: a vertex at 1e20).
             for (int a = 0; a < 3; ++a)

@@ -164,15 +164,19 @@ void Scene::applyPose(const std::vector<glm::mat4>& pose) {
     updateBounds();
 }
 
+Bounds partBoundsAt(const MovingPart& part, const glm::mat4& m) {
+    Bounds b;
+    const glm::vec3 lo = part.localMin, hi = part.localMax;
+    for (int c = 0; c < 8; ++c) {
+        const glm::vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        b.extend(glm::vec3(m * glm::vec4(corner, 1.0f)));
+    }
+    return b;
+}
+
 Bounds Scene::boundsAt(const std::vector<glm::mat4>& pose) const {
     Bounds b = staticBounds;
-    for (size_t p = 0; p < moving.size(); ++p) {
-        const glm::vec3 lo = moving[p].localMin, hi = moving[p].localMax;
-        for (int c = 0; c < 8; ++c) {
-            const glm::vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-            b.extend(glm::vec3(pose[p] * glm::vec4(corner, 1.0f)));
-        }
-    }
+    for (size_t p = 0; p < moving.size(); ++p) b.extend(partBoundsAt(moving[p], pose[p]));
     return b;
 }
 

@@ -16,7 +16,6 @@
 
 namespace shadowlab {
 
-
 /// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
 void collectIds(const Json& resolved, std::set<std::string>& ids) {
     if (resolved.value("reference", Json(true)) != Json(false)) ids.insert("reference");
@@ -26,7 +25,6 @@ void collectIds(const Json& resolved, std::set<std::string>& ids) {
 }
 
 namespace {
-
 
 /// Text a spreadsheet would read as a formula in a CSV cell: it starts with =, +, - or @ and is not
 /// a plain decimal number (a numeric axis's "-0.5" stays as it is).
@@ -249,8 +247,6 @@ Json resolveRun(const Json& config, const std::string& file) {
                      e.cause() + " (run " + std::to_string(run.index) + ": " + runLabel(s, run) + ")");
 }
 
-
-
 std::string idList(const std::set<std::string>& ids) {
     std::string list;
     for (const std::string& id : ids) list += (list.empty() ? "" : ", ") + id;
@@ -308,7 +304,6 @@ std::string fileFingerprint(const std::string& path) {
     cache[path] = {key, text};
     return text;
 }
-
 
 } // namespace
 

@@ -107,8 +107,9 @@ bool RunPaths::complete(std::string* why) const {
     if (!fs::exists(summaryStatus)) return fail("the run's folder has no summary.json");
     // A run writes its summary itself: a link there is another file's, not this run's result.
     if (fs::is_symlink(summaryStatus)) return fail("summary.json is a symbolic link, not the run's own file");
+    Json s;
     try {
-        const Json s = JsonNode::parseFile(summary);
+        s = JsonNode::parseFile(summary);
         if (!(s.is_object() && s.contains("complete") && s["complete"] == true)) return fail("summary.json does not say \"complete\": true");
     } catch (const InputError& e) {
         return fail("summary.json " + e.cause());
@@ -126,16 +127,11 @@ bool RunPaths::complete(std::string* why) const {
     // =HYPERLINK(...), reached sweep.csv from a summary.json that was taken as complete).
     std::set<std::string> ids;
     collectIds(resolved, ids);
-    try {
-        const Json s = JsonNode::parseFile(summary);
-        if (s.contains("algorithms") && s["algorithms"].is_object())
-            for (const auto& [name, entry] : s["algorithms"].items())
-                if (!ids.count(name))
-                    return fail("summary.json has results under the id \"" + shortText(name, 60) +
-                                "\", which its config.resolved.json does not give");
-    } catch (const InputError& e) {
-        return fail("summary.json " + e.cause());
-    }
+    if (s.contains("algorithms") && s["algorithms"].is_object())
+        for (const auto& [name, entry] : s["algorithms"].items())
+            if (!ids.count(name))
+                return fail("summary.json has results under the id \"" + shortText(name, 60) +
+                            "\", which its config.resolved.json does not give");
     return true;
 }
 
