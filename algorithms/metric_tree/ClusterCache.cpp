@@ -124,7 +124,7 @@ std::optional<Clustering> loadCache(const std::string& path, uint64_t sceneHash,
         seen[t] = true;
     }
     // And every place of `order` in exactly one cluster (fifteenth probe: clusters whose counts were
-    // set to 0, checksums recomputed, left every triangle out: 5.98 % of pixels lit, no overflow).
+    // set to 0, checksums recomputed, left every triangle out, and their shadows with them, uncounted).
     std::vector<bool> covered(triangles, false);
     for (const ClusterGpu& cl : c.clusters)
         for (uint64_t k = cl.first; k < uint64_t(cl.first) + cl.count; ++k) {

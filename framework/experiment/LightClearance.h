@@ -4,8 +4,8 @@
 // The reference (and bvh_raytrace) ends each shadow ray the ray offset short of the light; the
 // volume algorithms (psv, ptsv, shadow_volumes) and the cluster tests count every triangle up to the
 // light itself. A surface within that distance of the light is seen by one and not the other, and
-// their images disagree on whole regions (tenth probe: a light 1.2e-7 behind a wall, 479 of 1,024
-// pixels). Which one is right is a matter of definition, not of precision, so such a scene is
+// their images disagree on whole regions (tenth probe: a light just behind a wall; the count is in
+// results/reference/exactness_campaign_llvmpipe.md). Which one is right is a matter of definition, not of precision, so such a scene is
 // refused instead of compared, with a quarter of the offset more so that rounding at the ray's end
 // cannot decide it either.
 #include "framework/experiment/Config.h"
