@@ -613,9 +613,6 @@ void OutputPlace::refuseCommit(const std::string& why) {
 
 void OutputPlace::commit() {
     std::error_code ec;
-    // Once renamed into place the partial directory is the output, no leftover: its mark goes first
-    // (killed before the rename, an unmarked partial directory is left for the user, not removed).
-    fs::remove(fs::path(partial_) / kPartialMark, ec);
     struct stat st {};
     const bool exists = ::lstat(final_.c_str(), &st) == 0;
     // Only what open() checked is replaced: a directory that appeared since (a run into a folder
@@ -664,6 +661,11 @@ void OutputPlace::commit() {
         }
         committed_ = true;
     }
+    // The mark goes once the rename is done: a run killed before it leaves DIR.partial-PID marked,
+    // and the next run into DIR removes it (a sweep killed mid-commit left a complete-looking
+    // unmarked runs/ID.partial-PID that nothing removed). Killed after the rename, the output keeps
+    // a stray mark, which no check reads there.
+    fs::remove(fs::path(final_) / kPartialMark, ec);
     release();
 }
 
