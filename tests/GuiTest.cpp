@@ -2,6 +2,7 @@
 // options, which act through the same functions as the widgets (selectAlgorithm, applyParamChange,
 // the path recorder, the config writer). CPU tier: it needs no GL context of its own.
 #include "framework/experiment/Config.h"
+#include "tests/HostileInputs.h"
 #include "tests/TestSupport.h"
 
 #include <stb_image.h>
@@ -198,6 +199,23 @@ TEST(GuiTest, RecordedPathRunsUnchangedAndReproducesTheCamera) {
     }
 }
 
+// Fifteenth probe: with the config given by a relative path, its glTF was saved relative to the
+// working directory, and the saved config (in another folder) could not find it.
+TEST(GuiTest, ASavedConfigFindsItsGltfFromAnyFolder) {
+    REQUIRE_GUI(gui);
+    const std::string dir = test::makeTempDir("gui-gltf");
+    fs::create_directories(dir + "/cfg");
+    fs::create_directories(dir + "/saved");
+    std::ofstream(dir + "/cfg/b.gltf") << test::triangleGltf();
+    std::ofstream(dir + "/cfg/base.json") << test::configWith(
+        {{"scene", R"({"objects": [{"procedural": "plane", "size": [8, 8]}, {"gltf": "b.gltf"}]})"},
+         {"light", R"({"type": "point", "position": [2, 4, 1.5]})"}});
+    std::string out;
+    ASSERT_EQ(runGui("cd " + dir + " && " + gui + " cfg/base.json --size 64x64 --frames 1 --record-keyframes \"0,3,5,0,0,0\" "
+                     "--save-config saved/rec.json", out), 0) << out;
+    EXPECT_EQ(test::runCommand(std::string(SHADOWLAB_BINARY) + " validate " + dir + "/saved/rec.json", out), 0) << out;
+}
+
 TEST(GuiTest, PlaysMovingGeometryOnTheRunnersClock) {
     REQUIRE_GUI(gui);
     // The windmill config: its rotor and torus move on the camera path's clock; the playback (and
@@ -234,6 +252,20 @@ TEST(GuiTest, BadInputIsOneLineAndExitCode2) {
 int guiError(const std::string& args, std::string& out) {
     int rc = test::runCommand(kGui + " " + args, out);
     return rc;
+}
+
+// Fifteenth probe: each of these was read as something (64x64, frame 10, 16, 1) or as no output.
+TEST(GuiTest, MalformedNumbersAndEmptyFileNamesAreBadInput) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    for (const std::string args : {"--size 64x64x", "--size +64x+64", "--size 64xx64", "--resize 64x064", "--frames 0x2",
+                                   "--frames 2 --frame 010", "--frames 2 --frame 1e0", "--frames ' 2'", "--render-scale 0x1",
+                                   "--render-scale inf", "--frames 1 --screenshot ''", "--frames 1 --report ''",
+                                   "--record-keyframes '0,3,5,0,,0,0' --save-config x.json", "--record-keyframes '0,3,5,0,0,0' --save-config ''",
+                                   "--record-keyframes '0,3,5,0,0,0;;1,3,5,0,0,0' --save-config x.json"}) {
+        std::string out;
+        EXPECT_EQ(guiError(kSmoke + " " + args, out), 2) << args << "\n" << out;
+        EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << args << "\n" << out;
+    }
 }
 
 TEST(GuiTest, HelpExitsZeroWhateverElseTheLineHolds) {

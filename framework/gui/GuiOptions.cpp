@@ -2,12 +2,12 @@
 
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
+#include "framework/core/Text.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <sstream>
 
 namespace shadowlab {
 
@@ -44,32 +44,39 @@ std::string echoed(const std::string& text) {
     return "\"" + (text.size() > 60 ? text.substr(0, 57) + "..." : text) + "\"";
 }
 
+/// A plain decimal number (sign, digits, fraction, exponent), as the runner's --threshold: strtod's
+/// hex, inf and leading spaces are refused (fifteenth probe: `0x10` was read as 16).
 double number(const std::string& opt, const std::string& text) {
-    char* end = nullptr;
-    double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end || !std::isfinite(v)) throw usage(opt + " expects a number, got " + echoed(text));
+    const double v = plainDecimal(text) ? std::strtod(text.c_str(), nullptr) : NAN;
+    if (!std::isfinite(v)) throw usage(opt + " expects a number, got " + echoed(text));
     return v;
 }
 
+/// Decimal digits only, without a leading zero (`010`, `+5`, `1e0`, `0x2` refused: each was read as
+/// some number before), as the runner's counts.
 int integer(const std::string& opt, const std::string& text, int minValue) {
-    double v = number(opt, text);
-    if (v != std::floor(v) || v < minValue || v > 1e9)
-        throw usage(opt + " expects an integer >= " + std::to_string(minValue) + ", got " + echoed(text));
-    return int(v);
+    const bool digits = !text.empty() && text.size() <= 9 && text.find_first_not_of("0123456789") == std::string::npos &&
+                        (text.size() == 1 || text[0] != '0');
+    const int v = digits ? std::stoi(text) : -1;
+    if (v < minValue) throw usage(opt + " expects a whole number >= " + std::to_string(minValue) + " in decimal digits, got " + echoed(text));
+    return v;
 }
 
+/// The fields of `s` between each `sep`, empty ones kept (`64x64x` has three fields, `1,,2` an
+/// empty one: both refused by their callers rather than read as something else).
 std::vector<std::string> split(const std::string& s, char sep) {
     std::vector<std::string> out;
-    std::stringstream ss(s);
-    std::string item;
-    while (std::getline(ss, item, sep))
-        if (!item.empty()) out.push_back(item);
+    size_t at = 0;
+    for (size_t next; (next = s.find(sep, at)) != std::string::npos; at = next + 1) out.push_back(s.substr(at, next - at));
+    out.push_back(s.substr(at));
     return out;
 }
 
 std::vector<std::pair<glm::vec3, glm::vec3>> parseKeyframes(const std::string& text) {
     std::vector<std::pair<glm::vec3, glm::vec3>> out;
-    for (const std::string& key : split(text, ';')) {
+    std::vector<std::string> keys = split(text, ';');
+    if (keys.size() > 1 && keys.back().empty()) keys.pop_back();  // "k1;k2;" ends its last keyframe
+    for (const std::string& key : keys) {
         std::vector<std::string> f = split(key, ',');
         if (f.size() != 6) throw usage("--record-keyframes: " + echoed(key) + " needs 6 numbers x,y,z,tx,ty,tz");
         float v[6];
@@ -85,7 +92,7 @@ std::vector<std::pair<glm::vec3, glm::vec3>> parseKeyframes(const std::string& t
 glm::ivec2 size(const std::string& opt, const std::string& text) {
     std::vector<std::string> wh = split(text, 'x');
     if (wh.size() != 2) throw usage(opt + " expects WxH, got " + echoed(text));
-    const glm::ivec2 s(integer(opt, wh[0], 1), integer(opt, wh[1], 1));
+    const glm::ivec2 s(integer(opt, wh[0], 0), integer(opt, wh[1], 0));
     if (s.x < kWindowSideMin || s.y < kWindowSideMin || s.x > kWindowSideMax || s.y > kWindowSideMax)
         throw usage(opt + " " + echoed(text) + ": each side must be " + std::to_string(kWindowSideMin) + " to " +
                     std::to_string(kWindowSideMax));
@@ -95,7 +102,6 @@ glm::ivec2 size(const std::string& opt, const std::string& text) {
 /// An output file must be one that can be written as a whole and replaced: a directory, link,
 /// device or FIFO there is refused (writeFileAtomic would refuse it only after the whole session).
 void checkOutputFile(const std::string& opt, const std::string& file) {
-    if (file.empty()) throw usage(opt + " needs a file name");
     const std::string shown = shortPath(file);
     if (const std::string kind = nonRegularKind(file, false); !kind.empty())
         throw InputError(shown, "", opt + ": the path is " + kind + ", not a file it can replace");
@@ -103,6 +109,13 @@ void checkOutputFile(const std::string& opt, const std::string& file) {
     std::error_code ec;
     if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
         throw InputError(shown, "", opt + ": the folder " + echoed(parent.string()) + " does not exist");
+}
+
+/// An output option's value: an empty one is refused, not taken for "no output" (fifteenth probe:
+/// `--screenshot ''` wrote nothing and said nothing).
+const std::string& fileName(const std::string& opt, const std::string& value) {
+    if (value.empty()) throw usage(opt + " needs a file name");
+    return value;
 }
 
 } // namespace
@@ -137,13 +150,13 @@ GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
         else if (a == "--play") o.play = true;
         else if (a == "--frame") o.startFrame = integer(a, value(), 0);
         else if (a == "--frames") o.frames = integer(a, value(), 1);
-        else if (a == "--screenshot") o.screenshot = value();
+        else if (a == "--screenshot") o.screenshot = fileName(a, value());
         else if (a == "--record-keyframes") o.recordKeyframes = parseKeyframes(value());
         else if (a == "--record-step") {
             o.recordStep = float(number(a, value()));
             if (!(o.recordStep > 0)) throw usage("--record-step must be positive");
-        } else if (a == "--save-config") o.saveConfig = value();
-        else if (a == "--report") o.report = value();
+        } else if (a == "--save-config") o.saveConfig = fileName(a, value());
+        else if (a == "--report") o.report = fileName(a, value());
         else if (a == "--size") o.windowSize = size(a, value());
         else if (a == "--resize") o.resizeTo = size(a, value()); else if (a == "--render-scale") {
             o.renderScale = float(number(a, value()));

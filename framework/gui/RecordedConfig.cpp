@@ -5,6 +5,8 @@
 #include "framework/gui/Viewer.h"
 #include "framework/scene/SceneConfig.h"
 
+#include <filesystem>
+
 namespace shadowlab {
 
 namespace {
@@ -32,7 +34,9 @@ Json recordedConfigJson(const Viewer& viewer, const Path& cameraPath, const std:
     const ExperimentConfig& cfg = viewer.config();
     Json scene = viewer.source().at("scene");
     if (scene.contains("objects") && scene["objects"].is_array())
-        for (Json& o : scene["objects"]) absolutiseScenePaths(o, parentDir(cfg.file));
+        // Absolute: the saved config may go to another folder, and a config given as a relative path
+        // has a relative folder (fifteenth probe: "cfg/b.gltf" was read back as saved/cfg/b.gltf).
+        for (Json& o : scene["objects"]) absolutiseScenePaths(o, std::filesystem::absolute(parentDir(cfg.file)).string());
 
     const Camera& cam = viewer.camera;
     Json camera = {{"fov_y_deg", cam.fovYDeg}, {"near", cam.nearPlane}, {"far", cam.farPlane},
