@@ -1,6 +1,7 @@
 // shadowlab-gui driven without a person: launched under Xvfb (GLX on llvmpipe) with its automation
 // options, which act through the same functions as the widgets (selectAlgorithm, applyParamChange,
 // the path recorder, the config writer). CPU tier: it needs no GL context of its own.
+#include "framework/core/Text.h"
 #include "framework/experiment/Config.h"
 #include "tests/HostileInputs.h"
 #include "tests/TestSupport.h"
@@ -285,6 +286,22 @@ TEST(GuiTest, EchoedValuesStayShort) {
         EXPECT_EQ(guiError(kSmoke + " " + args, out), 2) << out.substr(0, 300);
         EXPECT_LT(out.size(), 500u) << out.substr(0, 300);
         EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << out.substr(0, 300);
+    }
+}
+
+// Sixteenth probe: the GUI printed escape sequences, bidi controls and a value cut inside a UTF-8
+// character to the terminal, where the runner masks them.
+TEST(GuiTest, ErrorLinesMaskControlCharactersAndStayValidUtf8) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    std::string longUtf8;
+    for (int i = 0; i < 100; ++i) longUtf8 += "\xc3\xa9";  // é, two bytes each
+    for (const std::string value : {std::string("\x1b[31mRED\x07"), std::string("a\xe2\x80\xae" "b"), longUtf8}) {
+        std::string out;
+        EXPECT_EQ(guiError(kSmoke + " --view '" + value + "'", out), 2) << out;
+        EXPECT_EQ(out.find('\x1b'), std::string::npos) << out;
+        EXPECT_EQ(out.find('\x07'), std::string::npos) << out;
+        EXPECT_EQ(out.find("\xe2\x80\xae"), std::string::npos) << out;
+        EXPECT_TRUE(isValidUtf8(out)) << out;
     }
 }
 

@@ -220,6 +220,15 @@ std::vector<BadCase> badCases() {
                                     "triangles": 100, "path": {"interpolation": "linear", "keyframes": [{"time": 0, "translate": [0, 0, 0]},
                                     {"time": 1, "translate": [1e8, 0, 0]}]}}]})"}}),
          {"/scene/objects/1/path", "the moving object", "would be drawn distorted", "frame 1"}},
+        // Sixteenth probe: a moving grid was held as one object (2000 units across), its 0.1-unit
+        // spheres moved to 1e5 where a float's spacing is 7.8 % of them.
+        {"MovingGridCopiesFarFromTheOrigin", "c.json",
+         configWith({{"frames", "2"}, {"light", R"({"type": "point", "position": [0, 100, 0]})"},
+                     {"scene", R"({"objects": [{"procedural": "plane"}, {"procedural": "grid", "count": [2, 1, 1],
+                                    "spacing": [2000, 0, 0], "object": {"procedural": "sphere", "radius": 0.05, "triangles": 16},
+                                    "path": {"interpolation": "linear", "keyframes": [{"time": 0, "translate": [0, 0, 0]},
+                                    {"time": 1, "translate": [1e5, 0, 0]}]}}]})"}}),
+         {"/scene/objects/1/path", "copy 1 of the grid's 2", "would be drawn distorted", "frame 1"}},
         // Sixth probe: an absolute buffer path was "not found" without a JSON path; "%zz" was called a NUL.
         {"GltfBufferAbsolutePath", "m.gltf", test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "/etc/hostname"}])"}}),
          {"m.gltf", "/buffers/0/uri", "an absolute path"}},

@@ -208,6 +208,11 @@ static void checkPoses(const ExperimentConfig& c) {
             if (const std::string why = floatDistortion(b); !why.empty())
                 throw InputError(file, path, "the moving object, " + why + ", at " + frameText(c, f) +
                                                  ": keep its path nearer the origin or make the object larger");
+            // Each copy of a moving grid too (sixteenth probe: 0.1-unit spheres 2000 apart moved to
+            // 1e5 ran, where the same grid placed there, or one sphere moved there, was refused).
+            if (const std::string why = copyDistortion(part, pose[p]); !why.empty())
+                throw InputError(file, path, "the moving grid's " + why + ", at " + frameText(c, f) +
+                                                 ": keep its path nearer the origin or make the object larger");
             if (checkTriangles) checkPosedTriangles(part, pose[p], file, path, c, f);
         }
         checkPoseBounds(c, f, scene.boundsAt(pose));

@@ -1,5 +1,6 @@
 // shadowlab-gui: the interactive viewer (GLFW window + Dear ImGui) over the same framework as `shadowlab`.
 #include "framework/core/Error.h"
+#include "framework/core/Text.h"
 #include "framework/gui/GuiApp.h"
 
 #include <cstdio>
@@ -32,10 +33,12 @@ int main(int argc, char** argv) {
         }
         return runGui(opts);
     } catch (const InputError& e) {
-        std::fprintf(stderr, "shadowlab-gui: error: %s\n", e.what());
+        // Masked and bounded as the runner's (sixteenth probe: escape sequences and bidi controls
+        // in a value or a config path reached the terminal raw).
+        std::fprintf(stderr, "shadowlab-gui: error: %s\n", shortText(e.what(), 1000).c_str());
         return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "shadowlab-gui: failed: %s\n", oneLine(e.what()).c_str());
+        std::fprintf(stderr, "shadowlab-gui: failed: %s\n", shortText(oneLine(e.what()), 1000).c_str());
         return 1;
     }
 }

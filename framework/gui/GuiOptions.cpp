@@ -41,7 +41,7 @@ InputError usage(const std::string& cause) { return InputError("command line", "
 
 /// What the user typed, echoed back at most 60 characters long (a pasted file stays one short line).
 std::string echoed(const std::string& text) {
-    return "\"" + (text.size() > 60 ? text.substr(0, 57) + "..." : text) + "\"";
+    return "\"" + shortText(text, 57) + "\"";
 }
 
 /// A plain decimal number (sign, digits, fraction, exponent), as the runner's --threshold: strtod's

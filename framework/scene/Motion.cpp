@@ -145,6 +145,18 @@ MotionFn composeMotion(MotionFn outer, MotionFn inner, std::string file, std::st
     };
 }
 
+void MovingPart::setCopies(size_t trianglesPerCopy) {
+    copyBoxes.clear();
+    if (trianglesPerCopy == 0 || triangleCount <= trianglesPerCopy || triangleCount % trianglesPerCopy != 0 ||
+        local.size() != 3 * triangleCount)
+        return;
+    for (size_t first = 0; first < local.size(); first += 3 * trianglesPerCopy) {
+        glm::vec3 lo = local[first], hi = local[first];
+        for (size_t v = first; v < first + 3 * trianglesPerCopy; ++v) lo = glm::min(lo, local[v]), hi = glm::max(hi, local[v]);
+        copyBoxes.emplace_back(lo, hi);
+    }
+}
+
 void MovingPart::setLocal(std::vector<glm::vec3> vertices) {
     local = std::move(vertices);
     localMin = glm::vec3(0.0f), localMax = glm::vec3(0.0f);

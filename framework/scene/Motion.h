@@ -11,6 +11,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace shadowlab {
@@ -82,9 +83,15 @@ struct MovingPart {
     std::string sourceFile, sourcePath;
     /// Its triangles are a mesh's: each keeps its shape within 1 % at every pose, not just an area.
     bool heldEachTriangle = false;
+    /// When the part is a grid's copies of one object: each copy's local box (min, max), so each is
+    /// held to the float spacing rule at every pose as a static grid's copies are; empty otherwise.
+    std::vector<std::pair<glm::vec3, glm::vec3>> copyBoxes;
 
     /// Sets the local copy and its box.
     void setLocal(std::vector<glm::vec3> vertices);
+    /// Marks the part as copies of `trianglesPerCopy` triangles each (a grid's innermost object)
+    /// when it holds two or more whole copies; does nothing otherwise.
+    void setCopies(size_t trianglesPerCopy);
 };
 
 /// `outer` composed onto `inner` (world = outer(t) · inner(t)), checked: a product of two finite

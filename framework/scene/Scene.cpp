@@ -174,6 +174,33 @@ Bounds partBoundsAt(const MovingPart& part, const glm::mat4& m) {
     return b;
 }
 
+std::string copyDistortion(const MovingPart& part, const glm::mat4& m) {
+    if (part.copyBoxes.empty()) return "";
+    // Every copy passes when the smallest could not be distorted at the part's farthest coordinate:
+    // a box of largest side L keeps a side of at least sigma_min(M) L / sqrt(3) under M, and
+    // 1 / |M^-1|_F bounds sigma_min(M) from below. Only a part that fails this is checked copy by copy.
+    const float far = farthestCoordinate(partBoundsAt(part, m));
+    const double spacing = double(std::nextafter(far, INFINITY) - far);
+    float smallest = INFINITY;
+    for (const auto& [lo, hi] : part.copyBoxes) {
+        const glm::vec3 e = hi - lo;
+        smallest = std::min(smallest, std::max({e.x, e.y, e.z}));
+    }
+    const glm::dmat3 inverse = glm::inverse(glm::dmat3(glm::mat3(m)));
+    double frobenius = 0.0;
+    for (int c = 0; c < 3; ++c) frobenius += glm::dot(inverse[c], inverse[c]);
+    const double lower = double(smallest) / (std::sqrt(frobenius) * std::sqrt(3.0));
+    if (std::isfinite(lower) && spacing <= 0.01 * lower) return "";
+    for (size_t i = 0; i < part.copyBoxes.size(); ++i) {
+        MovingPart copy;
+        copy.localMin = part.copyBoxes[i].first, copy.localMax = part.copyBoxes[i].second;
+        if (const std::string why = floatDistortion(partBoundsAt(copy, m)); !why.empty())
+            return "copy " + std::to_string(i + 1) + " of the grid's " + std::to_string(part.copyBoxes.size()) +
+                   " (its innermost object), " + why;
+    }
+    return "";
+}
+
 Bounds Scene::boundsAt(const std::vector<glm::mat4>& pose) const {
     Bounds b = staticBounds;
     for (size_t p = 0; p < moving.size(); ++p) b.extend(partBoundsAt(moving[p], pose[p]));

@@ -60,6 +60,9 @@ std::string floatPrecisionAt(const Bounds& b);
 glm::mat4 poseOf(const MovingPart& part, double time);
 /// A box around `part`'s triangles posed by `m`: its local box's corners under `m`.
 Bounds partBoundsAt(const MovingPart& part, const glm::mat4& m);
+/// floatDistortion() of the first of a grid part's copies (MovingPart::copyBoxes) that the pose `m`
+/// would draw distorted, named "copy I of the grid's N (its innermost object), ..."; "" when none.
+std::string copyDistortion(const MovingPart& part, const glm::mat4& m);
 
 /// Bytes a triangle takes in a Scene (3 positions 36, normal 12, material id 4), and in SceneGpu
 /// (positions 36, normal + material 16), which a software renderer keeps in host memory too.

@@ -558,7 +558,13 @@ Builder parseObject(JsonNode node, int depth, int budget) {
         if (built->written && kind != "mesh" && m != glm::mat4(1.0f)) before = s;
         if (m != glm::mat4(1.0f)) transformInPlace(s, m);
         // The path moves the placed object: world(t) = path(t) · transform · object.
-        if (path) s.attachMotion(motion, path->startTime(), path->endTime(), path->file, path->jsonPath);
+        if (path) {
+            s.attachMotion(motion, path->startTime(), path->endTime(), path->file, path->jsonPath);
+            // A part starting on a copy's first triangle holds whole copies (a grid's parts are runs of them).
+            if (const size_t leaf = built->leafCount(); leaf > 0)
+                for (MovingPart& part : s.moving)
+                    if (part.firstTriangle % leaf == 0) part.setCopies(leaf);
+        }
         if (built->written)
             for (MovingPart& part : s.moving) part.heldEachTriangle = true;  // checked at every pose (Config.cpp)
         checkBuilt(s, node, expected, built->leafCount());
