@@ -321,6 +321,17 @@ TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
         // Twelfth probe: a 200,000-character stage name was written whole into compare.md.
         {[](Json& s) { s["algorithms"]["psv"]["time_ms"][std::string(200000, 'A')] = {{"mean", 1.0}}; }, "/algorithms/psv/time_ms"},
         {[](Json& s) { s["algorithms"]["psv"]["counters"]["<img onerror=x>"] = {{"mean", 1.0}}; }, "/algorithms/psv/counters"},
+        // Seventeenth probe: the right types in the wrong nesting (a stage time as a bare number,
+        // repetitions without their times) stopped compare and history with the JSON library's
+        // message and exit 1; an algorithm written as a formula was taken.
+        {[](Json& s) { s["algorithms"]["psv"]["time_ms"]["total"] = 3; }, "/algorithms/psv/time_ms/total"},
+        {[](Json& s) { s["algorithms"]["psv"]["time_ms"] = 3; }, "/algorithms/psv/time_ms"},
+        {[](Json& s) { s["algorithms"]["psv"]["repetitions"] = {{"count", 9}}; }, "/algorithms/psv/repetitions"},
+        {[](Json& s) { s["algorithms"]["psv"]["repetitions"] = Json::array({1, 2, 3}); }, "/algorithms/psv/repetitions"},
+        {[](Json& s) { s["algorithms"]["psv"]["repetitions"]["time_ms"]["total"] = 4; }, "/algorithms/psv/repetitions/time_ms/total"},
+        {[](Json& s) { s["algorithms"]["psv"]["repetitions"]["count"] = 2.5; }, "/algorithms/psv/repetitions/count"},
+        {[](Json& s) { s["algorithms"]["psv"]["total_ms_per_frame"] = 4; }, "/algorithms/psv/total_ms_per_frame"},
+        {[](Json& s) { s["algorithms"]["psv"]["algorithm"] = "=HYPERLINK(\"http://x\",\"y\")"; }, "/algorithms/psv/algorithm"},
     };
     for (const auto& [change, path] : edits) {
         SCOPED_TRACE(path);

@@ -441,6 +441,23 @@ TEST(SweepStateTest, ResultsUnderAnIdTheConfigDoesNotGiveAreAFailedRun) {
     EXPECT_EQ(csv.find("SSSSSSSS"), std::string::npos);
 }
 
+// Seventeenth probe: a summary.json whose algorithm was rewritten (to a formula, which
+// readRunSummary refuses, or to another algorithm's name) was merged as the run's.
+TEST(SweepStateTest, ResultsOfAnotherAlgorithmThanTheConfigsAreAFailedRun) {
+    const std::string dir = test::makeTempDir("merge-forged-algorithm"), out = dir + "/out";
+    const Json plan = test::fakeSweepRuns(kBin, smallFile(dir), out);
+    ASSERT_EQ(plan["runs"].size(), 4u);
+    const std::string summary = out + "/runs/" + plan["runs"][1]["id"].get<std::string>() + "/summary.json";
+    Json forged = JsonNode::parseFile(summary);
+    forged["algorithms"]["psv"]["algorithm"] = "izb";
+    std::ofstream(summary, std::ios::trunc) << forged.dump();
+    const Ran r = runArgs(sweep({"merge", out, "--no-plots"}));
+    EXPECT_EQ(r.rc, 1) << r.err;
+    EXPECT_NE(r.err.find("names another algorithm for \"psv\" than its config.resolved.json (psv)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("3 of 4 runs merged (1 failed)"), std::string::npos) << r.err;
+    EXPECT_EQ(test::readText(out + "/sweep.csv").find("izb"), std::string::npos);
+}
+
 TEST(SweepStateTest, AStaleErrorRecordBesideACompleteRunIsIgnoredAndRemoved) {
     const std::string dir = test::makeTempDir("stale-error"), file = smallFile(dir), out = dir + "/out";
     const Json plan = test::fakeSweepRuns(kBin, file, out);

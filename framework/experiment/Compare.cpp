@@ -84,6 +84,34 @@ void checkAccuracy(const Json& a, const std::string& file, const std::string& pa
     }
 }
 
+/// The nesting compare and history read is the one a run writes (seventeenth probe: a stage time
+/// written as a bare number, or repetitions without their times, stopped compare and history
+/// with the JSON library's message and exit 1): time_ms, cpu_time_ms and counters map names to
+/// statistics objects; repetitions holds a count and, per stage, a list of times; the frames'
+/// totals are a list; the algorithm is a name as a run writes it (a formula in it reached sweep.csv).
+void checkRunFieldShapes(const Json& entry, const std::string& file, const std::string& at) {
+    if (entry.contains("algorithm") && !(entry["algorithm"].is_string() && isAlgorithmId(entry["algorithm"].get<std::string>())))
+        throw InputError(file, at + "/algorithm", "holds " + shortText(entry["algorithm"].dump(), 40) + " where a run writes an algorithm's name");
+    for (const char* key : {"time_ms", "cpu_time_ms", "counters"}) {
+        if (!entry.contains(key)) continue;
+        if (!entry[key].is_object()) throw InputError(file, at + "/" + key, "is not an object, as a run writes it");
+        for (const auto& [name, stats] : entry[key].items())
+            if (!stats.is_object())
+                throw InputError(file, at + "/" + key + "/" + shortText(name, 60), "is not an object of statistics (mean, median, ...), as a run writes it");
+    }
+    if (entry.contains("total_ms_per_frame") && !entry["total_ms_per_frame"].is_array())
+        throw InputError(file, at + "/total_ms_per_frame", "is not a list, as a run writes it");
+    if (entry.contains("repetitions")) {
+        const Json& r = entry["repetitions"];
+        if (!r.is_object() || !r.contains("count") || !r.contains("time_ms") || !r["time_ms"].is_object())
+            throw InputError(file, at + "/repetitions", "is not a run's repetitions ({\"count\": N, \"time_ms\": {stage: [times]}})");
+        checkCount(r["count"], file, at + "/repetitions/count");
+        for (const auto& [name, times] : r["time_ms"].items())
+            if (!times.is_array())
+                throw InputError(file, at + "/repetitions/time_ms/" + shortText(name, 60), "is not a list of times, as a run writes it");
+    }
+}
+
 /// The fields compare and history read have the types a run writes (eighth probe: a time written
 /// as the string "NaN" stopped compare with a library's message and exit 1).
 void checkRunFieldTypes(const Json& s, const std::string& file) {
@@ -114,6 +142,7 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
         for (const char* key : {"accuracy", "counters", "cpu_time_ms", "time_ms", "memory_bytes", "overflow", "preprocess_ms",
                                 "resident_bytes", "statistics_pass", "total_ms_per_frame", "repetitions"})
             if (entry.contains(key)) checkNumbersOnly(entry[key], file, at + "/" + key);
+        checkRunFieldShapes(entry, file, at);
         // Counts are what a run counts (ninth probe: an overflow of 1e30 read as 0, -1 as 2^64 - 1).
         for (const char* key : {"overflow", "memory_bytes", "resident_bytes"})
             if (entry.contains(key)) checkCount(entry[key], file, at + "/" + key);

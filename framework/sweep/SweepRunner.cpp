@@ -128,10 +128,16 @@ bool RunPaths::complete(std::string* why) const {
     std::set<std::string> ids;
     collectIds(resolved, ids);
     if (s.contains("algorithms") && s["algorithms"].is_object())
-        for (const auto& [name, entry] : s["algorithms"].items())
+        for (const auto& [name, entry] : s["algorithms"].items()) {
             if (!ids.count(name))
                 return fail("summary.json has results under the id \"" + shortText(name, 60) +
                             "\", which its config.resolved.json does not give");
+            // And of the algorithm the config runs under that id (seventeenth probe: a formula
+            // written as the algorithm reached sweep.csv).
+            if (const std::string algorithm = algorithmOf(resolved, name); entry.is_object() && entry.value("algorithm", Json()) != Json(algorithm))
+                return fail("summary.json names another algorithm for \"" + shortText(name, 60) + "\" than its config.resolved.json (" +
+                            shortText(algorithm, 60) + ")");
+        }
     return true;
 }
 
