@@ -24,6 +24,17 @@ TEST(CliTest, HelpAndListSucceed) {
     EXPECT_NE(out.find("reference"), std::string::npos);
 }
 
+// Eighteenth probe: `--version --bogus` printed the version and exited 0.
+TEST(CliTest, VersionTakesNoArguments) {
+    EXPECT_EQ(test::runArgs({bin(), "--version"}).rc, 0);
+    for (const char* extra : {"--bogus", "extra"}) {
+        const test::Ran r = test::runArgs({bin(), "--version", extra});
+        EXPECT_EQ(r.rc, 2) << r.err;
+        EXPECT_NE(r.err.find("--version takes no arguments"), std::string::npos) << r.err;
+        EXPECT_EQ(r.out, "");
+    }
+}
+
 // Every command and subcommand: --help and -h print that command's usage on stdout, exit code 0,
 // whatever else is on the line.
 TEST(CliTest, HelpOnEveryCommand) {

@@ -220,6 +220,21 @@ std::vector<BadCase> badCases() {
                                     "triangles": 100, "path": {"interpolation": "linear", "keyframes": [{"time": 0, "translate": [0, 0, 0]},
                                     {"time": 1, "translate": [1e8, 0, 0]}]}}]})"}}),
          {"/scene/objects/1/path", "the moving object", "would be drawn distorted", "frame 1"}},
+        // Eighteenth probe: past 10,000 frames the rules were checked on every other frame, and a
+        // sphere moved far away (or onto the light) at frame 1 only ran.
+        {"MovedFarAwayOnOneFrameOfTwentyThousand", "c.json",
+         configWith({{"frames", "20001"}, {"scene", R"({"time_range": [0, 20000], "objects": [{"procedural": "plane"},
+                                    {"procedural": "sphere", "radius": 0.5, "triangles": 16, "path": {"interpolation": "step",
+                                    "keyframes": [{"time": 0, "translate": [0, 1, 0]}, {"time": 1, "translate": [1e6, 1, 0]},
+                                    {"time": 1.5, "translate": [0, 1, 0]}]}}]})"}}),
+         {"/scene/objects/1/path", "the moving object", "would be drawn distorted", "frame 1 "}},
+        {"OntoTheLightOnOneFrameOfTwentyThousand", "c.json",
+         configWith({{"frames", "20001"}, {"light", R"({"type": "point", "position": [2, 4.5, 1.5]})"},
+                     {"scene", R"({"time_range": [0, 20000], "objects": [{"procedural": "plane"},
+                                    {"procedural": "sphere", "radius": 0.5, "triangles": 16, "path": {"interpolation": "step",
+                                    "keyframes": [{"time": 0, "translate": [0, 1, 0]}, {"time": 1, "translate": [2, 4, 1.5]},
+                                    {"time": 1.5, "translate": [0, 1, 0]}]}}]})"}}),
+         {"/light/position", "frame 1 "}},
         // Sixteenth probe: a moving grid was held as one object (2000 units across), its 0.1-unit
         // spheres moved to 1e5 where a float's spacing is 7.8 % of them.
         {"MovingGridCopiesFarFromTheOrigin", "c.json",
@@ -386,6 +401,23 @@ TEST_P(HostileInputTest, ExitsTwoWithOneShortLine) {
 
 INSTANTIATE_TEST_SUITE_P(Table, HostileInputTest, ::testing::ValuesIn(badCases()),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// Eighteenth probe: under `ulimit -v` the plan counted only the process's size when planned, and
+// runs it admitted died later, when Mesa and Embree map their threads and code (SIGSEGV, or
+// Embree's out of memory). A limit that leaves no room for them is refused up front.
+TEST(HostileInputTest, AnAddressSpaceLimitTooSmallForTheLibrariesIsRefusedNotACrash) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no ulimit -v run can start";
+#else
+    std::string dir = test::makeTempDir("hostile-ulimit");
+    std::ofstream(dir + "/c.json") << test::configWith({});
+    std::string out;
+    EXPECT_EQ(test::runCommand("(ulimit -v 700000; " + bin() + " run " + dir + "/c.json --no-progress --out " + dir + "/out)", out), 2)
+        << out;
+    EXPECT_NE(out.find("(ulimit -v)"), std::string::npos) << out;
+    EXPECT_FALSE(fs::exists(dir + "/out"));
+#endif
+}
 
 TEST(HostileInputTest, AMovingObjectWithANonFinitePoseFailsTheRunBeforeAnythingIsWritten) {
     // Formerly the object vanished from frame 1 on, every algorithm agreed with the reference on

@@ -411,6 +411,8 @@ static int dispatch(std::vector<std::string> args) {
             return args.empty() ? 2 : 0;
         }
         if (args[0] == "--version") {
+            // Eighteenth probe: `--version --bogus` printed the version; every command refuses what it does not take.
+            if (args.size() > 1) usageError("--version takes no arguments, got \"" + shortText(args[1], 60) + "\"");
             std::puts("shadowlab 0.1");
             return 0;
         }

@@ -8,7 +8,8 @@ namespace shadowlab {
 struct SystemMemory {
     size_t total = 0;     ///< MemTotal, bytes (0: unknown)
     /// What this process can still allocate, bytes: MemAvailable (without swapping), or less where
-    /// an address-space limit (ulimit -v: its headroom over VmSize) or the cgroup's memory.max
+    /// an address-space limit (ulimit -v: its headroom over VmSize and what the libraries map later,
+    /// SystemMemory.cpp) or the cgroup's memory.max
     /// (a container's limit: its headroom over memory.current) leaves less.
     size_t available = 0;
     const char* limitedBy = "";  ///< "" (MemAvailable), "ulimit -v" or "cgroup memory.max"

@@ -120,8 +120,7 @@ void checkLightClearance(const ExperimentConfig& c) {
     const double offset = largestRayOffset(c);
     const StaticChunks chunks(scene);
     const bool changes = !c.lightPath.empty() || scene.dynamic();
-    const int step = std::max(1, c.frames / 10000);  // as checkPoses() visits them
-    for (int f = 0;; f = std::min(f + step, c.frames - 1)) {
+    for (int f = 0;; ++f) {  // every frame, as checkPoses() visits them
         std::vector<glm::mat4> pose;
         if (scene.dynamic()) pose = scene.poseAt(c.sceneTimeAt(f));  // checked finite by checkPoses()
         const Bounds bounds = scene.dynamic() ? scene.boundsAt(pose) : scene.bounds;

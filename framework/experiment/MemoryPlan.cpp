@@ -248,7 +248,8 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
         refuseOverflow(cfg, "/statistics", "the statistics pass's structures with the timed pass's", setupPeak, triangles);
     }
     plan.peak = std::max({plan.loadPeak, gpuUploadPeak, held, setupPeak});
-    if (plan.available > 0 && plan.peak > plan.available)
+    // 0 available is unknown (no MemAvailable), except where a limit says nothing is left.
+    if ((plan.available > 0 || *machine.limitedBy) && plan.peak > plan.available)
         throw InputError(cfg.file, "/scene",
                          "the run would need about " + plan.summary() + " for up to " + std::to_string(triangles) +
                              " triangles; " +
