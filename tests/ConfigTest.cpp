@@ -96,6 +96,9 @@ const BadCase kBad[] = {
     {"ids_differ_in_case_only", R"({"algorithms": [{"algorithm": "shadow_map", "id": "SM"}, {"algorithm": "shadow_map", "id": "sm"}]})",
      "/algorithms/1/id", "only in case"},
     {"id_reference_in_another_case", R"({"algorithms": [{"algorithm": "shadow_map", "id": "Reference"}]})", "/algorithms/0/id", "only in case"},
+    // Nineteenth probe: an id "scene" replaced the scene's bytes in the memory tables.
+    {"id_scene", R"({"algorithms": [{"algorithm": "shadow_map", "id": "scene"}]})", "/algorithms/0/id", "the scene's own entry"},
+    {"id_scene_gpu", R"({"algorithms": [{"algorithm": "shadow_map", "id": "scene_gpu"}]})", "/algorithms/0/id", "the scene's own entry"},
     {"unknown_top_key", R"({"framez": 3})", "/framez", "accepted keys"},
     // Seventh probe: an integer written as a float was taken by frames but not by resolution; both take
     // it now, and a fraction is refused by both.

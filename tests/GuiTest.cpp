@@ -269,6 +269,16 @@ TEST(GuiTest, MalformedNumbersAndEmptyFileNamesAreBadInput) {
     }
 }
 
+// Nineteenth probe: --help and --version exited 0 with nothing written.
+TEST(GuiTest, HelpAndVersionToAFullOrClosedOutputAreAnError) {
+    if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
+    for (const std::string args : {"--help > /dev/full", "--version > /dev/full", "--help >&-", "--version >&-"}) {
+        std::string out;
+        EXPECT_EQ(test::runCommand("(" + kGui + " " + args + ")", out), 2) << args << "\n" << out;
+        EXPECT_NE(out.find("shadowlab-gui: error: standard output"), std::string::npos) << args << "\n" << out;
+    }
+}
+
 TEST(GuiTest, HelpExitsZeroWhateverElseTheLineHolds) {
     if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
     for (const std::string args : {"--help", "-h", "--help --frames x", "--size 1x1 --help"}) {

@@ -416,6 +416,12 @@ TEST(HostileInputTest, AnAddressSpaceLimitTooSmallForTheLibrariesIsRefusedNotACr
         << out;
     EXPECT_NE(out.find("(ulimit -v)"), std::string::npos) << out;
     EXPECT_FALSE(fs::exists(dir + "/out"));
+    // Nineteenth probe: 256 reference threads under a limit that holds the default's ended in
+    // std::terminate (exit 134); their stacks are set aside too.
+    std::ofstream(dir + "/t.json") << test::configWith({{"reference", R"({"params": {"threads": 256}})"}});
+    EXPECT_EQ(test::runCommand("(ulimit -v 1500000; " + bin() + " validate " + dir + "/c.json >/dev/null)", out), 0) << out;
+    EXPECT_EQ(test::runCommand("(ulimit -v 1500000; " + bin() + " validate " + dir + "/t.json >/dev/null)", out), 2) << out;
+    EXPECT_NE(out.find("(ulimit -v)"), std::string::npos) << out;
 #endif
 }
 

@@ -133,6 +133,7 @@ Footprint referenceFootprint(const FootprintQuery& q) {
     // Embree's builder holds primitive references and temporary nodes while it builds: at 74 M
     // triangles the run's peak stayed within 0.4 GiB of what was held after setup, so this is margin.
     f.peakBytes = saturatingMul(q.triangles, 32);
+    f.threads = size_t(EmbreeTracer::threadsFor(std::get<int>(q.params->get("threads")), pixels));
     return f;
 }
 

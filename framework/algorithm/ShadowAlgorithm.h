@@ -97,6 +97,9 @@ struct Footprint {
     /// Of `bytes`, what lies in textures: freed by the driver as soon as the algorithm is destroyed
     /// (llvmpipe keeps a destroyed algorithm's buffers, not its textures, until the run ends).
     size_t textureBytes = 0;
+    /// CPU threads it starts (0: none beyond one per core): under `ulimit -v` each maps a stack,
+    /// which the plan sets aside (SystemMemory.cpp covers two per core).
+    size_t threads = 0;
     std::string refusal;  ///< not empty: this algorithm cannot run the scene on this device, and why
 };
 

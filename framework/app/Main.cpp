@@ -2,6 +2,7 @@
 #include "framework/algorithm/ShadowAlgorithm.h"
 #include "framework/core/Error.h"
 #include "framework/core/Interrupt.h"
+#include "framework/core/StandardStreams.h"
 #include "framework/experiment/Config.h"
 #include "framework/experiment/MemoryPlan.h"
 #include "framework/experiment/OutputPlace.h"
@@ -366,33 +367,6 @@ int info(const std::vector<std::string>& args) {
 
 } // namespace
 
-/// A standard stream the caller closed is opened again, so that no file this process opens
-/// takes its number (a results file receiving the summary table): standard input and error on
-/// /dev/null, standard output on /dev/full, where every write fails and checkStandardOutput()
-/// reports it.
-static void reopenClosedStandardStreams() {
-    for (int fd : {0, 1, 2})
-        if (fcntl(fd, F_GETFD) < 0 && errno == EBADF) {
-            const int opened = open(fd == 1 ? "/dev/full" : "/dev/null", fd == 0 ? O_RDONLY : O_WRONLY);
-            if (opened >= 0 && opened != fd) {
-                dup2(opened, fd);
-                close(opened);
-            }
-        }
-}
-
-/// Whatever a command printed reached standard output: a full disk or a closed stream is an
-/// output place that cannot take the result, reported like any other (exit 2), never exit 0 with
-/// nothing written.
-static int checkStandardOutput(int rc) {
-    std::cout.flush();
-    errno = 0;
-    if (std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good()) return rc;
-    std::fprintf(stderr, "shadowlab: error: standard output: cannot write what the command printed (%s)\n",
-                 errno ? std::strerror(errno) : "write error");
-    return rc == 0 ? 2 : rc;
-}
-
 static int dispatch(std::vector<std::string> args);
 
 int main(int argc, char** argv) {
@@ -401,7 +375,7 @@ int main(int argc, char** argv) {
     // reports in one line (exit 2), instead of SIGPIPE ending the process without a word (seventh
     // probe). Children get the default back (SweepProcess, runChildProcess).
     std::signal(SIGPIPE, SIG_IGN);
-    return checkStandardOutput(dispatch(std::vector<std::string>(argv + 1, argv + argc)));
+    return checkStandardOutput("shadowlab", dispatch(std::vector<std::string>(argv + 1, argv + argc)));
 }
 
 static int dispatch(std::vector<std::string> args) {

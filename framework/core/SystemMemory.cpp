@@ -63,15 +63,17 @@ size_t cgroupHeadroom() {
 /// in SIGSEGV, a 16-triangle one in Embree's out of memory); measured at 2 cores, a run's VmPeak is
 /// about 190 MB above its VmSize when planned (results/reference/memory_bounds_llvmpipe.md).
 size_t laterAddressSpace() {
-    struct rlimit stack {};
-    size_t threadStack = size_t(8) << 20;
-    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur != RLIM_INFINITY && stack.rlim_cur > 0)
-        threadStack = size_t(stack.rlim_cur);
     const size_t cores = std::max(1u, std::thread::hardware_concurrency());
-    return (size_t(256) << 20) + 2 * cores * threadStack;
+    return (size_t(256) << 20) + 2 * cores * threadStackBytes();
 }
 
 } // namespace
+
+size_t threadStackBytes() {
+    struct rlimit stack {};
+    if (getrlimit(RLIMIT_STACK, &stack) == 0 && stack.rlim_cur != RLIM_INFINITY && stack.rlim_cur > 0) return size_t(stack.rlim_cur);
+    return size_t(8) << 20;  // glibc's default for threads when the limit is unlimited
+}
 
 SystemMemory systemMemory() {
     SystemMemory m{procKilobytes("/proc/meminfo", "MemTotal"), procKilobytes("/proc/meminfo", "MemAvailable"), ""};

@@ -15,6 +15,8 @@ struct SystemMemory {
     const char* limitedBy = "";  ///< "" (MemAvailable), "ulimit -v" or "cgroup memory.max"
 };
 SystemMemory systemMemory();
+/// The address space a new thread's stack takes (RLIMIT_STACK, as glibc sizes thread stacks).
+size_t threadStackBytes();
 
 /// This process's peak resident set (VmHWM), bytes; 0 when unknown.
 size_t peakResidentBytes();

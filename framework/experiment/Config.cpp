@@ -324,6 +324,10 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     auto entries = root.objectArray("algorithms");
     for (auto& node : entries) {
         AlgorithmEntry e = parseEntry(node, "");
+        // The memory tables list the scene's own parts beside the algorithms by name (nineteenth
+        // probe: an id "scene" replaced the scene's bytes in summary.json and the report).
+        if (e.id == "scene" || e.id == "scene_gpu")
+            throw InputError(file, node.childPath("id"), "the id \"" + e.id + "\" names the scene's own entry in the memory tables; choose another");
         if (!ids.insert(e.id).second)
             throw InputError(file, node.childPath("id"), "duplicate id \"" + e.id + "\" (ids label results, so each must be unique)");
         // Ids name files (images, plots): two that differ only in case are one file on a

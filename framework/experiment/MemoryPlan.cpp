@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <thread>
 
 namespace shadowlab {
 
@@ -224,6 +225,7 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
     // top of the scene and of what it and the ones before it hold, not of what comes after.
     size_t held = saturatingSum({plan.held[0].second, plan.held[1].second, plan.held[2].second}), setupPeak = 0;
     size_t buffersAgain = 0, largestSetup = 0;  // for the statistics pass, below
+    const size_t cores = std::max(1u, std::thread::hardware_concurrency());
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         if (!e->info->footprint) continue;
         const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
@@ -231,6 +233,10 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
         if (!f.refusal.empty())
             throw InputError(cfg.file, where, e->info->name + " cannot run this scene (up to " + std::to_string(triangles) +
                                                   " triangles) on this device: " + f.refusal);
+        // Nineteenth probe: 256 reference threads' stacks under `ulimit -v` ended a run in
+        // std::terminate (Embree could not start them); those past one per core are set aside.
+        if (std::string(machine.limitedBy) == "ulimit -v" && f.threads > cores)
+            plan.available -= std::min(plan.available, saturatingMul(f.threads - cores, threadStackBytes()));
         plan.held.emplace_back(e->id, f.bytes);
         buffersAgain = saturatingSum({buffersAgain, f.bytes - std::min(f.bytes, f.textureBytes)});
         largestSetup = std::max(largestSetup, f.peakBytes);

@@ -1,8 +1,10 @@
 // shadowlab-gui: the interactive viewer (GLFW window + Dear ImGui) over the same framework as `shadowlab`.
 #include "framework/core/Error.h"
+#include "framework/core/StandardStreams.h"
 #include "framework/core/Text.h"
 #include "framework/gui/GuiApp.h"
 
+#include <csignal>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -20,7 +22,17 @@ std::string oneLine(const char* text) {
 
 } // namespace
 
+static int guiMain(int argc, char** argv);
+
+// Nineteenth probe: --help and --version exited 0 with standard output full or closed, where
+// shadowlab reports it (exit 2), as the README says the two do alike.
 int main(int argc, char** argv) {
+    reopenClosedStandardStreams();
+    std::signal(SIGPIPE, SIG_IGN);  // a reader gone is a write error reported, not a silent death
+    return checkStandardOutput("shadowlab-gui", guiMain(argc, argv));
+}
+
+static int guiMain(int argc, char** argv) {
     try {
         GuiOptions opts = parseGuiOptions(std::vector<std::string>(argv + 1, argv + argc));
         if (opts.help) {
