@@ -269,6 +269,35 @@ TEST(GuiTest, MalformedNumbersAndEmptyFileNamesAreBadInput) {
     }
 }
 
+// Twentieth probe: the GUI opened what validate refuses (translucent casters under bvh_raytrace, a
+// scene past the memory plan, where it died in Mesa under ulimit -v), and --screenshot or
+// --report over its own config replaced it. Each is refused before the first frame.
+TEST(GuiTest, WhatValidateRefusesAndOutputsOverInputsAreRefusedBeforeAFrame) {
+    REQUIRE_GUI(cmd);
+    const std::string dir = test::makeTempDir("gui-refusals");
+    std::ofstream(dir + "/glass.json") << test::configWith(
+        {{"scene", R"({"objects": [{"procedural": "plane"}, {"procedural": "sphere", "material": {"opacity": 0.5}}]})"},
+         {"algorithms", R"([{"algorithm": "bvh_raytrace"}])"}});
+    std::string out;
+    // An algorithm's fit on the scene asks the device, so this one is refused once the context exists.
+    EXPECT_EQ(runGui(cmd + " " + dir + "/glass.json --frames 1 2>&1", out), 2) << out;
+    EXPECT_NE(out.find("translucent"), std::string::npos) << out;
+    std::ofstream(dir + "/c.json") << test::configWith({});
+    auto text = [](const std::string& path) { std::ifstream in(path); return std::string(std::istreambuf_iterator<char>(in), {}); };
+    const std::string original = text(dir + "/c.json");
+    for (const std::string option : {"--screenshot", "--report"}) {
+        EXPECT_EQ(guiError(dir + "/c.json --frames 1 " + option + " " + dir + "/c.json", out), 2) << out;
+        EXPECT_NE(out.find("an input of this session"), std::string::npos) << out;
+    }
+    EXPECT_EQ(text(dir + "/c.json"), original);
+#if !defined(__SANITIZE_ADDRESS__)
+    std::ofstream(dir + "/big.json") << test::configWith(
+        {{"scene", R"({"objects": [{"procedural": "soup", "triangles": 8000000}]})"}});
+    EXPECT_EQ(test::runCommand("(ulimit -v 1500000; " + kGui + " " + dir + "/big.json --frames 1)", out), 2) << out;
+    EXPECT_NE(out.find("(ulimit -v)"), std::string::npos) << out;
+#endif
+}
+
 // Nineteenth probe: --help and --version exited 0 with nothing written.
 TEST(GuiTest, HelpAndVersionToAFullOrClosedOutputAreAnError) {
     if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";

@@ -353,6 +353,27 @@ TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
 // Seventh probe: `compare A B --out A --force` and `history H --out H/r1 --force` replaced a run
 // they had just read with their report (exit 0). An output that is, holds or lies inside an input
 // is refused before anything is read or written.
+// Twentieth probe: a run and a compare went into a compare's output (and a history's), whose next
+// --force was then refused for what it would delete. Outputs never nest.
+TEST(HistoryTest, NothingIsWrittenInsideACompareOrHistoryOutput) {
+    const std::string dir = test::makeTempDir("history-nesting");
+    writeRuns(dir, {20, 20, 20}, {0, 0, 0}, kSpread);
+    const std::string runs = dir + "/runs";
+    fs::create_directories(runs);
+    for (const char* r : {"run-100", "run-99", "run-98"}) fs::rename(dir + "/" + r, runs + "/" + r);
+    ASSERT_EQ(test::runArgs({SHADOWLAB_BINARY, "compare", runs + "/run-100", runs + "/run-99", "--out", dir + "/cmp"}).rc, 0);
+    ASSERT_EQ(test::runArgs({SHADOWLAB_BINARY, "history", runs, "--out", dir + "/hist"}).rc, 0);
+    for (const std::string outer : {dir + "/cmp", dir + "/hist"}) {
+        const test::Ran c = test::runArgs({SHADOWLAB_BINARY, "compare", runs + "/run-100", runs + "/run-99", "--out", outer + "/inner"});
+        EXPECT_EQ(c.rc, 2) << c.err;
+        EXPECT_NE(c.err.find("a shadowlab output"), std::string::npos) << c.err;
+        const test::Ran r = test::runArgs({SHADOWLAB_BINARY, "validate", std::string(SHADOWLAB_SOURCE_DIR) + "/configs/smoke.json", "--set",
+                                           "output.dir=\"" + outer + "/inner\""});
+        EXPECT_EQ(r.rc, 2) << r.err;
+        EXPECT_FALSE(fs::exists(outer + "/inner"));
+    }
+}
+
 TEST(HistoryTest, NeitherHistoryNorCompareReplacesARunItReads) {
     const std::string dir = test::makeTempDir("history-inputs");
     writeRuns(dir, {20, 20, 20}, {0, 0, 0}, kSpread);

@@ -96,6 +96,15 @@ TEST(UserTextTest, ValidateRefusesAnOutputPlaceNoRunCanUse) {
         const Result r = shell(kBin + " validate " + kSmoke + " --set 'output.dir=\"" + dir + "\"'");
         expectOneLineNaming(r, "/output/dir");
     }
+    // Twentieth probe: names the file system cannot hold once a run adds its suffixes validated,
+    // and run stopped with "File name too long".
+    const std::string base = test::makeTempDir("user-text-long");
+    std::string deep = base;
+    while (deep.size() < 4000) deep += "/" + std::string(100, 'd');
+    for (const std::string& dir : {base + "/" + std::string(245, 'n'), deep}) {
+        const Result r = shell(kBin + " validate " + kSmoke + " --set 'output.dir=\"" + dir + "\"'");
+        expectOneLineNaming(r, "/output/dir");
+    }
 }
 
 // Reproduction 4 (and 12's non-UTF-8 name): a name that is not one line of plain text is bad input.

@@ -129,7 +129,7 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
         // and U+FFFE in one made compare.junit.xml unreadable).
         if (!isAlgorithmId(id))
             throw InputError(file, "/algorithms", "holds the id \"" + shortText(id, 60) +
-                                                      "\", which no run writes (ids are 1 to 64 letters, digits, '_', '-' or '.', neither of the last two first)");
+                                                      "\", which no run writes (ids are 1 to 64 letters, digits, '_', '-' or '.', starting with a letter or digit)");
         if (!entry.is_object()) throw InputError(file, at, "is not an object, as a run writes each algorithm's results");
         // Stage and counter names reach tables and plots too (twelfth probe: a 200,000-character
         // stage name was written whole into compare.md, .html and .json).
@@ -138,7 +138,7 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
                 for (const auto& [name, value] : entry[key].items())
                     if (!isMeasureName(name))
                         throw InputError(file, at + "/" + key, "holds the name \"" + shortText(name, 60) +
-                                                                   "\", which no run writes (1 to 64 letters, digits, '_', '-' or '.')");
+                                                                   "\", which no run writes (1 to 64 letters, digits, '_', '-' or '.', starting with a letter or digit)");
         for (const char* key : {"accuracy", "counters", "cpu_time_ms", "time_ms", "memory_bytes", "overflow", "preprocess_ms",
                                 "resident_bytes", "statistics_pass", "total_ms_per_frame", "repetitions"})
             if (entry.contains(key)) checkNumbersOnly(entry[key], file, at + "/" + key);

@@ -98,7 +98,7 @@ AlgorithmEntry parseEntry(JsonNode node, const std::string& defaultName) {
         e.id = node.getString("id", name);
         // Ids name result files (images/ID_f0000_shaded.png) and columns: no separators or spaces.
         if (!isAlgorithmId(e.id))
-            node.fail("id", "an id is 1 to 64 letters, digits, '_', '-' or '.' (neither of the last two first), got \"" +
+            node.fail("id", "an id is 1 to 64 letters, digits, '_', '-' or '.', starting with a letter or digit, got \"" +
                                 (e.id.size() > 40 ? e.id.substr(0, 37) + "..." : e.id) + "\"");
     } else {
         e.info = findAlgorithm(name);
@@ -128,7 +128,7 @@ static bool withinCoordinates(const Bounds& b) {
 }
 
 bool isAlgorithmId(const std::string& id) {
-    return !id.empty() && id.size() <= 64 && id[0] != '.' && id[0] != '-' &&
+    return !id.empty() && id.size() <= 64 && std::isalnum(static_cast<unsigned char>(id[0])) &&
            id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") == std::string::npos;
 }
 
@@ -422,6 +422,11 @@ ExperimentConfig loadConfig(const std::string& file, bool loadScene, const std::
 ScenePrediction predictConfigScene(const std::string& file, const std::vector<std::string>& overrides) {
     Json j = JsonNode::parseFile(file);
     for (const auto& o : overrides) applyOverride(j, o);
+    return predictConfigScene(j, file);
+}
+
+ScenePrediction predictConfigScene(const Json& config, const std::string& file) {
+    Json j = config;
     Json resolved = Json::object();
     JsonNode root(file, &j, "", &resolved);
     if (!root.has("scene")) root.fail("scene", "required key is missing");

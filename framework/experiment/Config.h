@@ -68,10 +68,11 @@ struct ExperimentConfig {
 };
 const char* toString(ExperimentConfig::Statistics s);
 
-/// Whether `id` can label an algorithm's results: 1 to 64 letters, digits, '_', '-' or '.', neither
-/// of the last two first. Ids name result files (images/ID_f0000_shaded.png) and columns (a '-'
-/// first would make "-A1" a formula in sweep.csv), so a summary.json whose ids break it is no
-/// run's (compare, history and sweep merge refuse it).
+/// Whether `id` can label an algorithm's results: 1 to 64 letters, digits, '_', '-' or '.',
+/// starting with a letter or digit. Ids name result files (images/ID_f0000_shaded.png), columns (a
+/// '-' first would make "-A1" a formula in sweep.csv) and plot legends (matplotlib hides a label
+/// starting with '_'), so a summary.json whose ids break it is no run's (compare, history and
+/// sweep merge refuse it).
 bool isAlgorithmId(const std::string& id);
 /// Whether `name` can be a stage's or a counter's name in summary.json: the same rule as an id
 /// (they are columns, table rows and measure names; the algorithms' own are lower-case words).
@@ -106,5 +107,7 @@ void applyOverride(Json& config, const std::string& assignment);
 ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loadScene = true);
 /// The config's scene counted without making it (predictScene), with the same overrides.
 ScenePrediction predictConfigScene(const std::string& file, const std::vector<std::string>& overrides = {});
+/// The same for a config already read (`file` names it in errors).
+ScenePrediction predictConfigScene(const Json& config, const std::string& file);
 
 } // namespace shadowlab

@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <climits>
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
@@ -227,6 +228,11 @@ void checkAncestors(const std::string& dir, const std::string& runConfig) {
                 throw InputError(shortPath(dir), "", "the output lies inside " + shortPath(a.string()) +
                                               ", a shadowlab run's temporary directory; choose --out outside it");
             const std::string marker = fs::is_directory(fs::symlink_status(a, ec)) ? markerOf(a) : "";
+            // Any output carrying the mark, a compare's or a history's too (twentieth probe: runs
+            // went into them, and their next --force was refused for what it would delete).
+            if (marker.empty() && fs::is_directory(fs::symlink_status(a, ec)) && isRegularFile(a / kOutputMark))
+                throw InputError(shortPath(dir), "", "the output lies inside " + shortPath(a.string()) +
+                                              ", a shadowlab output; replacing that one would delete this. Choose --out outside it");
             if (marker.empty()) continue;
             if (marker == "sweep.json") {
                 // A sweep runs each of its runs into SWEEP/runs/ID, after writing ID.config.json
@@ -457,6 +463,20 @@ void OutputPlace::refuseOtherKind(const std::string& given, const std::string& o
 void OutputPlace::check(const std::string& given, const std::string& runConfig) {
     const std::string dir = normalize(given);
     checkPlace(dir, runConfig, "results/run1");
+    // Every name the run makes fits the file system's limits (twentieth probe: a 245-byte folder
+    // name validated, and run could not make DIR.partial-PID): the folder's own name with the
+    // longest suffix a run adds (".partial-" and a pid), and the whole path with the deepest file
+    // a run writes (images/ID_fNNNN_difference.png and the like, ids 64 bytes).
+    std::error_code pathEc;
+    const fs::path absolute = fs::absolute(fs::path(dir), pathEc);
+    const std::string last = absolute.filename().string();
+    constexpr size_t kSuffix = 20, kDeepestFile = 160;
+    if (last.size() + kSuffix > NAME_MAX)
+        throw InputError(shortPath(dir), "", "the folder name is " + std::to_string(last.size()) + " bytes; a run adds up to " +
+                                              std::to_string(kSuffix) + " to it, and a name holds at most " + std::to_string(NAME_MAX));
+    if (absolute.string().size() + kSuffix + kDeepestFile > PATH_MAX)
+        throw InputError(shortPath(dir), "", "the path is " + std::to_string(absolute.string().size()) + " bytes; with the files a run "
+                                              "writes inside it, it would pass the system's " + std::to_string(PATH_MAX) + "-byte limit");
     // What run will do first, tried: make a folder beside DIR, in the nearest folder that exists
     // (sixth probe: validate accepted output.dir=/proc/x, which run then could not make).
     std::error_code ec;

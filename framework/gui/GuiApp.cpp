@@ -2,6 +2,10 @@
 
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
+#include "framework/core/JsonNode.h"
+#include "framework/core/Text.h"
+#include "framework/experiment/MemoryPlan.h"
+#include "framework/scene/SceneConfig.h"
 #include "framework/gl/Gl.h"
 #include "framework/gui/Automation.h"
 #include "framework/gui/DefaultScene.h"
@@ -17,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 namespace shadowlab {
 
@@ -100,10 +105,38 @@ void drawSidePanel(GuiState& s) {
 
 } // namespace
 
+/// An output file of the session (--screenshot, --report, --save-config) must not be one of its
+/// inputs (twentieth probe: `--screenshot c.json` replaced the config being read, where
+/// `run --force` refuses the same).
+static void refuseOutputsOverInputs(const GuiOptions& opts, const Json& source) {
+    std::vector<std::string> inputs;
+    if (!opts.config.empty()) inputs.push_back(opts.config);
+    const std::filesystem::path folder = std::filesystem::path(parentDir(opts.config.empty() ? std::string("./x") : opts.config));
+    for (const std::string& g : gltfPathsOf(source.value("scene", Json())))
+        for (const std::string& f : gltfFiles(std::filesystem::path(g).is_absolute() ? g : (folder / g).string())) inputs.push_back(f);
+    for (const auto& [option, file] : {std::pair<const char*, const std::string*>{"--screenshot", &opts.screenshot},
+                                       {"--report", &opts.report}, {"--save-config", &opts.saveConfig}}) {
+        std::error_code ec;
+        for (const std::string& input : inputs)
+            if (!file->empty() && std::filesystem::equivalent(*file, input, ec))
+                throw InputError(shortPath(*file), "", std::string(option) + ": the file is an input of this session (" +
+                                                           shortPath(input) + "); write it elsewhere");
+    }
+}
+
 int runGui(const GuiOptions& opts) {
     // Everything that can be bad input is checked before a window opens (exit 2 even without a display).
     Json source = opts.config.empty() ? defaultGuiConfig() : JsonNode::parseFile(opts.config);
-    ExperimentConfig config = parseConfig(source, opts.config.empty() ? "<built-in scene>" : opts.config);
+    const std::string name = opts.config.empty() ? "<built-in scene>" : opts.config;
+    refuseOutputsOverInputs(opts, source);
+    // As run and validate (twentieth probe: the GUI built an 8 M-triangle scene that the plan
+    // refuses, and died in Mesa; it drew opaque shadows under translucent casters that validate
+    // refuses, and saved that config): the memory plan of the predicted scene before it is made,
+    // then the scene. The device's own limits and each algorithm's fit on the scene (which asks
+    // the device) are checked once its context exists, before the first frame.
+    const ScenePrediction predicted = predictConfigScene(source, name);
+    checkMemoryPlan(parseConfig(source, name, false), predicted, DeviceLimits{});
+    ExperimentConfig config = parseConfig(source, name);
     AutomationPlan plan = planAutomation(opts, config);
 
     GlfwContext context(opts.windowSize, "shadowlab — " + config.name, opts.frames == 0);
@@ -114,6 +147,8 @@ int runGui(const GuiOptions& opts) {
         checkWindowSize("--size", opts.windowSize, std::min(viewport[0], viewport[1]), texture);
         if (opts.resizeTo.x > 0) checkWindowSize("--resize", opts.resizeTo, std::min(viewport[0], viewport[1]), texture);
     }
+    checkMemoryPlan(config, predicted, currentDeviceLimits(predicted.triangles));
+    checkAlgorithmsTakeScene(config);
     installGlDebugCallback(true);
     ImGuiSession imgui(context);
 
