@@ -93,6 +93,8 @@ std::vector<BadCase> badCases() {
              {"time": 1, "position": [0, 5, 0], "target": [0, 5, 0]}]}})"}}),
          {"/light/path", "frame 1", "equals its position"}},
         {"NumberOverflowsDouble", "c.json", configWith({{"frames", "1e999"}}), {"/frames", "does not fit in a double"}},
+        // Twentieth probe: 1e-400 was read as 0 (a fit_size of 1e-400 turned the fitting off).
+        {"NumberUnderflowsDouble", "c.json", configWith({{"camera", R"({"near": 1e-400})"}}), {"/camera/near", "too small for a double"}},
         {"EmptyOutputDir", "c.json", configWith({{"output", R"({"dir": ""})"}}), {"/output/dir", "must not be empty"}},
         {"MillionNumberResolution", "c.json", configWith({{"resolution", million}}), {"/resolution", "expected an array of 2"}},
         {"DuplicateKey", "c.json", configWith({{"frames", "2"}, {"frames", "3"}}), {"/frames", "duplicate key"}},
