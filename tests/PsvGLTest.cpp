@@ -283,6 +283,60 @@ TEST_F(PsvGLTest, NodeLoopsTheDeviceEndsAreCounted) {
     }
 }
 
+// The plane walk (stack and stackless) decides by planes alone and leaves every pixel that meets a
+// close call to the exact walk of a second pass over the listed pixels: the two passes write the
+// image the exact walk writes in one (the hybrid walk, which never defers, with a stack that never
+// fills), bit for bit.
+// A fence and a sphere 2e4 from the origin, where the close-call margin (4e-6 of the coordinates'
+// size, halved) is about a pixel wide: every shadow border is lined with close calls.
+Shot farFromTheOrigin() {
+    const glm::vec3 o(2.0e4f, 0.0f, 2.0e4f);
+    Shot s;
+    s.scene.append(ground(), translate(o));
+    s.scene.append(makeFence(9, 0.45f, 0.6f, 0.015f, 2, 24, Material{}), translate(o + glm::vec3(0, 0, -0.5f)));
+    s.scene.append(makeSphere(0.3f, 200, Material{}), translate(o + glm::vec3(0.6f, 0.5f, 0.4f)));
+    s.camera = lookAt(o + glm::vec3(0.4f, 2.5f, 3.0f), o + glm::vec3(0, 0, -0.5f));
+    s.light = pointLight(o + glm::vec3(1.0f, 3.0f, 1.5f));
+    return s;
+}
+
+TEST_F(PsvGLTest, PlaneWalkLeavesOnlyCloseCallsToTheExactWalk) {
+    const Shot s = farFromTheOrigin();
+    const Outcome oneWalk = run(s, {{"traversal", std::string("hybrid")}, {"hybrid_stack", 64}});
+    ASSERT_EQ(oneWalk.counters.at("deferred_pixels"), 0.0);
+    for (const char* walk : {"stack", "stackless"}) {
+        SCOPED_TRACE(walk);
+        const Outcome o = run(s, {{"traversal", std::string(walk)}});
+        const double deferred = o.counters.at("deferred_pixels"), traversed = o.counters.at("traversed_pixels");
+        std::printf("[psv] %s: %.0f of %.0f pixels left to the exact walk, %.0f close calls\n", walk, deferred, traversed,
+                    o.counters.at("close_calls"));
+        EXPECT_GT(deferred, 0.0) << "the scene must have close calls";
+        // The exact walk meets, on the same nodes with the same plane values, the close call
+        // that made the plane walk list the pixel: at least one a listed pixel.
+        EXPECT_GE(o.counters.at("close_calls"), deferred);
+        EXPECT_EQ(o.visibility, oneWalk.visibility);
+        EXPECT_EQ(o.accuracy.mismatchRatio, 0.0);
+        EXPECT_EQ(o.overflow, 0u);
+    }
+}
+
+// The pixel list holds every pixel once, which a plane walk that lists a pixel at most once cannot
+// fill; were it full, the pixel is written shadowed and counted, never lit by mistake.
+TEST_F(PsvGLTest, FaultFullPixelListWritesTheCloseCallsShadowed) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_FULL_PIXEL_LIST", "1"}});
+    for (const char* walk : {"stack", "stackless"}) {
+        SCOPED_TRACE(walk);
+        const Outcome o = run(farFromTheOrigin(), {{"traversal", std::string(walk)}});
+        const double refused = o.counters.at("stack_overflow_pixels");
+        std::printf("[psv] %s with a full list: %.0f pixels written shadowed\n", walk, refused);
+        ASSERT_GT(refused, 0.0);
+        EXPECT_EQ(o.counters.at("deferred_pixels"), 0.0);
+        EXPECT_EQ(o.overflow, uint64_t(refused));
+        expectOverflowedPixelsShadowed(o, refused);
+        EXPECT_EQ(o.accuracy.falseLitPixels, 0u);
+    }
+}
+
 // x-ray shadows keep a capping plane's negative child pending besides its other side, which one
 // escape per triangle cannot express: the stackless walks refuse transparency by name.
 TEST_F(PsvGLTest, StacklessWalksRefuseTransparency) {

@@ -1,6 +1,7 @@
 #include "algorithms/psv/Psv.h"
 
 #include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/PixelList.h"
 #include "framework/algorithm/SharedParams.h"
 #include "algorithms/psv/PsvGpuLayout.h"
 #include "algorithms/psv/PsvPermutation.h"
@@ -10,6 +11,7 @@
 #include "framework/render/LightUniforms.h"
 
 #include <algorithm>
+#include <bit>
 #include <array>
 #include <climits>
 
@@ -105,6 +107,7 @@ public:
     }
 
     void resize(glm::ivec2 resolution) override {
+        deferred_.resize(resolution);
         if (!options_.instrumentation) return; // timing mode: no debug images
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
@@ -131,8 +134,10 @@ public:
             const float inside[4] = {0.0f, 0.0f, 0.0f, -1.0f};
             glClearNamedBufferData(nodes_.id(), GL_RGBA32F, GL_RGBA, GL_FLOAT, inside);
         }
-        const GLuint zero = 0;
-        glClearNamedBufferSubData(nodes_.id(), GL_R32UI, 0, PSV_NODE_BYTES, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+        // The sentinel's plane carries the query's close-call margin (query.comp, psvCloseCallMargin).
+        const uint32_t sentinelPlane[4] = {0, 0, 0, std::bit_cast<uint32_t>(closeCall_)}, noChildren[4] = {0, 0, 0, 0};
+        glClearNamedBufferSubData(nodes_.id(), GL_RGBA32UI, 0, 16, GL_RGBA_INTEGER, GL_UNSIGNED_INT, sentinelPlane);
+        glClearNamedBufferSubData(nodes_.id(), GL_RGBA32UI, 16, 16, GL_RGBA_INTEGER, GL_UNSIGNED_INT, noChildren);
         scene_->bindStorage();
         nodes_.bindBase(GL_SHADER_STORAGE_BUFFER, PSV_NODE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, PSV_COUNTER_BINDING);
@@ -148,14 +153,13 @@ public:
         // Light culling: a point light sees every direction and a directional light the whole
         // scene; a spot light's cone culls the triangles wholly outside it (frusta.comp).
         f.timer.begin("traverse");
-        if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
-        else runPixelPass(f, query_, {});
+        traverse(f);
         // Test fault: a GL error in the frame (what a failed allocation raises), which must stop
         // the run before it saves anything.
         if (shaderFaultActive("SHADOWLAB_FAULT_GL_ERROR")) glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0xFFFFFFF0u);
         // Test fault: the traverse stage done N more times (the same image), a planted slowdown
         // for the checks that must catch one (expectations, compare).
-        for (int extra = shaderFaultCount("SHADOWLAB_FAULT_SLOW_TRAVERSE"); extra > 0; --extra) runPixelPass(f, query_, {});
+        for (int extra = shaderFaultCount("SHADOWLAB_FAULT_SLOW_TRAVERSE"); extra > 0; --extra) traverse(f);
         f.timer.end();
         counters_.markStale();
     }
@@ -181,6 +185,7 @@ public:
                 {"culled_occluded", double(c[PSV_C_CULLED_OCCLUDED])},
                 {"insert_depth_max", double(c[PSV_C_INSERT_DEPTH_MAX])},
                 {"close_calls", double(c[PSV_C_CLOSE_CALLS])},
+                {"deferred_pixels", double(c[PSV_C_DEFERRED])},
                 {"stackless_walks", double(c[PSV_C_STACKLESS_WALKS])},
                 {"build_errors", double(c[PSV_C_BUILD_ERRORS])}};
     }
@@ -205,6 +210,17 @@ public:
     }
 
 private:
+    /// The query: with the plane walk, every pixel by planes alone and then the pixels it listed
+    /// (a close call met) by the exact walk (query.comp); otherwise the exact walk on every pixel.
+    void traverse(const FrameInputs& f) const {
+        if (planeWalk_) deferred_.begin();
+        if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
+        else runPixelPass(f, query_, {});
+        if (!planeWalk_) return;
+        deferred_.dispatch(exactPass_); // the inputs and debug images are still bound
+        finishPixelPass();
+    }
+
     /// `auto`: stackless, or the stack walk for x-ray shadows (docs/algorithms/psv.md, "Traversals").
     std::string traversal() const {
         if (p_.traversal != "auto") return p_.traversal;
@@ -217,7 +233,11 @@ private:
         if (p_.transparency && walk != "stack")
             throw RuntimeError("psv: traversal = " + walk + " cannot take transparency (a capping plane's negative "
                                "child would be a second pending side of one node): use traversal = stack");
-        const ShaderDefines defines = {{"PSV_WEDGE", flag(p_.wedge)},
+        // The plane walk first where the walk can stop at a close call and leave the pixel to the
+        // exact walk: not with x-ray shadows (a close call's transmission is a factor of the
+        // product) nor the hybrid walk (whose stackless subtrees return to the stack walk).
+        planeWalk_ = !p_.transparency && walk != "hybrid";
+        ShaderDefines defines = {{"PSV_WEDGE", flag(p_.wedge)},
                                        {"PSV_WEDGE_BOUND", p_.wedgeBound == "vertices" ? "2" : p_.wedgeBound == "distance" ? "1" : "0"},
                                        {"PSV_RANDOM_ORDER", flag(p_.randomOrder)},
                                        {"PSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
@@ -226,10 +246,17 @@ private:
                                        {"PSV_STACK_SIZE", std::to_string(p_.stackSize)},
                                        {"PSV_TRAVERSAL", walk == "stackless" ? "1" : walk == "hybrid" ? "2" : "0"},
                                        {"PSV_HYBRID_STACK", std::to_string(p_.hybridStack)},
+                                       {"PSV_PLANE_WALK", flag(planeWalk_)},
                                        instrumentationDefine(options_)};
         frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
         build_ = ShaderProgram::compute("psv/build.comp", defines);
         query_ = ShaderProgram::compute("psv/query.comp", defines);
+        exactPass_ = ShaderProgram();
+        if (planeWalk_) {
+            defines.push_back({"PSV_QUERY_PASS", "1"});
+            exactPass_ = ShaderProgram::compute("psv/query.comp", defines);
+            deferred_.compile(PSV_DEFER_LIST_BINDING, PSV_DEFER_ARGS_BINDING);
+        }
     }
 
     void setUniforms(const Light& light) {
@@ -245,7 +272,8 @@ private:
         const glm::vec3 depthOrigin = center - light.direction() * (2.0f * radius);
         const float rayOffset = rayOffsetLength(p_.rayOffset, *scene_);
         const uint32_t n = uint32_t(scene_->triangleCount());
-        for (const ShaderProgram* p : {&frusta_, &build_, &query_}) {
+        for (const ShaderProgram* p : {&frusta_, &build_, &query_, &exactPass_}) {
+            if (!*p) continue; // no exact pass without the plane walk
             setLightUniforms(*p, light);
             p->set("uTriangleCount", unsigned(n));
             p->set("uTolerance", tolerance);
@@ -254,10 +282,11 @@ private:
                                 permutation_.keys[2], permutation_.keys[3]);
             p->set("uPermHalfBits", unsigned(permutation_.halfBits));
         }
-        query_.set("uRayOffset", rayOffset);
+        for (const ShaderProgram* p : {&query_, &exactPass_})
+            if (*p) p->set("uRayOffset", rayOffset);
         // Half the tolerance: a plane value computed this close to 0 is within the tolerance in
         // fact, which is what lets the query skip the subtrees on both sides (query.comp).
-        query_.set("uCloseCall", 0.5f * tolerance);
+        closeCall_ = 0.5f * tolerance;
     }
 
     /// One invocation per triangle, as a 2D grid when n needs more than 65535 groups of 64.
@@ -266,7 +295,10 @@ private:
     PsvParams p_;
     AlgorithmOptions options_;
     const SceneGpu* scene_ = nullptr;
-    ShaderProgram frusta_, build_, query_;
+    ShaderProgram frusta_, build_, query_, exactPass_; ///< exactPass_: the listed pixels' exact walk
+    bool planeWalk_ = false;
+    float closeCall_ = 0.0f; ///< the query's close-call margin, written into the sentinel node
+    PixelList deferred_; ///< the pixels the plane walk left to the exact walk
     GlBuffer nodes_;
     GpuCounters<PSV_COUNTER_WORDS> counters_;
     GlTexture nodesVisited_, overflow_;
@@ -281,7 +313,8 @@ private:
 Footprint psvFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t n = q.triangles;
-    f.bytes = saturatingSum({psv::memoryBytes(n), 8 * size_t(q.resolution.x) * size_t(q.resolution.y)});
+    // Per pixel: the two debug images (8 bytes) and the plane walk's list of close calls (4).
+    f.bytes = saturatingSum({psv::memoryBytes(n), saturatingMul(12, saturatingMul(size_t(q.resolution.x), size_t(q.resolution.y)))});
     f.refusal = storageRefusal(q, "its node pool", saturatingMul(psv::nodeCount(n), PSV_NODE_BYTES));
     if (f.refusal.empty()) f.refusal = texelRefusal(q, "its node pool's view", saturatingMul(2, psv::nodeCount(n)));
     if (f.refusal.empty()) f.refusal = texelRefusal(q, "the scene positions' view it reads", saturatingMul(3, n));

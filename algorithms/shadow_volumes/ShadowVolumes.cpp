@@ -9,6 +9,7 @@
 
 #include "algorithms/shadow_volumes/EdgeAdjacency.h"
 #include "framework/algorithm/AlgorithmSupport.h"
+#include "framework/algorithm/PixelList.h"
 #include "framework/algorithm/SharedParams.h"
 #include "framework/accel/SceneBvh.h"
 #include "framework/core/CheckedMath.h"
@@ -142,9 +143,7 @@ public:
         count_ = makeTexture2D(GL_R32F, r.x, r.y);
         close_ = makeTexture2D(GL_R32UI, r.x, r.y);
         other_ = makeTexture2D(GL_R32I, r.x, r.y);
-        const size_t pixels = size_t(r.x) * size_t(r.y);
-        closeList_ = GlBuffer((pixels + 1) * sizeof(uint32_t));
-        closeArgs_ = GlBuffer(3 * sizeof(uint32_t), nullptr, 0);
+        closeList_.resize(r);
         if (options_.instrumentation) {
             closeView_ = makeTexture2D(GL_R32F, r.x, r.y);
             countView_ = makeTexture2D(GL_R32F, r.x, r.y);
@@ -273,10 +272,7 @@ public:
         glBindTextureUnit(SV_COUNT_UNIT, count_.id());
         glBindImageTexture(SV_CLOSE_IMAGE, close_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
         if (checked()) glBindImageTexture(SV_OTHER_IMAGE, other_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32I);
-        const uint32_t noEntries = 0;
-        glNamedBufferSubData(closeList_.id(), 0, sizeof(noEntries), &noEntries);
-        closeList_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_CLOSE_LIST_BINDING);
-        closeArgs_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_CLOSE_ARGS_BINDING);
+        closeList_.begin();
         setLightUniforms(resolvePass_, f.light);
         resolvePass_.set("uRayOffset", offset);
         resolvePass_.set("uCloseCall", closeCallLength());
@@ -288,19 +284,12 @@ public:
 
         // The close calls: one ray each through the BVH, an indirect dispatch sized by the list.
         f.timer.begin("close_calls");
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        closeArgsPass_.use();
-        glDispatchCompute(1, 1, 1);
-        glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
         bindPixelPassInputs(f);
         bvh_.gpu().bind(SV_BVH_NODE_UNIT, SV_BVH_TRI_UNIT);
         setLightUniforms(closeRayPass_, f.light);
         closeRayPass_.set("uRayOffset", offset);
         closeRayPass_.set("uBvhStepCap", unsigned(bvh_.gpu().stepCap));
-        closeRayPass_.use();
-        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, closeArgs_.id());
-        glDispatchComputeIndirect(0);
-        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+        closeList_.dispatch(closeRayPass_);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         finishPixelPass();
         f.timer.end();
@@ -398,7 +387,7 @@ private:
         resolvePass_ = ShaderProgram::compute("shadow_volumes/resolve.comp",
                                               {instr, check, {"SV_CLOSE_CALLS", p_.closeCalls ? "1" : "0"}});
         eyePass_ = ShaderProgram::compute("shadow_volumes/eye_count.comp", {{"SCENE_POSITION_TEXELS", "1"}});
-        closeArgsPass_ = ShaderProgram::compute("shadow_volumes/close_args.comp", {});
+        closeList_.compile(SV_CLOSE_LIST_BINDING, SV_CLOSE_ARGS_BINDING);
         closeRayPass_ = ShaderProgram::compute("shadow_volumes/close_rays.comp", {instr});
     }
 
@@ -409,8 +398,9 @@ private:
     glm::ivec2 resolution_{0};
     int subpixelBits_ = 8;
     bool zfailLast_ = true;
-    ShaderProgram eyePass_, facingPass_, silhouettePass_, depthPass_, volumePass_, resolvePass_, closeArgsPass_, closeRayPass_;
-    GlBuffer sides_, first_, facing_, records_, draw_, closeList_, closeArgs_;
+    ShaderProgram eyePass_, facingPass_, silhouettePass_, depthPass_, volumePass_, resolvePass_, closeRayPass_;
+    GlBuffer sides_, first_, facing_, records_, draw_;
+    PixelList closeList_;
     bvh::SceneBvh bvh_; ///< the close calls' rays trace through it
     GlTexture facingTexels_, recordTexels_, sideTexels_, depthStencil_, count_, close_, other_, closeView_, countView_;
     GlFramebuffer fbo_;

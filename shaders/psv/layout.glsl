@@ -5,6 +5,8 @@
 // SSBO binding points (0..2 are the scene buffers of shaders/common/scene.glsl).
 #define PSV_NODE_BINDING 3
 #define PSV_COUNTER_BINDING 4
+#define PSV_DEFER_LIST_BINDING 5  // the pixels the plane walk leaves to the exact walk (PixelList)
+#define PSV_DEFER_ARGS_BINDING 6  // the exact walk's grid over them
 // Texture unit of the nodes' buffer-texture view (RGBA32UI, two texels per node; units 0 and 1
 // are the query's G-buffer).
 #define PSV_NODE_UNIT 2
@@ -34,7 +36,8 @@
 #define PSV_C_STACKLESS_WALKS 12  // stackless walks: 1 per pixel (stackless), 1 per full stack (hybrid)
 #define PSV_C_CULLED_CONE 13      // spot light: triangles wholly outside its cone
 #define PSV_C_LOOP_CAPPED 14      // pixels whose stackless walk hit its escape cap (written shadowed)
-// Words 15..23 are reserved (kept so the block size, hence memory_bytes, stays fixed).
+#define PSV_C_DEFERRED 15         // pixels the plane walk left to the exact walk (a close call met)
+// Words 16..23 are reserved (kept so the block size, hence memory_bytes, stays fixed).
 
 // Below this light transmission a transparent query stops: the same cut-off as the reference
 // (EmbreeTracer::kOpaqueTransmission).

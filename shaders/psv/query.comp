@@ -12,13 +12,18 @@
 //     intersection child that finds it full is walked stacklessly at once, up to its owner.
 // All three visit the same nodes and decide every triangle alike, so their images are identical.
 //
-// Exactness. A plane value within uCloseCall of 0 is too close to call (the rounding of the plane
+// Exactness. A plane value within the close-call margin of 0 is too close to call (the rounding of the plane
 // and of the reference's ray test could disagree there). Such a triangle is decided by the
 // reference's own ray and watertight test (psvCloseCall), and only the nodes that can still hold q
 // are walked: at a shadow plane q goes down the frustum's negative side, since a triangle below
 // the positive child lies more than uTolerance from the plane and so does its whole frustum (the
 // plane passes through the light); at the capping plane, a point that is not inside all four
-// planes by more than uCloseCall goes to the ray test.
+// planes by more than the margin goes to the ray test.
+//
+// Two passes (PSV_QUERY_PASS) where PSV_PLANE_WALK is set (the stack and stackless walks of opaque
+// shadows): 0 walks every pixel with the plane walk (psv/plane_walk.glsl), which decides by planes
+// alone and lists the pixels that meet a close call; 1 walks the listed pixels again with the exact
+// walk below. Without PSV_PLANE_WALK, pass 0 runs the exact walk on every pixel.
 #define PSV_NODE_ACCESS readonly restrict // the tree is complete: built by the previous dispatches
 #include "common/light.glsl"
 #define SCENE_POSITION_TEXELS 1 // close calls test triangles through the positions view (any scene size)
@@ -27,15 +32,31 @@
 #include "psv/tree.glsl"
 #include "common/shadow_ray.glsl"
 #include "common/pixel_order.glsl"
+#define PIXEL_LIST_BINDING PSV_DEFER_LIST_BINDING
+#include "common/pixel_list.glsl"
+#ifndef PSV_QUERY_PASS
+#define PSV_QUERY_PASS 0
+#endif
+#ifndef PSV_PLANE_WALK
+#define PSV_PLANE_WALK 0
+#endif
+#if PSV_QUERY_PASS == 0
 layout(local_size_x = 8, local_size_y = 8) in;
+#else
+layout(local_size_x = PIXEL_LIST_GROUP) in;
+#endif
 
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 uniform float uRayOffset; // world units: the reference's shadow-ray origin offset along the normal
-// World units: a plane value this small is too close to call (half the build's tolerance, so the
-// true value is within uTolerance, which the skipped subtrees keep from every plane).
-uniform float uCloseCall;
+
+// The close-call margin, world units: a plane value this small is too close to call (half the
+// build's tolerance, so the true value is within uTolerance, which the skipped subtrees keep from
+// every plane). It travels in the sentinel node's plane (Psv.cpp writes it each frame) and is read
+// once an invocation, not as a uniform: llvmpipe re-reads a uniform at every use inside a loop,
+// and this one compare made the walk 13 % slower (results/reference/psv_plane_walk_llvmpipe.md).
+float psvCloseCallMargin() { return psvPlane(0u).w; }
 
 #ifndef PSV_TRAVERSAL
 #define PSV_TRAVERSAL 0
@@ -49,14 +70,17 @@ struct Result {
     uint visited, closeCalls, stacklessWalks;
     bool overflow; // a full stack, or (stackless walks) the escape cap: written shadowed, counted
     bool capped;   // the escape cap
+    bool deferred; // the plane walk met a close call: the exact walk decides the pixel
 };
 
 // A stackless walk goes down links (the tree has no cycles: a frustum is linked below nodes already
 // in it) and up escapes; each node is entered at most once from an escape, so one walk takes at
 // most 4n + 1 escapes. One more can only be a corrupt escape: the walk ends at its owner with
-// `capped` set, and the pixel is written shadowed and counted (never a hang). The count and the
-// cap are data flow into the jump, not a branch of the node loop (llvmpipe pays for every branch).
-uint psvEscapeCap() { return PSV_NODES_PER_TRIANGLE * uTriangleCount + 1u; }
+// `capped` set, and the pixel is written shadowed and counted (never a hang). The walk counts its
+// escapes down from this budget, as data flow into the jump, not a branch of the node loop
+// (llvmpipe pays for every branch), and not as a compare with a uniform, which llvmpipe re-reads
+// at every iteration (psvCloseCallMargin).
+uint psvEscapeBudget() { return PSV_NODES_PER_TRIANGLE * uTriangleCount + 2u; }
 
 // What the walk needs of the query point. The reference's ray is not kept here: it is built where
 // a close call needs it, so that its nine values do not stay live through the walk (registers).
@@ -64,6 +88,7 @@ struct Query {
     vec3 q;
     float depth;      // psvDepth(q), for the depth skip
     float wedgeScale; // psvWedgeScale(q)
+    float closeCall;  // psvCloseCallMargin()
 };
 
 // The light triangle t lets through to q (1 - opacity, 0 for opaque shadows).
@@ -75,15 +100,20 @@ float psvTransmission(uint t) {
 #endif
 }
 
+// Whether q is inside each of triangle t's four planes by more than Q.closeCall.
+bool psvClearlyInside(Query Q, uint t) {
+    uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
+    return psvSigned(psvPlane(base), Q.q) < -Q.closeCall && psvSigned(psvPlane(base + 1u), Q.q) < -Q.closeCall &&
+           psvSigned(psvPlane(base + 2u), Q.q) < -Q.closeCall && psvSigned(psvPlane(base + 3u), Q.q) < -Q.closeCall;
+}
+
 // Whether triangle t shadows q, asked where the walk found q behind (or too close to) t's capping
 // plane, after going down the negative side (or too close to) its three shadow planes. Its four
-// planes decide where q is inside each by more than uCloseCall; elsewhere the reference's ray test
+// planes decide where q is inside each by more than Q.closeCall; elsewhere the reference's ray test
 // decides (the same ray, the same watertight test, so the same answer), counted in closeCalls.
 // `clearly` tells which.
 bool psvShadows(Query Q, uint t, out bool clearly, inout Result r) {
-    uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
-    clearly = psvSigned(psvPlane(base), Q.q) < -uCloseCall && psvSigned(psvPlane(base + 1u), Q.q) < -uCloseCall &&
-              psvSigned(psvPlane(base + 2u), Q.q) < -uCloseCall && psvSigned(psvPlane(base + 3u), Q.q) < -uCloseCall;
+    clearly = psvClearlyInside(Q, t);
     if (clearly) return true;
     ++r.closeCalls;
     return watertightHit(shadowRayToLight(Q.q, uRayOffset), sceneVertex(t, 0u), sceneVertex(t, 1u), sceneVertex(t, 2u));
@@ -116,13 +146,13 @@ bool psvShadows(Query Q, uint t, out bool clearly, inout Result r) {
 // so the walk visits exactly the nodes the stack walk visits.
 bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
     bool second = false;
-    uint escapes = 0u, escapeCap = psvEscapeCap();
+    uint budget = psvEscapeBudget();
     // The next node: `side`, or where it is none the escape of `triangle`; the owner past the cap.
 #define PSV_STEP(side, triangle)                                                \
     {                                                                           \
         second = (side) == 0u;                                                  \
-        escapes += second ? 1u : 0u;                                            \
-        bool over = escapes > escapeCap;                                        \
+        budget -= second ? 1u : 0u;                                             \
+        bool over = budget == 0u;                                               \
         r.capped = r.capped || over;                                            \
         node = over ? owner : (second ? psvEscape(triangle) : (side));          \
     }
@@ -135,11 +165,11 @@ bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
             float s = psvSigned(n.plane, Q.q);
             uint side; // the child on q's side of the plane (0: none)
             if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
-                side = s <= uCloseCall ? node + 1u : n.pos;
+                side = s <= Q.closeCall ? node + 1u : n.pos;
                 if (!second && PSV_VISITS_INTER(Q, n, s)) { node = n.inter; continue; }
             } else { // capping plane
                 if (!second && PSV_SKIPS_DEPTH(Q, n)) side = 0u;
-                else if (!second && s <= uCloseCall) { cap = node; break; }
+                else if (!second && s <= Q.closeCall) { cap = node; break; }
                 else side = !second && n.inter != 0u ? n.inter : n.pos;
             }
             PSV_STEP(side, (node - 1u) / PSV_NODES_PER_TRIANGLE)
@@ -165,14 +195,14 @@ bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
 
 #if PSV_TRAVERSAL == 1
 Result query(Query Q) {
-    Result r = Result(1.0, 0u, 0u, 1u, false, false);
+    Result r = Result(1.0, 0u, 0u, 1u, false, false, false);
     psvWalkStackless(Q, psvNode(0u).pos, 0u, r);
     if (r.capped) { r.overflow = true; r.visibility = 0.0; }
     return r;
 }
 #else
 Result query(Query Q) {
-    Result r = Result(1.0, 0u, 0u, 0u, false, false);
+    Result r = Result(1.0, 0u, 0u, 0u, false, false, false);
 #if PSV_TRAVERSAL == 2
 #define PSV_STACK_ENTRIES PSV_HYBRID_STACK
     // A full stack: the node loop stops, the intersection child is walked stacklessly up to its
@@ -199,7 +229,7 @@ Result query(Query Q) {
             PsvNode n = psvNode(node);
             float s = psvSigned(n.plane, Q.q);
             if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
-                uint next = s <= uCloseCall ? node + 1u : n.pos;
+                uint next = s <= Q.closeCall ? node + 1u : n.pos;
                 if (PSV_VISITS_INTER(Q, n, s)) {
                     if (next == 0u) next = n.inter;
                     else PSV_PUSH(node, n.inter);
@@ -211,7 +241,7 @@ Result query(Query Q) {
                 continue;
             }
             if (PSV_SKIPS_DEPTH(Q, n)) { node = 0u; continue; }
-            if (s <= uCloseCall) { cap = node; break; }
+            if (s <= Q.closeCall) { cap = node; break; }
             if (n.inter != 0u) PSV_PUSH(node, n.inter);
             node = n.pos;
 #if PSV_TRAVERSAL == 2
@@ -257,70 +287,103 @@ Result query(Query Q) {
 }
 #endif
 
+#if PSV_QUERY_PASS == 0 && PSV_PLANE_WALK
+#include "psv/plane_walk.glsl"
+#endif
+
 #if SHADOWLAB_INSTRUMENTATION
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map
 layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
-shared uint sTraversed, sVisited, sVisitedMax, sOverflow, sCloseCalls, sStackless, sCapped;
+shared uint sTraversed, sVisited, sVisitedMax, sOverflow, sCloseCalls, sStackless, sCapped, sDeferred;
 #endif
+
+// One pixel's query: its visibility and debug images written, its counts added. The plane walk
+// leaves a pixel with a close call to the exact walk of the second pass (listed, nothing written).
+void queryPixel(ivec2 px) {
+    vec4 pos = texelFetch(uPosition, px, 0);
+    float visibility = 1.0; // background: nothing to shadow (the reference's convention)
+    Result r = Result(1.0, 0u, 0u, 0u, false, false, false);
+    if (pos.w >= 0.5) {
+        vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
+        visibility = 0.0; // facing away from the light, or outside a spot's cone
+        if (lightReaches(p, n)) {
+            // The reference's ray origin: the same offset along the same (unnormalised) normal;
+            // precise, so that both passes' programs round it alike.
+            precise vec3 q = p + n * uRayOffset;
+            Query Q;
+            Q.q = q;
+            Q.closeCall = psvCloseCallMargin();
+#if PSV_DEPTH_SKIP
+            Q.depth = psvDepth(Q.q);
+#else
+            Q.depth = 0.0;
+#endif
+#if PSV_WEDGE
+            Q.wedgeScale = psvWedgeScale(Q.q);
+#else
+            Q.wedgeScale = 1.0;
+#endif
+#if PSV_QUERY_PASS == 0 && PSV_PLANE_WALK
+            r = psvPlaneWalk(Q);
+            if (r.deferred) {
+                // Listed for the exact walk, which writes this pixel. A full list (one entry a
+                // pixel cannot fill it) would leave it shadowed and counted.
+                if (pixelListAppend(px)) {
+#if SHADOWLAB_INSTRUMENTATION
+                    atomicAdd(sDeferred, 1u);
+#endif
+                    return;
+                }
+                r.overflow = true;
+                r.visibility = 0.0;
+            }
+#else
+            r = query(Q);
+#endif
+            visibility = r.visibility;
+#if SHADOWLAB_INSTRUMENTATION
+            atomicAdd(sTraversed, 1u);
+            atomicAdd(sVisited, r.visited);
+            atomicMax(sVisitedMax, r.visited);
+            if (r.overflow && !r.capped) atomicAdd(sOverflow, 1u);
+            if (r.capped) atomicAdd(sCapped, 1u);
+            if (r.closeCalls != 0u) atomicAdd(sCloseCalls, r.closeCalls);
+            if (r.stacklessWalks != 0u) atomicAdd(sStackless, r.stacklessWalks);
+#else
+            // Timing mode still counts every overflowed pixel (never a silent wrong image).
+            if (r.overflow && !r.capped) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], 1u);
+            if (r.capped) atomicAdd(psvCounters[PSV_C_LOOP_CAPPED], 1u);
+#endif
+        }
+    }
+#if SHADOWLAB_FAULT_PLANTED_LIT
+    // Test fault (framework/gl/Shader.h): a planted regression, every 61st pixel written lit,
+    // for the checks that must catch a wrong image (expectations, compare).
+    if ((px.x + px.y * 7) % 61 == 0) visibility = 1.0;
+#endif
+    imageStore(uVisibility, px, vec4(visibility));
+#if SHADOWLAB_INSTRUMENTATION
+    imageStore(uNodesVisited, px, vec4(float(r.visited)));
+    imageStore(uOverflow, px, vec4(r.overflow ? 1.0 : 0.0));
+#endif
+}
 
 void main() {
 #if SHADOWLAB_INSTRUMENTATION
-    if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = sCloseCalls = sStackless = sCapped = 0u;
+    if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = sCloseCalls = sStackless = sCapped = sDeferred = 0u;
     barrier();
 #endif
+#if PSV_QUERY_PASS == 0
     ivec2 px = pixelOfInvocation();
-    if (all(lessThan(px, imageSize(uVisibility)))) {
-        vec4 pos = texelFetch(uPosition, px, 0);
-        float visibility = 1.0; // background: nothing to shadow (the reference's convention)
-        Result r = Result(1.0, 0u, 0u, 0u, false, false);
-        if (pos.w >= 0.5) {
-            vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
-            visibility = 0.0; // facing away from the light, or outside a spot's cone
-            if (lightReaches(p, n)) {
-                // The reference's ray origin: the same offset along the same (unnormalised) normal.
-                Query Q;
-                Q.q = p + n * uRayOffset;
-#if PSV_DEPTH_SKIP
-                Q.depth = psvDepth(Q.q);
+    if (all(lessThan(px, imageSize(uVisibility)))) queryPixel(px);
 #else
-                Q.depth = 0.0;
+    ivec2 px;
+    if (pixelListEntry(px)) queryPixel(px);
 #endif
-#if PSV_WEDGE
-                Q.wedgeScale = psvWedgeScale(Q.q);
-#else
-                Q.wedgeScale = 1.0;
-#endif
-                r = query(Q);
-                visibility = r.visibility;
-#if SHADOWLAB_INSTRUMENTATION
-                atomicAdd(sTraversed, 1u);
-                atomicAdd(sVisited, r.visited);
-                atomicMax(sVisitedMax, r.visited);
-                if (r.overflow && !r.capped) atomicAdd(sOverflow, 1u);
-                if (r.capped) atomicAdd(sCapped, 1u);
-                if (r.closeCalls != 0u) atomicAdd(sCloseCalls, r.closeCalls);
-                if (r.stacklessWalks != 0u) atomicAdd(sStackless, r.stacklessWalks);
-#else
-                // Timing mode still counts every overflowed pixel (never a silent wrong image).
-                if (r.overflow && !r.capped) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], 1u);
-                if (r.capped) atomicAdd(psvCounters[PSV_C_LOOP_CAPPED], 1u);
-#endif
-            }
-        }
-#if SHADOWLAB_FAULT_PLANTED_LIT
-        // Test fault (framework/gl/Shader.h): a planted regression, every 61st pixel written lit,
-        // for the checks that must catch a wrong image (expectations, compare).
-        if ((px.x + px.y * 7) % 61 == 0) visibility = 1.0;
-#endif
-        imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
-        imageStore(uNodesVisited, px, vec4(float(r.visited)));
-        imageStore(uOverflow, px, vec4(r.overflow ? 1.0 : 0.0));
-#endif
-    }
 #if SHADOWLAB_INSTRUMENTATION
     barrier();
-    if (gl_LocalInvocationIndex == 0u && sTraversed != 0u) {
+    if (gl_LocalInvocationIndex == 0u && (sTraversed | sDeferred) != 0u) {
+        if (sDeferred != 0u) atomicAdd(psvCounters[PSV_C_DEFERRED], sDeferred);
         atomicAdd(psvCounters[PSV_C_TRAVERSED], sTraversed);
         COUNTER_ADD_WIDE(psvCounters, PSV_C_VISITED_LO, sVisited)
         atomicMax(psvCounters[PSV_C_VISITED_MAX], sVisitedMax);

@@ -1,7 +1,7 @@
 #version 450
 // shadow_volumes: the close calls decided by the reference's own ray (common/shadow_ray.glsl, the
 // watertight test) traced through the scene's BVH (framework/accel, common/bvh_traverse.glsl): one
-// invocation per listed pixel, SV_CLOSE_GROUP to a workgroup, workgroups in rows of SV_CLOSE_ROW.
+// invocation per listed pixel (common/pixel_list.glsl).
 // The walk is bounded by the tree (uBvhStepCap); one that overflows its stack or reaches its cap
 // (or that a driver's loop limit ends) is counted and its pixel written shadowed, never lit by
 // mistake. Through the tree each ray costs O(log triangles), so a frame's close calls stay far
@@ -14,11 +14,12 @@
 #define BVH_TRAVERSE_NODE_UNIT SV_BVH_NODE_UNIT
 #define BVH_TRAVERSE_TRI_UNIT SV_BVH_TRI_UNIT
 #include "common/bvh_traverse.glsl"
-layout(local_size_x = SV_CLOSE_GROUP) in;
+#define PIXEL_LIST_BINDING SV_CLOSE_LIST_BINDING
+#include "common/pixel_list.glsl"
+layout(local_size_x = PIXEL_LIST_GROUP) in;
 layout(binding = 0) uniform sampler2D uPosition;
 layout(binding = 1) uniform sampler2D uNormal;
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-layout(std430, binding = SV_CLOSE_LIST_BINDING) readonly buffer CloseList { uint closeCount; uint closeList[]; };
 layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
 uniform float uRayOffset;
 
@@ -27,11 +28,8 @@ void addWide(int lo, uint value) COUNTER_ADD_WIDE(counters, lo, value)
 #endif
 
 void main() {
-    uint group = gl_WorkGroupID.y * uint(SV_CLOSE_ROW) + gl_WorkGroupID.x;
-    uint entry = group * uint(SV_CLOSE_GROUP) + gl_LocalInvocationIndex;
-    if (entry >= closeCount) return;
-    uint word = closeList[entry];
-    ivec2 px = ivec2(int(word & 0xFFFFu), int(word >> 16));
+    ivec2 px;
+    if (!pixelListEntry(px)) return;
     vec3 p = texelFetch(uPosition, px, 0).xyz, n = texelFetch(uNormal, px, 0).xyz;
     vec3 o = p + n * uRayOffset, d;
     float tfar;

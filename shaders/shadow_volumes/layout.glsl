@@ -40,10 +40,6 @@
 // the larger: a face the depth test orders wrongly lies within it, and is a close call.
 #define SV_NUDGE_ULPS 8
 #define SV_DEPTH_ULPS 16
-// The close calls' rays (close_rays.comp): SV_CLOSE_GROUP listed pixels a workgroup, workgroups in
-// rows of SV_CLOSE_ROW, each ray traced through the scene's BVH.
-#define SV_CLOSE_GROUP 64
-#define SV_CLOSE_ROW 32768
 #define SV_BVH_NODE_UNIT 6    // the BVH's nodes and leaf-ordered triangles (buffer textures)
 #define SV_BVH_TRI_UNIT 7
 // The eye's count (eye_count.comp): SV_EYE_LANES invocations, SV_EYE_RANGE triangles a dispatch (so

@@ -30,7 +30,8 @@ layout(r32f, binding = 1) writeonly uniform image2D uCloseView; // debug: 1 on c
 layout(r32f, binding = 2) writeonly uniform image2D uCountView; // debug: the exact count
 #endif
 layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
-layout(std430, binding = SV_CLOSE_LIST_BINDING) buffer CloseList { uint closeCount; uint closeList[]; };
+#define PIXEL_LIST_BINDING SV_CLOSE_LIST_BINDING
+#include "common/pixel_list.glsl"
 
 // The pixel's own triangle holds p only up to the G-buffer's rounding, which grows with the
 // coordinates' size (far from the origin) and at grazing views. Where that leaves the reference's
@@ -78,9 +79,9 @@ void main() {
             }
 #endif
             if (close) {
-                // Listed for close_rays.comp, which writes this pixel's visibility.
-                uint entry = atomicAdd(closeCount, 1u);
-                closeList[entry] = uint(px.x) | uint(px.y) << 16;
+                // Listed for close_rays.comp, which writes this pixel's visibility (a full list,
+                // which one entry a pixel cannot fill, would leave it shadowed and counted).
+                if (!pixelListAppend(px)) { shadowed = true; atomicAdd(counters[SV_C_CUT_LOOPS], 1u); }
                 atomicAdd(counters[SV_C_CLOSE_PIXELS], 1u);
                 closeView = 1.0;
             }
