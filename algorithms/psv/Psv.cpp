@@ -134,8 +134,8 @@ public:
             const float inside[4] = {0.0f, 0.0f, 0.0f, -1.0f};
             glClearNamedBufferData(nodes_.id(), GL_RGBA32F, GL_RGBA, GL_FLOAT, inside);
         }
-        // The sentinel's plane carries the query's close-call margin (query.comp, psvCloseCallMargin).
-        const uint32_t sentinelPlane[4] = {0, 0, 0, std::bit_cast<uint32_t>(closeCall_)}, noChildren[4] = {0, 0, 0, 0};
+        // The sentinel's plane carries the tolerance to every pass (psv/tree.glsl, psvReadMargins).
+        const uint32_t sentinelPlane[4] = {0, 0, 0, std::bit_cast<uint32_t>(tolerance_)}, noChildren[4] = {0, 0, 0, 0};
         glClearNamedBufferSubData(nodes_.id(), GL_RGBA32UI, 0, 16, GL_RGBA_INTEGER, GL_UNSIGNED_INT, sentinelPlane);
         glClearNamedBufferSubData(nodes_.id(), GL_RGBA32UI, 16, 16, GL_RGBA_INTEGER, GL_UNSIGNED_INT, noChildren);
         scene_->bindStorage();
@@ -276,7 +276,6 @@ private:
             if (!*p) continue; // no exact pass without the plane walk
             setLightUniforms(*p, light);
             p->set("uTriangleCount", unsigned(n));
-            p->set("uTolerance", tolerance);
             p->set("uDepthOrigin", depthOrigin);
             glProgramUniform4ui(p->id(), p->location("uPermKeys"), permutation_.keys[0], permutation_.keys[1],
                                 permutation_.keys[2], permutation_.keys[3]);
@@ -284,9 +283,7 @@ private:
         }
         for (const ShaderProgram* p : {&query_, &exactPass_})
             if (*p) p->set("uRayOffset", rayOffset);
-        // Half the tolerance: a plane value computed this close to 0 is within the tolerance in
-        // fact, which is what lets the query skip the subtrees on both sides (query.comp).
-        closeCall_ = 0.5f * tolerance;
+        tolerance_ = tolerance; // the query's close-call margin is half of it (query.comp)
     }
 
     /// One invocation per triangle, as a 2D grid when n needs more than 65535 groups of 64.
@@ -297,7 +294,7 @@ private:
     const SceneGpu* scene_ = nullptr;
     ShaderProgram frusta_, build_, query_, exactPass_; ///< exactPass_: the listed pixels' exact walk
     bool planeWalk_ = false;
-    float closeCall_ = 0.0f; ///< the query's close-call margin, written into the sentinel node
+    float tolerance_ = 0.0f; ///< the build's tolerance, written into the sentinel node each frame
     PixelList deferred_; ///< the pixels the plane walk left to the exact walk
     GlBuffer nodes_;
     GpuCounters<PSV_COUNTER_WORDS> counters_;

@@ -55,17 +55,14 @@ uint insertTriangle(uint t, out uint tested) {
     // The stackless walks' escape: the last node whose intersection child this descent took. A
     // child field is set once, so the path this thread walks is the path to its frustum for good.
     uint escape = 0u;
+    bool linked = false;
     uvec4 fields = psvFields(0u);
     while (true) {
         if (slot == SLOT_INTER) escape = node;
         uint child = psvChild(fields, slot);
         if (child == 0u) {
             child = psvLinkChild(node, slot, root);
-            if (child == 0u) {
-                // Read by the query only, after this dispatch (nothing in the build reads it).
-                psvNodes[root + PSV_ESCAPE_NODE].minDepth = escape;
-                return PSV_C_INSERTED;
-            }
+            if (child == 0u) { linked = true; break; } // the escape is stored below, out of the loop
         }
         // Every link points at the first node of a frustum; anything else is a corrupt tree.
         if (child >= nodeCount || child % PSV_NODES_PER_TRIANGLE != 1u) return PSV_C_BUILD_ERRORS;
@@ -101,7 +98,12 @@ uint insertTriangle(uint t, out uint tested) {
             atomicMax(psvNodes[node].wedgeOrNeg, floatBitsToUint(psvWedge(plane, wedgeTriangle)));
 #endif
     }
-    return PSV_C_BUILD_ERRORS; // not reached
+    // A loop the device ended from outside (rule 13) linked nothing: an error, counted.
+    if (!linked) return PSV_C_BUILD_ERRORS;
+    // Read by the query only, after this dispatch (nothing in the build reads it). A store inside
+    // the descent loop would cost every step on a SIMD back end, whichever lanes take it.
+    psvNodes[root + PSV_ESCAPE_NODE].minDepth = escape;
+    return PSV_C_INSERTED;
 }
 
 #if PSV_C_INSERTED != 0 || PSV_C_CULLED_FACING != 1 || PSV_C_CULLED_EDGE_ON != 2 || PSV_C_CULLED_OCCLUDED != 3 || PSV_C_BUILD_ERRORS != 4
@@ -113,6 +115,7 @@ shared uint sTestedMax, sCone;
 #endif
 
 void main() {
+    psvReadMargins();
 #if SHADOWLAB_INSTRUMENTATION
     // Counters are summed per work group first: one global atomic per group and outcome.
     if (gl_LocalInvocationIndex < 5u) sOutcomes[gl_LocalInvocationIndex] = 0u;

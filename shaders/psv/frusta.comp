@@ -14,6 +14,7 @@ layout(local_size_x = 64) in;
 uniform uint uInvocationsPerRow; // gl_NumWorkGroups.x * 64: 2D dispatch past 65535 groups
 
 void main() {
+    psvReadMargins();
     uint t = gl_GlobalInvocationID.y * uInvocationsPerRow + gl_GlobalInvocationID.x;
     if (t >= uTriangleCount) return;
     vec3 v0 = sceneVertex(t, 0u), v1 = sceneVertex(t, 1u), v2 = sceneVertex(t, 2u);

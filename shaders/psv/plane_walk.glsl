@@ -50,7 +50,7 @@ Result psvPlaneWalk(Query Q) {
         PsvNode n = psvNode(node);
         float s = psvSigned(n.plane, Q.q);
         if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
-            uint next = s <= Q.closeCall ? node + 1u : n.pos;
+            uint next = s <= psvCloseCall ? node + 1u : n.pos;
             if (PSV_VISITS_INTER(Q, n, s)) {
                 if (next == 0u) next = n.inter;
                 else PSV_PUSH(n.inter);
@@ -59,7 +59,7 @@ Result psvPlaneWalk(Query Q) {
             continue;
         }
         if (PSV_SKIPS_DEPTH(Q, n)) { node = 0u; continue; }
-        if (s <= Q.closeCall) { cap = node; break; }
+        if (s <= psvCloseCall) { cap = node; break; }
         if (n.inter != 0u) PSV_PUSH(n.inter);
         node = n.pos;
     }
@@ -81,11 +81,11 @@ Result psvPlaneWalk(Query Q) {
         float s = psvSigned(n.plane, Q.q);
         uint side; // the child on q's side of the plane (0: none)
         if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
-            side = s <= Q.closeCall ? node + 1u : n.pos;
+            side = s <= psvCloseCall ? node + 1u : n.pos;
             if (!second && PSV_VISITS_INTER(Q, n, s)) { node = n.inter; continue; }
         } else { // capping plane
             if (!second && PSV_SKIPS_DEPTH(Q, n)) side = 0u;
-            else if (!second && s <= Q.closeCall) { cap = node; break; }
+            else if (!second && s <= psvCloseCall) { cap = node; break; }
             else side = !second && n.inter != 0u ? n.inter : n.pos;
         }
         // The next node: `side`, or where it is none the escape of this node's triangle; past the

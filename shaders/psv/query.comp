@@ -14,9 +14,9 @@
 //
 // Exactness. A plane value within the close-call margin of 0 is too close to call (the rounding of the plane
 // and of the reference's ray test could disagree there). Such a triangle is decided by the
-// reference's own ray and watertight test (psvCloseCall), and only the nodes that can still hold q
+// reference's own ray and watertight test (psvShadows), and only the nodes that can still hold q
 // are walked: at a shadow plane q goes down the frustum's negative side, since a triangle below
-// the positive child lies more than uTolerance from the plane and so does its whole frustum (the
+// the positive child lies more than the tolerance from the plane and so does its whole frustum (the
 // plane passes through the light); at the capping plane, a point that is not inside all four
 // planes by more than the margin goes to the ray test.
 //
@@ -51,13 +51,6 @@ layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 uniform float uRayOffset; // world units: the reference's shadow-ray origin offset along the normal
 
-// The close-call margin, world units: a plane value this small is too close to call (half the
-// build's tolerance, so the true value is within uTolerance, which the skipped subtrees keep from
-// every plane). It travels in the sentinel node's plane (Psv.cpp writes it each frame) and is read
-// once an invocation, not as a uniform: llvmpipe re-reads a uniform at every use inside a loop,
-// and this one compare made the walk 13 % slower (results/reference/psv_plane_walk_llvmpipe.md).
-float psvCloseCallMargin() { return psvPlane(0u).w; }
-
 #ifndef PSV_TRAVERSAL
 #define PSV_TRAVERSAL 0
 #endif
@@ -79,7 +72,7 @@ struct Result {
 // `capped` set, and the pixel is written shadowed and counted (never a hang). The walk counts its
 // escapes down from this budget, as data flow into the jump, not a branch of the node loop
 // (llvmpipe pays for every branch), and not as a compare with a uniform, which llvmpipe re-reads
-// at every iteration (psvCloseCallMargin).
+// at every iteration (psvReadMargins, psv/tree.glsl).
 uint psvEscapeBudget() { return PSV_NODES_PER_TRIANGLE * uTriangleCount + 2u; }
 
 // What the walk needs of the query point. The reference's ray is not kept here: it is built where
@@ -88,7 +81,6 @@ struct Query {
     vec3 q;
     float depth;      // psvDepth(q), for the depth skip
     float wedgeScale; // psvWedgeScale(q)
-    float closeCall;  // psvCloseCallMargin()
 };
 
 // The light triangle t lets through to q (1 - opacity, 0 for opaque shadows).
@@ -100,16 +92,16 @@ float psvTransmission(uint t) {
 #endif
 }
 
-// Whether q is inside each of triangle t's four planes by more than Q.closeCall.
+// Whether q is inside each of triangle t's four planes by more than psvCloseCall.
 bool psvClearlyInside(Query Q, uint t) {
     uint base = PSV_NODES_PER_TRIANGLE * t + 1u;
-    return psvSigned(psvPlane(base), Q.q) < -Q.closeCall && psvSigned(psvPlane(base + 1u), Q.q) < -Q.closeCall &&
-           psvSigned(psvPlane(base + 2u), Q.q) < -Q.closeCall && psvSigned(psvPlane(base + 3u), Q.q) < -Q.closeCall;
+    return psvSigned(psvPlane(base), Q.q) < -psvCloseCall && psvSigned(psvPlane(base + 1u), Q.q) < -psvCloseCall &&
+           psvSigned(psvPlane(base + 2u), Q.q) < -psvCloseCall && psvSigned(psvPlane(base + 3u), Q.q) < -psvCloseCall;
 }
 
 // Whether triangle t shadows q, asked where the walk found q behind (or too close to) t's capping
 // plane, after going down the negative side (or too close to) its three shadow planes. Its four
-// planes decide where q is inside each by more than Q.closeCall; elsewhere the reference's ray test
+// planes decide where q is inside each by more than psvCloseCall; elsewhere the reference's ray test
 // decides (the same ray, the same watertight test, so the same answer), counted in closeCalls.
 // `clearly` tells which.
 bool psvShadows(Query Q, uint t, out bool clearly, inout Result r) {
@@ -165,11 +157,11 @@ bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
             float s = psvSigned(n.plane, Q.q);
             uint side; // the child on q's side of the plane (0: none)
             if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
-                side = s <= Q.closeCall ? node + 1u : n.pos;
+                side = s <= psvCloseCall ? node + 1u : n.pos;
                 if (!second && PSV_VISITS_INTER(Q, n, s)) { node = n.inter; continue; }
             } else { // capping plane
                 if (!second && PSV_SKIPS_DEPTH(Q, n)) side = 0u;
-                else if (!second && s <= Q.closeCall) { cap = node; break; }
+                else if (!second && s <= psvCloseCall) { cap = node; break; }
                 else side = !second && n.inter != 0u ? n.inter : n.pos;
             }
             PSV_STEP(side, (node - 1u) / PSV_NODES_PER_TRIANGLE)
@@ -181,7 +173,7 @@ bool psvWalkStackless(Query Q, uint node, uint owner, inout Result r) {
         bool clearly;
         if (psvShadows(Q, t, clearly, r)) { r.visibility = 0.0; return true; }
         // Lit by it: on to the subtree in front, as for a point in front of the plane. (The subtree
-        // behind it lies inside its frustum and more than uTolerance behind it: not q's.)
+        // behind it lies inside its frustum and more than the tolerance behind it: not q's.)
         PsvNode n = psvNode(cap);
         PSV_STEP(n.inter != 0u ? n.inter : n.pos, t)
     }
@@ -229,7 +221,7 @@ Result query(Query Q) {
             PsvNode n = psvNode(node);
             float s = psvSigned(n.plane, Q.q);
             if (node % PSV_NODES_PER_TRIANGLE != 0u) { // shadow plane
-                uint next = s <= Q.closeCall ? node + 1u : n.pos;
+                uint next = s <= psvCloseCall ? node + 1u : n.pos;
                 if (PSV_VISITS_INTER(Q, n, s)) {
                     if (next == 0u) next = n.inter;
                     else PSV_PUSH(node, n.inter);
@@ -241,7 +233,7 @@ Result query(Query Q) {
                 continue;
             }
             if (PSV_SKIPS_DEPTH(Q, n)) { node = 0u; continue; }
-            if (s <= Q.closeCall) { cap = node; break; }
+            if (s <= psvCloseCall) { cap = node; break; }
             if (n.inter != 0u) PSV_PUSH(node, n.inter);
             node = n.pos;
 #if PSV_TRAVERSAL == 2
@@ -261,7 +253,7 @@ Result query(Query Q) {
                 if (r.visibility <= PSV_OPAQUE_TRANSMISSION) { r.visibility = 0.0; break; }
 #if PSV_TRANSPARENCY
                 // Frusta behind this triangle (negative child) may hold q too, where q is clearly
-                // inside it (elsewhere they lie more than uTolerance from q); in front ones below.
+                // inside it (elsewhere they lie more than the tolerance from q); in front ones below.
                 if (clearly && n.wedgeOrNeg != 0u) PSV_PUSH(cap, n.wedgeOrNeg);
 #endif
             }
@@ -312,7 +304,6 @@ void queryPixel(ivec2 px) {
             precise vec3 q = p + n * uRayOffset;
             Query Q;
             Q.q = q;
-            Q.closeCall = psvCloseCallMargin();
 #if PSV_DEPTH_SKIP
             Q.depth = psvDepth(Q.q);
 #else
@@ -369,6 +360,7 @@ void queryPixel(ivec2 px) {
 }
 
 void main() {
+    psvReadMargins();
 #if SHADOWLAB_INSTRUMENTATION
     if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = sCloseCalls = sStackless = sCapped = sDeferred = 0u;
     barrier();

@@ -35,7 +35,18 @@ PsvNode psvNode(uint i) {
 }
 
 uniform uint uTriangleCount;
-uniform float uTolerance;   // world units: vertices this close to a plane count as touching it
+
+// World units: vertices this close to a plane count as touching it (psvTolerance); a plane value
+// half as close to 0 is too close for the query to call (psvCloseCall). Both are per-invocation
+// values that psvReadMargins() sets at the start of each main from the sentinel node's plane (node
+// 0, whose plane nothing else reads; Psv.cpp writes the tolerance there each frame), not uniforms:
+// llvmpipe re-reads a uniform at each use inside a loop, and one such compare cost the query's
+// node loop 13 % (results/reference/psv_plane_walk_llvmpipe.md).
+float psvTolerance, psvCloseCall;
+void psvReadMargins() {
+    psvTolerance = psvPlane(0u).w;
+    psvCloseCall = 0.5 * psvTolerance;
+}
 uniform vec3 uDepthOrigin;  // directional light: depth is measured along the light from here
 
 // ---- Insertion order: a keyed bijection on [0, n) ------------------------------------------------
@@ -110,7 +121,7 @@ uint psvEscape(uint t) {
 // far less precise). γ ≤ 89° (the config's limit) and α < 90° keep γ + α below π, where cos falls.
 bool psvOutsideCone(vec3 v0, vec3 v1, vec3 v2) {
     vec3 c = (v0 + v1 + v2) / 3.0;
-    float r = max(length(v0 - c), max(length(v1 - c), length(v2 - c))) * (1.0 + 1e-5) + uTolerance;
+    float r = max(length(v0 - c), max(length(v1 - c), length(v2 - c))) * (1.0 + 1e-5) + psvTolerance;
     vec3 d = c - uLightPosition;
     float dist = length(d);
     if (!(dist > r)) return false; // the sphere holds the apex
@@ -172,8 +183,8 @@ float psvSigned(vec4 plane, vec3 x) {
 // the query may always visit, so it costs a little speed and never correctness.
 int psvClassify(vec4 plane, vec3 v0, vec3 v1, vec3 v2) {
     vec3 s = vec3(psvSigned(plane, v0), psvSigned(plane, v1), psvSigned(plane, v2));
-    if (all(greaterThan(s, vec3(uTolerance)))) return 1;
-    if (all(lessThan(s, vec3(-uTolerance)))) return -1;
+    if (all(greaterThan(s, vec3(psvTolerance)))) return 1;
+    if (all(lessThan(s, vec3(-psvTolerance)))) return -1;
     return 0;
 }
 
@@ -209,7 +220,7 @@ vec3 psvClosestPoint(vec3 p, vec3 a, vec3 b, vec3 c) {
 float psvTriangleMinDepth(vec3 v0, vec3 v1, vec3 v2) {
     float d = lightIsDirectional() ? min(psvDepth(v0), min(psvDepth(v1), psvDepth(v2)))
                                : length(psvClosestPoint(uLightPosition, v0, v1, v2) - uLightPosition);
-    return max(0.0, d * (1.0 - 1e-5) - uTolerance);
+    return max(0.0, d * (1.0 - 1e-5) - psvTolerance);
 }
 
 // ---- Wedge (section 3.5) -------------------------------------------------------------------------
@@ -261,7 +272,7 @@ PsvWedgeTriangle psvWedgeTriangle(vec3 v0, vec3 v1, vec3 v2) {
     float chord = max(length(t.b - t.a), length(t.c - t.a));
     t.arc = chord < 0.5 ? 1.02 * chord : 2.0;
 #if PSV_WEDGE_BOUND == 1
-    t.minDist = length(psvClosestPoint(uLightPosition, v0, v1, v2) - uLightPosition) * (1.0 - 1e-5) - uTolerance;
+    t.minDist = length(psvClosestPoint(uLightPosition, v0, v1, v2) - uLightPosition) * (1.0 - 1e-5) - psvTolerance;
 #else
     t.minDist = 0.0;
 #endif
@@ -274,7 +285,7 @@ PsvWedgeTriangle psvWedgeTriangle(vec3 v0, vec3 v1, vec3 v2) {
 // largest |distance| of the vertices (exact, the distance being linear over the triangle).
 float psvWedge(vec4 plane, PsvWedgeTriangle t) {
     if (lightIsDirectional())
-        return max(abs(psvSigned(plane, t.v0)), max(abs(psvSigned(plane, t.v1)), abs(psvSigned(plane, t.v2)))) + uTolerance;
+        return max(abs(psvSigned(plane, t.v0)), max(abs(psvSigned(plane, t.v1)), abs(psvSigned(plane, t.v2)))) + psvTolerance;
     vec3 n = plane.xyz;
     float m = max(abs(dot(n, t.a)), max(abs(dot(n, t.b)), abs(dot(n, t.c))));
 #if PSV_WEDGE_BOUND == 2
@@ -285,7 +296,7 @@ float psvWedge(vec4 plane, PsvWedgeTriangle t) {
     // its largest value at a vertex, and |p - light| at least the triangle's distance. Wider than
     // the exact value by about the triangle's depth extent over its distance, never narrower.
     float s = max(abs(psvSigned(plane, t.v0)), max(abs(psvSigned(plane, t.v1)), abs(psvSigned(plane, t.v2))));
-    return t.minDist > 0.0 ? min(1.0, (s + uTolerance) * (1.0 + 1e-5) / t.minDist + 1e-6) : 1.0;
+    return t.minDist > 0.0 ? min(1.0, (s + psvTolerance) * (1.0 + 1e-5) / t.minDist + 1e-6) : 1.0;
 #endif
     m = max(m, max(psvArcMax(n, t.a, t.b), max(psvArcMax(n, t.b, t.c), psvArcMax(n, t.c, t.a))));
     if (psvInsideCone(n, t.a, t.b, t.c) || psvInsideCone(-n, t.a, t.b, t.c)) m = 1.0;
@@ -310,4 +321,4 @@ float psvWedgeScale(vec3 q) { return lightIsDirectional() ? 1.0 : length(q - uLi
 
 // Whether a query point (plane value s, psvWedgeScale `scale`) is inside a node's intersection
 // wedge (same units as psvWedge).
-bool psvInWedge(float s, float scale, float wedge) { return abs(s) <= wedge * scale + uTolerance; }
+bool psvInWedge(float s, float scale, float wedge) { return abs(s) <= wedge * scale + psvTolerance; }
