@@ -42,7 +42,7 @@ uniform uint uTriangleCount;
 // 0, whose plane nothing else reads; Psv.cpp writes the tolerance there each frame), not uniforms:
 // llvmpipe re-reads a uniform at each use inside a loop, and one such compare cost the query's
 // node loop 13 % (results/reference/psv_plane_walk_llvmpipe.md).
-float psvTolerance, psvCloseCall;
+float psvTolerance = 0.0, psvCloseCall = 0.0; // set by psvReadMargins() first thing in main
 void psvReadMargins() {
     psvTolerance = psvPlane(0u).w;
     psvCloseCall = 0.5 * psvTolerance;
