@@ -71,8 +71,8 @@ struct Result {
 // most 4n + 1 escapes. One more can only be a corrupt escape: the walk ends at its owner with
 // `capped` set, and the pixel is written shadowed and counted (never a hang). The walk counts its
 // escapes down from this budget, as data flow into the jump, not a branch of the node loop
-// (llvmpipe pays for every branch), and not as a compare with a uniform, which llvmpipe re-reads
-// at every iteration (psvReadMargins, psv/tree.glsl).
+// (llvmpipe pays for every branch), and not as a compare with a uniform, which cost psv's node
+// loop on llvmpipe (psvReadMargins, psv/tree.glsl).
 uint psvEscapeBudget() { return PSV_NODES_PER_TRIANGLE * uTriangleCount + 2u; }
 
 // What the walk needs of the query point. The reference's ray is not kept here: it is built where
