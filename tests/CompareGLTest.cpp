@@ -42,7 +42,7 @@ TEST_F(CompareGLTest, PlantedRegressionsAreNamedAndARunAgainstItselfChangesNothi
     const std::string dir = test::makeTempDir("compare");
     runInto(dir + "/base");
     {
-        test::ScopedShaderFaults fault(ShaderDefines{{"SHADOWLAB_FAULT_PLANTED_LIT", "1"}, {"SHADOWLAB_FAULT_SLOW_TRAVERSE", "30"}});
+        test::ScopedShaderFaults fault(ShaderDefines{{"SHADOWLAB_FAULT_PLANTED_LIT", "1"}, {"SHADOWLAB_FAULT_SLOW_TRAVERSE", "100"}});
         runInto(dir + "/planted");
     }
     const Comparison same = compareRuns(dir + "/base", dir + "/base", {});
