@@ -1,17 +1,19 @@
 // PSV's plane walks (query.comp, first pass): the stack and stackless walks decided by the tree's
 // planes alone. Each stops at the first capping plane q is behind or too close to call, as the
-// exact walk does, and decides there after the loop: q inside all four of the triangle's planes by
-// more than the close-call margin is shadowed; anything else is a close call, and the pixel is listed for the
-// exact walk (query.comp's second pass, PSV_QUERY_PASS 1), which walks it again from the root and
-// decides such triangles by the reference's ray. The plane walk visits the exact walk's nodes up to
-// that point and decides a shadow from the same plane values (psvClearlyInside), and a pixel it
-// finds lit met no close call, so the two passes write the exact walk's image.
+// exact walk does, and decides there after the loop: q inside all four of the triangle's planes
+// by more than the close-call margin is shadowed; anything else is a close call, and the pixel is
+// listed for the exact walk (query.comp's second pass, PSV_QUERY_PASS 1), which walks it again
+// from the root and decides such triangles by the reference's ray. The plane walk visits the exact
+// walk's nodes up to that point and decides a shadow from the same plane values
+// (psvClearlyInside), and a pixel it finds lit met no close call, so the two passes write the
+// exact walk's image.
 //
 // Why a second pass: a SIMD back end (llvmpipe, and any GPU for a divergent branch) pays for a
 // loop's body whatever few lanes take a branch of it. With the ray test, or even a list append or
-// a second read of the frustum's planes, inside the walk's loops every node paid for it: 15 % of
-// the traversal on the peer orbit (results/reference/psv_plane_walk_llvmpipe.md). Here the node
-// loop holds what the paper's walk holds, and the decision runs once, after it.
+// a second read of the frustum's planes, inside the walk's loops every node paid for it: about
+// half of the 15 % the traversal had lost on the peer orbit (results/reference/
+// psv_plane_walk_llvmpipe.md). Here the node loop holds what the paper's walk holds, and the
+// decision runs once, after it.
 //
 // Include after the definitions of Query, Result, psvClearlyInside, PSV_VISITS_INTER and
 // PSV_SKIPS_DEPTH.
