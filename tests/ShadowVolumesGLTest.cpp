@@ -134,6 +134,20 @@ TEST_F(ShadowVolumesGLTest, EveryPixelTheDepthTestGetsWrongIsACloseCall) {
     EXPECT_GT(wrongWithout, 0u) << "the scenes should hold pixels the depth test cannot call";
 }
 
+// The close calls' list (framework/algorithm/PixelList.h) holds every pixel once, which the resolve
+// pass, listing a pixel at most once, cannot fill; were it full, each close call it refused is
+// written shadowed and counted, never lit by mistake.
+TEST_F(ShadowVolumesGLTest, FaultFullPixelListWritesTheCloseCallsShadowed) {
+    ScopedShaderFaults faults(ShaderDefines{{"SHADOWLAB_FAULT_FULL_PIXEL_LIST", "1"}});
+    const AlgorithmRun o = runAlgorithm(shadowVolumesInfo(), grazingOverThin(), {});
+    const double refused = o.counters.at("close_call_pixels");
+    std::printf("[shadow_volumes] with a full list: %.0f close calls written shadowed\n", refused);
+    ASSERT_GT(refused, 0.0);
+    EXPECT_EQ(o.counters.at("loop_capped_pixels"), refused);
+    EXPECT_EQ(o.overflow, uint64_t(refused));
+    EXPECT_EQ(o.accuracy.falseLitPixels, 0u);
+}
+
 // 256 triangles stacked over the ground: a point under all of them is in 256 volumes, which the
 // 8-bit stencil reads as 0 (lit). The exact count catches it: every such pixel is counted in the
 // overflow and written shadowed, and the image is the reference's.
