@@ -11,7 +11,8 @@
 // are the query's G-buffer).
 #define PSV_NODE_UNIT 2
 
-// TOP tree: node 0 is a sentinel whose `pos` field is the root pointer; triangle t owns the four
+// TOP tree: node 0 is a sentinel whose `pos` field is the root pointer (its plane's w carries the
+// frame's tolerance: psvReadMargins in psv/tree.glsl); triangle t owns the four
 // nodes 4t+1 .. 4t+4 (three shadow planes, then its capping plane), so `index % 4 == 0` marks a
 // capping node and the negative child of a shadow-plane node is simply index + 1 (never stored).
 // Index 0 in a child field is an empty leaf. 4n + 1 nodes of 32 bytes in all.
