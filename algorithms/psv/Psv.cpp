@@ -238,16 +238,16 @@ private:
         // product) nor the hybrid walk (whose stackless subtrees return to the stack walk).
         planeWalk_ = !p_.transparency && walk != "hybrid";
         ShaderDefines defines = {{"PSV_WEDGE", flag(p_.wedge)},
-                                       {"PSV_WEDGE_BOUND", p_.wedgeBound == "vertices" ? "2" : p_.wedgeBound == "distance" ? "1" : "0"},
-                                       {"PSV_RANDOM_ORDER", flag(p_.randomOrder)},
-                                       {"PSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
-                                       {"PSV_DEPTH_SKIP", flag(p_.depthSkip)},
-                                       {"PSV_TRANSPARENCY", flag(p_.transparency)},
-                                       {"PSV_STACK_SIZE", std::to_string(p_.stackSize)},
-                                       {"PSV_TRAVERSAL", walk == "stackless" ? "1" : walk == "hybrid" ? "2" : "0"},
-                                       {"PSV_HYBRID_STACK", std::to_string(p_.hybridStack)},
-                                       {"PSV_PLANE_WALK", flag(planeWalk_)},
-                                       instrumentationDefine(options_)};
+                                 {"PSV_WEDGE_BOUND", p_.wedgeBound == "vertices" ? "2" : p_.wedgeBound == "distance" ? "1" : "0"},
+                                 {"PSV_RANDOM_ORDER", flag(p_.randomOrder)},
+                                 {"PSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
+                                 {"PSV_DEPTH_SKIP", flag(p_.depthSkip)},
+                                 {"PSV_TRANSPARENCY", flag(p_.transparency)},
+                                 {"PSV_STACK_SIZE", std::to_string(p_.stackSize)},
+                                 {"PSV_TRAVERSAL", walk == "stackless" ? "1" : walk == "hybrid" ? "2" : "0"},
+                                 {"PSV_HYBRID_STACK", std::to_string(p_.hybridStack)},
+                                 {"PSV_PLANE_WALK", flag(planeWalk_)},
+                                 instrumentationDefine(options_)};
         frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
         build_ = ShaderProgram::compute("psv/build.comp", defines);
         query_ = ShaderProgram::compute("psv/query.comp", defines);
