@@ -183,13 +183,8 @@ void refuseInputsInsideReplacedOutput(const std::string& config, const std::vect
     if (!fs::is_directory(fs::symlink_status(dir, ec))) return;
     Json j = JsonNode::parseFile(config);
     for (const auto& o : overrides) applyOverride(j, o);
-    const std::vector<std::string> gltf = gltfPathsOf(j.value("scene", Json()));
-    std::vector<std::string> inputs = {config};
-    const fs::path folder = fs::absolute(config).parent_path();
     // Each glTF file with the buffer files it names (eleventh probe: a buffer inside DIR was deleted).
-    for (const std::string& g : gltf)
-        for (const std::string& file : gltfFiles(fs::path(g).is_absolute() ? g : (folder / g).string())) inputs.push_back(file);
-    OutputPlace::refuseInputsInside(dir, inputs, "this run");
+    OutputPlace::refuseInputsInside(dir, configInputFiles(j, config), "this run");
 }
 
 int run(const std::vector<std::string>& args) {

@@ -109,11 +109,9 @@ void drawSidePanel(GuiState& s) {
 /// inputs (twentieth probe: `--screenshot c.json` replaced the config being read, where
 /// `run --force` refuses the same).
 static void refuseOutputsOverInputs(const GuiOptions& opts, const Json& source) {
-    std::vector<std::string> inputs;
-    if (!opts.config.empty()) inputs.push_back(opts.config);
-    const std::filesystem::path folder = std::filesystem::path(parentDir(opts.config.empty() ? std::string("./x") : opts.config));
-    for (const std::string& g : gltfPathsOf(source.value("scene", Json())))
-        for (const std::string& f : gltfFiles(std::filesystem::path(g).is_absolute() ? g : (folder / g).string())) inputs.push_back(f);
+    // The built-in scene has no config file: its scene's files only, relative to this folder.
+    std::vector<std::string> inputs = configInputFiles(source, opts.config.empty() ? std::string("built-in") : opts.config);
+    if (opts.config.empty()) inputs.erase(inputs.begin());
     for (const auto& [option, file] : {std::pair<const char*, const std::string*>{"--screenshot", &opts.screenshot},
                                        {"--report", &opts.report}, {"--save-config", &opts.saveConfig}}) {
         std::error_code ec;

@@ -711,4 +711,13 @@ std::vector<std::string> gltfFiles(const std::string& gltf) {
     return files;
 }
 
+std::vector<std::string> configInputFiles(const Json& config, const std::string& configFile) {
+    namespace fs = std::filesystem;
+    std::vector<std::string> inputs = {configFile};
+    const fs::path folder = fs::absolute(configFile).parent_path();
+    for (const std::string& g : gltfPathsOf(config.value("scene", Json())))
+        for (const std::string& file : gltfFiles(fs::path(g).is_absolute() ? g : (folder / g).string())) inputs.push_back(file);
+    return inputs;
+}
+
 } // namespace shadowlab

@@ -19,6 +19,9 @@ std::vector<std::string> gltfPathsOf(const Json& scene);
 /// The files a glTF file's geometry comes from: itself and, for a .gltf, the buffer files its
 /// buffers name (relative, not data: URIs). A file that cannot be read names no buffers.
 std::vector<std::string> gltfFiles(const std::string& gltf);
+/// Every file a config read from `configFile` takes as input: the config itself and each glTF file
+/// of its scene with its buffer files, relative paths resolved against the config's folder.
+std::vector<std::string> configInputFiles(const Json& config, const std::string& configFile);
 /// The same checks as buildScene (keys, values, glTF files present, triangle limits) without
 /// generating or loading anything, so thousands of scenes can be checked in a moment. A malformed
 /// glTF file is found only when it is loaded.

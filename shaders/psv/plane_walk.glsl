@@ -10,10 +10,9 @@
 //
 // Why a second pass: a SIMD back end (llvmpipe, and any GPU for a divergent branch) pays for a
 // loop's body whatever few lanes take a branch of it. With the ray test, or even a list append or
-// a second read of the frustum's planes, inside the walk's loops every node paid for it: about
-// half of the 15 % the traversal had lost on the peer orbit (results/reference/
-// psv_plane_walk_llvmpipe.md). Here the node loop holds what the paper's walk holds, and the
-// decision runs once, after it.
+// a second read of the frustum's planes, inside the walk's loops every node paid for it
+// (measured: results/reference/psv_plane_walk_llvmpipe.md). Here the node loop holds what the
+// paper's walk holds, and the decision runs once, after it.
 //
 // Include after the definitions of Query, Result, psvClearlyInside, PSV_VISITS_INTER and
 // PSV_SKIPS_DEPTH.

@@ -40,8 +40,8 @@ uniform uint uTriangleCount;
 // half as close to 0 is too close for the query to call (psvCloseCall). Both are per-invocation
 // values that psvReadMargins() sets at the start of each main from the sentinel node's plane (node
 // 0, whose plane nothing else reads; Psv.cpp writes the tolerance there each frame), not uniforms:
-// on llvmpipe, comparing with a uniform margin in the query's node loop cost it 13 %, the same
-// margin as a per-invocation value nothing (results/reference/psv_plane_walk_llvmpipe.md).
+// on llvmpipe, comparing with a uniform margin slowed the query's node loop, the same margin as a
+// per-invocation value did not (measured: results/reference/psv_plane_walk_llvmpipe.md).
 float psvTolerance = 0.0, psvCloseCall = 0.0; // set by psvReadMargins() first thing in main
 void psvReadMargins() {
     psvTolerance = psvPlane(0u).w;
