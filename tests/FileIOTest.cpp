@@ -172,5 +172,33 @@ TEST(FileIOTest, AFailedWriteKeepsTheOldFileAndRemovesItsTemporary) {
     EXPECT_EQ(strays(dir, {"summary.json"}), std::vector<std::string>{});
 }
 
+/// Runs this test binary on one test in a child process; returns the child's pid after it exited 0.
+pid_t runSelfOn(const std::string& filter, bool keepDirs) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+        if (keepDirs) ::setenv("SHADOWLAB_KEEP_TEST_DIRS", "1", 1);
+        else ::unsetenv("SHADOWLAB_KEEP_TEST_DIRS");
+        const std::string arg = "--gtest_filter=" + filter;
+        ::execl("/proc/self/exe", "shadowlab_tests", arg.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int status = 0;
+    if (child < 0 || ::waitpid(child, &status, 0) != child || !WIFEXITED(status) || WEXITSTATUS(status) != 0) return -1;
+    return child;
+}
+
+TEST(TestSupportTest, TempDirsAreRemovedWhenTheTestsPass) {
+    // Each test run used to leave every folder it made in /tmp behind (thousands, gigabytes).
+    const std::string probe = "FileIOTest.AFailedWriteKeepsTheOldFileAndRemovesItsTemporary";
+    const auto dirOf = [](pid_t pid) { return fs::temp_directory_path() / ("shadowlab-test-fileio-full-" + std::to_string(pid)); };
+    const pid_t removed = runSelfOn(probe, false);
+    ASSERT_GT(removed, 0);
+    EXPECT_FALSE(fs::exists(dirOf(removed)));
+    const pid_t kept = runSelfOn(probe, true);
+    ASSERT_GT(kept, 0);
+    EXPECT_TRUE(fs::exists(dirOf(kept) / "summary.json")) << "SHADOWLAB_KEEP_TEST_DIRS=1 keeps them for a look";
+    fs::remove_all(dirOf(kept));
+}
+
 } // namespace
 } // namespace shadowlab

@@ -57,7 +57,8 @@ inline const std::string kEngineGlb = kAssimpGltf + "/2CylinderEngine-glTF-Binar
 
 /// Runs a shell command, returns its exit code; stdout+stderr go to `output`.
 int runCommand(const std::string& command, std::string& output);
-/// A fresh empty temporary directory for this test.
+/// A fresh empty temporary directory for this test, removed when the process exits unless a test
+/// failed or SHADOWLAB_KEEP_TEST_DIRS is set.
 std::string makeTempDir(const std::string& tag);
 
 } // namespace shadowlab::test
