@@ -22,7 +22,7 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
     SceneGpu gpu(shot.scene);
     GBuffer gbuffer({res, res});
     gbuffer.render(gpu, shot.camera);
-    AlgorithmHost host(info, params, AlgorithmOptions{options.instrumentation});
+    AlgorithmHost host(info, params, AlgorithmOptions{options.statistics});
     host.resize({res, res});
     host.setScene(gpu);
     StageTimer timer;

@@ -42,8 +42,8 @@ struct RunOptions {
     bool withReference = true;
     /// The frame's side in pixels: kRes unless a test needs a smaller, cheaper frame.
     int resolution = kRes;
-    /// Off: the host's timing mode (AlgorithmOptions::instrumentation), statistics compiled out.
-    bool instrumentation = true;
+    /// Off: the host's timed pass (AlgorithmOptions::statistics off), statistics compiled out.
+    bool statistics = true;
     /// Each stage waits for the GL (StageTimer::setSynchronous), so its CPU time is its wall time, as
     /// the runner times a CPU rasteriser: an implementation that defers work to a later submission
     /// (zink) would otherwise show only the time to issue it.

@@ -64,10 +64,10 @@ TEST_P(ConformanceGLTest, DefaultsGiveValidVisibilityAndExactOnesMatchTheReferen
     }
 }
 
-// Timing mode compiles the statistics out of the shaders; what an algorithm computes must not
+// The timed pass compiles the statistics out of the shaders; what an algorithm computes must not
 // change: the same visibility bit for bit, the same overflow count, and no debug image left to
 // write in the timed stages.
-TEST_P(ConformanceGLTest, TimingModeGivesBitIdenticalVisibility) {
+TEST_P(ConformanceGLTest, TimedPassGivesBitIdenticalVisibility) {
     const Case& c = GetParam();
     for (test::Shot (*scene)() : {&test::intersectingTriangles, &test::thousandsOfTriangles}) {
         const test::Shot shot = test::withLight(scene(), c.light);
@@ -75,7 +75,7 @@ TEST_P(ConformanceGLTest, TimingModeGivesBitIdenticalVisibility) {
         options.resolution = kRes;
         options.withReference = false;
         const test::AlgorithmRun instrumented = test::runAlgorithm(*c.info, shot, {}, options);
-        options.instrumentation = false;
+        options.statistics = false;
         const test::AlgorithmRun timed = test::runAlgorithm(*c.info, shot, {}, options);
         ASSERT_EQ(instrumented.visibility.size(), timed.visibility.size());
         size_t differing = 0;
@@ -83,18 +83,18 @@ TEST_P(ConformanceGLTest, TimingModeGivesBitIdenticalVisibility) {
             differing += std::memcmp(&timed.visibility[i], &instrumented.visibility[i], sizeof(float)) != 0;
         EXPECT_EQ(differing, 0u) << "pixels whose visibility differs between the two modes";
         EXPECT_EQ(timed.overflow, instrumented.overflow);
-        EXPECT_TRUE(timed.overflowMask.empty()) << "timing mode still writes the stack_overflow image";
+        EXPECT_TRUE(timed.overflowMask.empty()) << "the timed pass still writes the stack_overflow image";
     }
 }
 
-class ConformanceTimingModeGLTest : public test::GLTest {};
+class ConformanceTimedPassGLTest : public test::GLTest {};
 
-TEST_F(ConformanceTimingModeGLTest, NoDebugViews) {
-    // Every plugin that has statistics drops them, and its debug images, in timing mode.
+TEST_F(ConformanceTimedPassGLTest, NoDebugViews) {
+    // Every plugin that has statistics drops them, and its debug images, in the timed pass.
     for (const AlgorithmInfo* info : conformingAlgorithms()) {
         AlgorithmHost host(*info, ParamValues(info->schema()), AlgorithmOptions{false});
         EXPECT_TRUE(host.algorithm().debugViews().empty()) << info->name;
-        EXPECT_FALSE(host.options().instrumentation);
+        EXPECT_FALSE(host.options().statistics);
     }
 }
 

@@ -68,7 +68,7 @@ TEST_F(HonestTimingGLTest, TimedFramesNeverCarryTheStatisticsPassCounters) {
         ASSERT_EQ(a.frames.size(), 3u);
         ASSERT_EQ(a.statistics.size(), 3u) << "statistics: all runs the pass on every frame";
         EXPECT_TRUE(n.statistics.empty()) << "statistics: none runs no pass";
-        EXPECT_TRUE(a.visibilityDiffers.empty()) << "instrumentation changed the image";
+        EXPECT_TRUE(a.visibilityDiffers.empty()) << "the statistics changed the image";
         for (size_t f = 0; f < a.frames.size(); ++f) {
             const std::set<std::string> timed = counterNames(a.frames[f]), stats = counterNames(a.statistics[f]);
             // The timed pass reports the same counters whether or not a statistics pass ran in the
@@ -121,7 +121,7 @@ TEST_F(HonestTimingGLTest, SummarySaysWhichPassEachNumberCameFrom) {
     EXPECT_FALSE(std::filesystem::exists(dirNone + "/out/images/psv_f0001_heat_nodes_visited.png"));
 }
 
-TEST(HonestTimingConfigTest, TimingModeIsRefusedWithWhereToGo) {
+TEST(HonestTimingConfigTest, RetiredTimingModeKeyIsRefusedWithWhereToGo) {
     Json cfg = smallConfig("");
     cfg["timing_mode"] = true;
     try {

@@ -193,7 +193,7 @@ struct NamedShot {
 const NamedShot kShots[] = {{"intersecting_triangles", &test::intersectingTriangles},
                             {"thousands_of_triangles", &test::thousandsOfTriangles}};
 
-/// The path an algorithm reports having taken, for the table (counters of the timing mode).
+/// The path an algorithm reports having taken, for the table (counters of the timed pass).
 std::string pathOf(const std::string& algorithm, std::map<std::string, double> c) {
     std::ostringstream s;
     if (algorithm == "ptsv") {
@@ -249,7 +249,7 @@ TEST_P(PortabilityGLTest, ExactOnEveryPath) {
         const test::Shot shot = test::withLight(named.make(), c.light);
         test::RunOptions options;
         options.resolution = kRes;
-        options.instrumentation = false;  // the timed pass's shaders, as an experiment times them
+        options.statistics = false;  // the timed pass's shaders, as an experiment times them
         options.warmUp = true;            // the measured frame without the first dispatch's compile
         options.synchronousStages = true; // wall time per stage on every implementation
         const auto start = std::chrono::steady_clock::now();

@@ -94,7 +94,7 @@ public:
     void sceneMoved(const FrameInputs& f) override { bvh_.refit(*scene_, f.timer); }
 
     void resize(glm::ivec2 resolution) override {
-        if (!options_.instrumentation) return; // timing mode: no debug images
+        if (!options_.statistics) return; // the timed pass: no debug images
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
@@ -120,9 +120,9 @@ public:
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, BVH_COUNTER_BINDING);
         bindPixelPassInputs(f);
-        if (options_.instrumentation) bindDebugImage(1, nodesVisited_), bindDebugImage(2, overflow_);
+        if (options_.statistics) bindDebugImage(1, nodesVisited_), bindDebugImage(2, overflow_);
         // The state between dispatches (layout.glsl); a single dispatch never touches it.
-        batches_.begin(sampleCount, budget, res, options_.instrumentation, BVH_ACCUM_UNIT);
+        batches_.begin(sampleCount, budget, res, options_.statistics, BVH_ACCUM_UNIT);
         batches_.dispatch(trace_, res);
         finishPixelPass();
         f.timer.end();
@@ -134,7 +134,7 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(BVH_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
-        // The structure and what is measured in both modes; timing mode compiles the rest out.
+        // The structure and what is measured in both modes; the timed pass compiles the rest out.
         std::vector<Counter> out = {{"stack_overflow_rays", double(c[BVH_C_OVERFLOW_RAYS])},
                                     {"stack_overflow_pixels", double(c[BVH_C_OVERFLOW_PIXELS])},
                                     {"truncated_pixels", double(c[BVH_C_TRUNCATED_PIXELS])},
@@ -147,7 +147,7 @@ public:
                                     {"bvh_build_ms", buildMs_},
                                     {"node_bytes", double(bvh_.gpu().nodes.size())},
                                     {"triangle_bytes", double(bvh_.gpu().triangles.size())}};
-        if (!options_.instrumentation) return out;
+        if (!options_.statistics) return out;
         out.insert(out.begin(), {{"nodes_visited_mean", perRay(wide(BVH_C_VISITED_LO))},
                                  {"nodes_visited_max", double(c[BVH_C_VISITED_MAX])},
                                  {"triangles_tested_mean", perRay(wide(BVH_C_TRIS_LO))},
@@ -160,7 +160,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
     }
 
@@ -180,7 +180,7 @@ private:
     void compile() {
         const ShaderDefines defines = {{"BVH_STACK_SIZE", std::to_string(p_.stackSize)},
                                        {"BVH_SHORT_STACK", p_.shortStack ? "1" : "0"},
-                                       simdProbeDefine(options_), instrumentationDefine(options_)};
+                                       simdProbeDefine(options_), statisticsDefine(options_)};
         trace_ = ShaderProgram::compute("bvh_raytrace/trace.comp", defines);
     }
 

@@ -87,7 +87,7 @@ public:
         next_ = GlBuffer(pixels * 4, nullptr, 0);
         samples_ = GlBuffer(pixels * 16, nullptr, 0);
         blocked_ = GlBuffer(pixels * 4, nullptr, 0);
-        if (options_.instrumentation) listView_ = makeTexture2D(GL_R32F, r.x, r.y);
+        if (options_.statistics) listView_ = makeTexture2D(GL_R32F, r.x, r.y);
         resolution_ = r;
     }
 
@@ -169,7 +169,7 @@ public:
 
         f.timer.begin("resolve");
         resolve_.set("uResolution", r);
-        if (options_.instrumentation) runPixelPass(f, resolve_, {&listView_});
+        if (options_.statistics) runPixelPass(f, resolve_, {&listView_});
         else runPixelPass(f, resolve_, {});
         f.timer.end();
         counters_.markStale();
@@ -185,7 +185,7 @@ public:
                                     {"loop_capped_pixels", double(c[IZB_C_CUT_LOOPS])},
                                     {"overflow_pixels", double(c[IZB_C_OVERFLOW_PIXELS])},
                                     {"grid_faces", double(faces_)}};
-        if (options_.instrumentation) {
+        if (options_.statistics) {
             const double samples = double(c[IZB_C_SAMPLES]);
             out.push_back({"tests_per_sample", samples > 0 ? double(counters_.wide(IZB_C_TESTS_LO)) / samples : 0.0});
             out.push_back({"list_max", double(c[IZB_C_LIST_MAX])});
@@ -193,7 +193,7 @@ public:
         return out;
     }
     std::vector<DebugView> debugViews() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         return {{"list_length", listView_.id(), 0.0f, "samples in the pixel's cell"}};
     }
     size_t memoryBytes() const override {
@@ -226,7 +226,7 @@ private:
     }
 
     void compile() {
-        const auto instr = instrumentationDefine(options_);
+        const auto instr = statisticsDefine(options_);
         const std::pair<std::string, std::string> texels{"SCENE_POSITION_TEXELS", "1"};
         const std::pair<std::string, std::string> fit{"IZB_FIT_SAMPLES", p_.gridFit == "samples" ? "1" : "0"};
         bounds_ = ShaderProgram::compute("izb/bounds.comp", {});

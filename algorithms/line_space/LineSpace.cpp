@@ -262,7 +262,7 @@ public:
 
     void resize(glm::ivec2 resolution) override {
         resolution_ = resolution;
-        if (!options_.instrumentation) return; // timing mode: no debug image
+        if (!options_.statistics) return; // the timed pass: no debug image
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         loopCapped_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
@@ -313,9 +313,9 @@ public:
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_COUNTER_BINDING);
         if (classify) classifyBuf_.bindBase(GL_SHADER_STORAGE_BUFFER, LS_CLASSIFY_BINDING);
         bindPixelPassInputs(f);
-        if (options_.instrumentation) bindDebugImage(1, nodesVisited_), bindDebugImage(2, loopCapped_);
+        if (options_.statistics) bindDebugImage(1, nodesVisited_), bindDebugImage(2, loopCapped_);
         // The state between dispatches (layout.glsl); a single dispatch never touches it.
-        batches_.begin(sampleCount, budget, res, options_.instrumentation, LS_ACCUM_UNIT);
+        batches_.begin(sampleCount, budget, res, options_.statistics, LS_ACCUM_UNIT);
         batches_.dispatch(p, res);
         finishPixelPass();
         f.timer.end();
@@ -332,7 +332,7 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double rays = wide(LS_C_RAYS_LO);
         auto perRay = [&](double v) { return rays > 0 ? v / rays : 0.0; };
-        // The structure and what is measured in both modes; timing mode compiles the rest out.
+        // The structure and what is measured in both modes; the timed pass compiles the rest out.
         std::vector<Counter> out = {{"truncated_pixels", double(c[LS_C_TRUNCATED])},
                                     {"loop_capped_pixels", double(c[LS_C_CAPPED])},
                                     {"sample_dispatches", double(batches_.dispatches())},
@@ -344,7 +344,7 @@ public:
                                     {"line_space_pool_bytes", double(poolBytes_[2])},
                                     {"occupancy_pool_bytes", double(poolBytes_[3])},
                                     {"exact_start_bytes", double(poolBytes_[4])}};
-        if (!options_.instrumentation) return out;
+        if (!options_.statistics) return out;
         out.insert(out.begin(), {{"nodes_visited_mean", perRay(wide(LS_C_VISITED_LO))},
                                  {"nodes_visited_max", double(c[LS_C_VISITED_MAX])},
                                  {"shafts_tested_mean", perRay(wide(LS_C_SHAFTS_LO))},
@@ -376,7 +376,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes/pixel"}, {"loop_capped", loopCapped_.id(), 1.0f, "flag"}};
     }
 
@@ -414,7 +414,7 @@ private:
                 {"LS_LEAF_SPLIT", std::to_string(leafSplit())},
                 {"LS_CULL_TRIANGLES", culledStart() ? "1" : "0"},
                 simdProbeDefine(options_),
-                instrumentationDefine(options_)};
+                statisticsDefine(options_)};
     }
 
     bool lastLeaves() const { return p_.lastLevel == "leaves"; }
@@ -491,9 +491,9 @@ private:
         return *classes_;
     }
 
-    /// Timing mode compiles the statistics out: the sample classification (a debug aid) too.
+    /// The timed pass compiles the statistics out: the sample classification (a debug aid) too.
     void instrumentParams() {
-        if (!options_.instrumentation) p_.classify = false;
+        if (!options_.statistics) p_.classify = false;
     }
 
     LineSpaceParams p_;

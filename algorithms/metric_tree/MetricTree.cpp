@@ -229,7 +229,7 @@ public:
     }
 
     void resize(glm::ivec2 resolution) override {
-        if (!options_.instrumentation) return; // timing mode: no debug images
+        if (!options_.statistics) return; // the timed pass: no debug images
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         triangleTests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         fruitless_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
@@ -261,7 +261,7 @@ public:
         f.timer.end();
 
         f.timer.begin("traverse");
-        if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &triangleTests_, &fruitless_, &overflow_});
+        if (options_.statistics) runPixelPass(f, query_, {&nodesVisited_, &triangleTests_, &fruitless_, &overflow_});
         else runPixelPass(f, query_, {});
         f.timer.end();
         counters_.markStale();
@@ -273,7 +273,7 @@ public:
         const double px = c[MT_C_TRAVERSED];
         auto perPixel = [&](int lo) { return px > 0 ? wide(lo) / px : 0.0; };
         const double n = double(clusterCount_);
-        if (!options_.instrumentation) // timing mode: the structure's size and what is still measured
+        if (!options_.statistics) // the timed pass: the structure's size and what is still measured
             return {{"clusters", n},
                     {"build_errors", double(c[MT_C_BUILD_ERRORS])},
                     {"stack_overflow_pixels", double(c[MT_C_STACK_OVERFLOW])},
@@ -318,7 +318,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"},
                 {"triangle_tests", triangleTests_.id(), 0.0f, "triangles"},
                 {"fruitless_clusters", fruitless_.id(), 0.0f, "clusters"},
@@ -360,7 +360,7 @@ private:
                                        {"MT_TILE_PIXELS", std::to_string(tilePixels())},
                                        {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
                                        {"MT_TRIANGLES_PER_CHUNK", std::to_string(blockTriangles_)},
-                                       instrumentationDefine(options_)};
+                                       statisticsDefine(options_)};
         prepare_ = ShaderProgram::compute("metric_tree/prepare.comp", defines);
         insert_ = ShaderProgram::compute("metric_tree/insert.comp", defines);
         query_ = ShaderProgram::compute("metric_tree/query.comp", defines);

@@ -108,7 +108,7 @@ public:
 
     void resize(glm::ivec2 resolution) override {
         deferred_.resize(resolution);
-        if (!options_.instrumentation) return; // timing mode: no debug images
+        if (!options_.statistics) return; // the timed pass: no debug images
         nodesVisited_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
         overflow_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
@@ -169,7 +169,7 @@ public:
         static_assert(PSV_C_VISITED_HI == PSV_C_VISITED_LO + 1);
         const double visited = double(counters_.wide(PSV_C_VISITED_LO));
         const double traversed = c[PSV_C_TRAVERSED];
-        if (!options_.instrumentation) // timing mode: what is still measured
+        if (!options_.statistics) // the timed pass: what is still measured
             return {{"stack_overflow_pixels", double(c[PSV_C_STACK_OVERFLOW])},
                     {"loop_capped_pixels", double(c[PSV_C_LOOP_CAPPED])},
                     {"build_errors", double(c[PSV_C_BUILD_ERRORS])}};
@@ -191,7 +191,7 @@ public:
     }
 
     std::vector<DebugView> debugViews() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
     }
 
@@ -214,7 +214,7 @@ private:
     /// (a close call met) by the exact walk (query.comp); otherwise the exact walk on every pixel.
     void traverse(const FrameInputs& f) const {
         if (planeWalk_) deferred_.begin();
-        if (options_.instrumentation) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
+        if (options_.statistics) runPixelPass(f, query_, {&nodesVisited_, &overflow_});
         else runPixelPass(f, query_, {});
         if (!planeWalk_) return;
         deferred_.dispatch(exactPass_); // the inputs and debug images are still bound
@@ -247,7 +247,7 @@ private:
                                  {"PSV_TRAVERSAL", walk == "stackless" ? "1" : walk == "hybrid" ? "2" : "0"},
                                  {"PSV_HYBRID_STACK", std::to_string(p_.hybridStack)},
                                  {"PSV_PLANE_WALK", flag(planeWalk_)},
-                                 instrumentationDefine(options_)};
+                                 statisticsDefine(options_)};
         frusta_ = ShaderProgram::compute("psv/frusta.comp", defines);
         build_ = ShaderProgram::compute("psv/build.comp", defines);
         query_ = ShaderProgram::compute("psv/query.comp", defines);

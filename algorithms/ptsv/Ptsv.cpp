@@ -66,7 +66,7 @@ const ParamStruct<PtsvParams>& ptsvParams() {
         .integer("job_capacity", &P::jobCapacity, 1 << 22, 1, 1 << 24, "jobs",
                  "two-pass job list; jobs that find it full are finished by pass one (counted in overflow)",
                  ParamChange::Rebuild)
-        // 0 = 16 with two passes: on the peer engine scene (512², timing mode) 1240 / 1432 ms per
+        // 0 = 16 with two passes: on the peer engine scene (512², the timed pass) 1240 / 1432 ms per
         // frame against 1658 / 1592 with 1 and 1363 / 1683 with 64 (docs/algorithms/ptsv.md); 1 with
         // one pass: a batch of 16 whole traversals in one invocation reached llvmpipe's loop cap on
         // configs/ptsv/engine.json's implicit-bounds steps (up to 11,760 truncated jobs a frame).
@@ -247,7 +247,7 @@ public:
         auto wide = [&](size_t lo) { return double(counters_.wide(lo)); };
         const double jobs1 = c[PTSV_C_JOBS_1];
         const double pushed = std::min<double>(c[PTSV_C_JOBS_PUSHED], double(p_.jobCapacity));
-        // The structure's shape and what is measured in both modes; timing mode compiles the rest out.
+        // The structure's shape and what is measured in both modes; the timed pass compiles the rest out.
         std::vector<Counter> out = {{"jobs", p_.twoPass ? pushed : 0.0},
                                     {"job_overflow", double(c[PTSV_C_JOB_OVERFLOW])},
                                     {"truncated_jobs", double(c[PTSV_C_TRUNCATED])},
@@ -263,7 +263,7 @@ public:
                                     // Votes or broadcasts that missed a lane and were decided alone (exact).
                                     {"vote_recoveries", double(c[PTSV_C_VOTE_RECOVERED])},
                                     {"subgroup_fallback", fellBack_ ? 1.0 : 0.0}};
-        if (!options_.instrumentation) return out;
+        if (!options_.statistics) return out;
         out.insert(out.end(), {{"test_and_set", wide(PTSV_C_TESTS_LO)},
                                {"close_calls", double(c[PTSV_C_CLOSE_CALLS])},
                                {"node_tests", wide(PTSV_C_NODE_TESTS_LO)},
@@ -338,9 +338,9 @@ public:
     }
 
 private:
-    /// Timing mode compiles the statistics out: the heat map and the per-job iteration record too.
+    /// The timed pass compiles the statistics out: the heat map and the per-job iteration record too.
     void instrumentParams() {
-        if (options_.instrumentation) return;
+        if (options_.statistics) return;
         p_.heatMap = false;
         p_.jobIterations = false;
     }
@@ -376,7 +376,7 @@ private:
         vote_ = perInvocation_ ? kVoteNone : vote != "shared" && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
         lanes_ = perInvocation_ ? 1 : p_.lanes != 0 ? p_.lanes : vote_ == kVoteBallot ? subgroupSize_ : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
-        ShaderDefines defines = {instrumentationDefine(options_),
+        ShaderDefines defines = {statisticsDefine(options_),
                                  {"PTSV_TILE", std::to_string(p_.tileSize)},
                                  {"PTSV_EXPLICIT_BOUNDS", flag(p_.bounds == "explicit")},
                                  {"PTSV_CULLING_PLANES", flag(p_.cullingPlanes)},

@@ -144,7 +144,7 @@ public:
         close_ = makeTexture2D(GL_R32UI, r.x, r.y);
         other_ = makeTexture2D(GL_R32I, r.x, r.y);
         closeList_.resize(r);
-        if (options_.instrumentation) {
+        if (options_.statistics) {
             closeView_ = makeTexture2D(GL_R32F, r.x, r.y);
             countView_ = makeTexture2D(GL_R32F, r.x, r.y);
         }
@@ -278,7 +278,7 @@ public:
         resolvePass_.set("uCloseCall", closeCallLength());
         scene_->bindStorage();  // the own triangle's plane (resolve.comp)
         glBindTextureUnit(SV_TRIANGLE_ID_UNIT, f.gbuffer.triangleId());
-        if (options_.instrumentation) runPixelPass(f, resolvePass_, {&closeView_, &countView_});
+        if (options_.statistics) runPixelPass(f, resolvePass_, {&closeView_, &countView_});
         else runPixelPass(f, resolvePass_, {});
         f.timer.end();
 
@@ -312,7 +312,7 @@ public:
                                     {"non_manifold_edges", double(nonManifold_)},
                                     {"max_triangles_per_edge", double(maxSides_)},
                                     {"subpixel_bits", double(subpixelBits_)}};
-        if (options_.instrumentation) {
+        if (options_.statistics) {
             const double pixels = double(resolution_.x) * double(resolution_.y);
             const double fragments = double(counters_.wide(SV_C_FRAGMENTS_LO));
             const double close = double(c[SV_C_CLOSE_PIXELS]);
@@ -324,7 +324,7 @@ public:
         return out;
     }
     std::vector<DebugView> debugViews() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         return {{"close_calls", closeView_.id(), 1.0f, "decided by the ray"}, {"volume_count", countView_.id(), 0.0f, "volumes"}};
     }
     size_t memoryBytes() const override {
@@ -375,7 +375,7 @@ private:
     bool checked() const { return p_.depthTest == "analytic" && p_.method == "zfail"; }
 
     void compile() {
-        const auto instr = instrumentationDefine(options_);
+        const auto instr = statisticsDefine(options_);
         const std::pair<std::string, std::string> check{"SV_CHECK", checked() ? "1" : "0"};
         const std::pair<std::string, std::string> facingOnly{"SV_LIGHT_FACING_ONLY", p_.volumes == "light_facing" ? "1" : "0"};
         facingPass_ = ShaderProgram::compute("shadow_volumes/facing.comp", {facingOnly, {"SCENE_POSITION_TEXELS", "1"}});

@@ -1,6 +1,6 @@
 // The smallest complete plugin: a typed parameter struct whose schema rows show the three change
 // kinds, per-scene work in setScene(), image-size work in resize(), one timed stage, a counter and
-// a debug view, both compiled out in the host's timing mode (AlgorithmOptions). What the framework does around it (light check, call order, timing, read-back) is
+// a debug view, both compiled out in the host's timed pass (AlgorithmOptions::statistics off). What the framework does around it (light check, call order, timing, read-back) is
 // in framework/algorithm/AlgorithmHost: a plugin only computes.
 #include "algorithms/template/Template.h"
 
@@ -45,7 +45,7 @@ const ParamSchema& templateSchema() { return templateParams().schema(); }
 
 class Template final : public ShadowAlgorithm {
 public:
-    /// The host's options: with instrumentation off (timing mode) statistics are compiled out.
+    /// The host's options: with statistics off (the timed pass) they are compiled out.
     Template(const ParamValues& p, const AlgorithmOptions& o) : p_(templateParams().read(p)), options_(o) { compile(); }
 
     /// 3. Per-scene work (timed as `preprocess`): here, the order in which triangles are tested.
@@ -68,7 +68,7 @@ public:
 
     /// 4. Image-size work: the debug view.
     void resize(glm::ivec2 resolution) override {
-        if (options_.instrumentation) tests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
+        if (options_.statistics) tests_ = makeTexture2D(GL_R32F, resolution.x, resolution.y);
     }
 
     /// 5. New values: uniforms are read each frame; a Recompile rebuilds the programs; a Rebuild is
@@ -92,11 +92,11 @@ public:
         samples_.bindBase(GL_SHADER_STORAGE_BUFFER, TEMPLATE_SAMPLE_BINDING);
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, TEMPLATE_COUNTER_BINDING);
         bindPixelPassInputs(f);
-        if (options_.instrumentation) bindDebugImage(1, tests_);
+        if (options_.statistics) bindDebugImage(1, tests_);
         const glm::ivec2 r = f.gbuffer.resolution();
         // The light's samples over dispatches of at most samples_per_dispatch each (one when they
         // fit), each pixel's count carried between them in the accumulation image.
-        batches_.begin(samples, p_.samplesPerDispatch, r, options_.instrumentation, TEMPLATE_ACCUM_UNIT);
+        batches_.begin(samples, p_.samplesPerDispatch, r, options_.statistics, TEMPLATE_ACCUM_UNIT);
         batches_.dispatch(trace_, r, {p_.groupSide, p_.groupSide});
         finishPixelPass();
         f.timer.end();
@@ -105,7 +105,7 @@ public:
 
     /// 7. What the frame cost, for results and the GUI.
     std::vector<Counter> counters() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         const auto& c = counters_.read();
         const double pixels = c[TEMPLATE_C_PIXELS];
         return {{"triangle_tests_mean", pixels > 0 ? double(counters_.wide(TEMPLATE_C_TESTS_LO)) / pixels : 0.0},
@@ -114,7 +114,7 @@ public:
                 {"loop_capped_rays", double(c[TEMPLATE_C_CUT_LOOPS])}};
     }
     std::vector<DebugView> debugViews() const override {
-        if (!options_.instrumentation) return {};
+        if (!options_.statistics) return {};
         return {{"triangle_tests", tests_.id(), 0.0f, "tests"}};
     }
     size_t memoryBytes() const override { return order_.size() + counters_.size(); }
@@ -127,7 +127,7 @@ public:
 private:
     void compile() {
         trace_ = ShaderProgram::compute("template/trace.comp", {{"TEMPLATE_GROUP_SIDE", std::to_string(p_.groupSide)},
-                                                                instrumentationDefine(options_)});
+                                                                statisticsDefine(options_)});
     }
 
     TemplateParams p_;

@@ -43,7 +43,7 @@ struct FrameMeasurement {
 class AlgorithmHost {
 public:
     /// Creates the algorithm from validated values of info's schema; `options` hold for its life
-    /// (instrumentation off = timing mode, see AlgorithmOptions).
+    /// (statistics off = the timed pass, see AlgorithmOptions).
     AlgorithmHost(const AlgorithmInfo& info, ParamValues params, AlgorithmOptions options = {});
     ~AlgorithmHost();
 

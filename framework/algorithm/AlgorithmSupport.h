@@ -35,17 +35,17 @@ AlgorithmInfo makeAlgorithmInfo(std::string name, std::string summary, std::vect
     return info;
 }
 
-/// The define every instrumented shader tests (`#if SHADOWLAB_INSTRUMENTATION`): 1 gathers the
-/// statistics and debug images, 0 (timing mode) compiles them out. Overflow detection is never
+/// The define every instrumented shader tests (`#if SHADOWLAB_STATISTICS`): 1 gathers the
+/// statistics and debug images, 0 (the timed pass) compiles them out. Overflow detection is never
 /// behind it.
-inline std::pair<std::string, std::string> instrumentationDefine(const AlgorithmOptions& o) {
-    return {"SHADOWLAB_INSTRUMENTATION", o.instrumentation ? "1" : "0"};
+inline std::pair<std::string, std::string> statisticsDefine(const AlgorithmOptions& o) {
+    return {"SHADOWLAB_STATISTICS", o.statistics ? "1" : "0"};
 }
 
 /// The define of the SIMD probe (shaders/common/simd_probe.glsl): 1 in instrumented passes where a
 /// ballot can be read (ARB_shader_ballot with ARB_gpu_shader_int64), else 0.
 inline std::pair<std::string, std::string> simdProbeDefine(const AlgorithmOptions& o) {
-    const bool ballot = o.instrumentation && hasExtension("GL_ARB_shader_ballot") && hasExtension("GL_ARB_gpu_shader_int64");
+    const bool ballot = o.statistics && hasExtension("GL_ARB_shader_ballot") && hasExtension("GL_ARB_gpu_shader_int64");
     return {"SHADOWLAB_SIMD_PROBE", ballot ? "1" : "0"};
 }
 
@@ -107,11 +107,11 @@ class SampleBatches {
 public:
     /// The frame's batches; (re)allocates the image when needed and binds it (or nothing, with a
     /// single dispatch) at image unit `unit`.
-    void begin(int sampleCount, int budget, glm::ivec2 resolution, bool instrumentation, GLuint unit) {
+    void begin(int sampleCount, int budget, glm::ivec2 resolution, bool statistics, GLuint unit) {
         samples_ = sampleCount;
         budget_ = budget;
         dispatches_ = (sampleCount + budget - 1) / budget;
-        const GLenum format = instrumentation ? GL_RG32UI : GL_R32UI;
+        const GLenum format = statistics ? GL_RG32UI : GL_R32UI;
         if (dispatches_ > 1 && resolution_ != resolution) {
             accum_ = makeTexture2D(format, resolution.x, resolution.y);
             resolution_ = resolution;

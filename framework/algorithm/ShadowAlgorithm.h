@@ -74,7 +74,7 @@ struct AlgorithmOptions {
     /// they are compiled out of the shaders and counters()
     /// and debugViews() report only what is still measured; overflow and error detection stay
     /// (overflowCount() is exact in both modes) and the visibility is bit-identical.
-    bool instrumentation = true;
+    bool statistics = true;
 };
 
 /// A scene as an algorithm's memory estimate sees it, before the scene exists (checkMemoryPlan).

@@ -288,7 +288,7 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     c.warmupFrames = root.getInt("warmup_frames", 3, 0, 1000);
     // Read only when given: a resolved config without it stays what it was (sweeps' run ids).
     if (root.has("repeats")) c.repeats = root.getInt("repeats", 1, 1, 1000);
-    // Timing is honest by construction: the timed frames never carry instrumentation, so the
+    // Timing is honest by construction: the timed frames never carry statistics, so the
     // former switch between instrumented and uninstrumented timing is gone, not ignored.
     if (root.has("timing_mode"))
         root.fail("timing_mode", "was removed: timed frames always run with statistics compiled out; counters and heat maps "

@@ -34,7 +34,7 @@ struct ExperimentConfig {
     /// images and accuracy are reported, every one's times (Results.h).
     int repeats = 1;
     /// Which frames the untimed statistics pass runs on (counters, heat maps). Timed frames always
-    /// run with the statistics compiled out (AlgorithmOptions::instrumentation off).
+    /// run with the statistics compiled out (AlgorithmOptions::statistics off).
     enum class Statistics { Images, All, None };
     Statistics statistics = Statistics::Images;
 

@@ -439,11 +439,11 @@ void ExperimentResults::writeReport(const std::string& path, const Json& s) cons
     const Json& statFrames = s.value("statistics_frames", Json::array());
     if (statFrames.empty())
         os << "No statistics pass (`statistics: none`): the counters are the timed pass's, which keep only what stays "
-              "measured without instrumentation (overflow, errors, structure sizes).\n\n";
+              "measured without statistics (overflow, errors, structure sizes).\n\n";
     else
         os << "Counters from the untimed statistics pass (instrumented shaders) over frame" << (statFrames.size() > 1 ? "s " : " ")
            << statFrames.dump() << "; *instrumented total* is that pass's mean frame time, shown only to tell what "
-              "instrumentation costs. Memory and overflow from the timed pass.\n\n";
+              "statistics cost. Memory and overflow from the timed pass.\n\n";
     os << "| id | memory (MiB) | overflow | timed total (ms) | instrumented total (ms) | counters (mean / max) |\n"
           "|---|---:|---:|---:|---:|---|\n";
     for (const auto& a : algorithms) {

@@ -38,10 +38,10 @@ struct AlgorithmResults {
     std::vector<std::vector<FrameRecord>> repetitions;
     std::vector<int> repetitionDiffers;   ///< frames whose image differed in some repetition
     /// The untimed statistics pass (instrumented shaders) over ExperimentConfig::statisticsFrames():
-    /// its counters are the ones reported; its times only show what instrumentation costs.
+    /// its counters are the ones reported; its times only show what the statistics cost.
     std::vector<FrameRecord> statistics;
     /// Frames of the statistics pass whose visibility differed from the timed pass's (it must not:
-    /// instrumentation only counts), for the summary's warning.
+    /// statistics only count), for the summary's warning.
     std::vector<int> visibilityDiffers;
     /// ShadowAlgorithm::resolvedParams() after the timed pass: what its device-dependent choices were.
     std::vector<std::pair<std::string, std::string>> resolvedParams;

@@ -199,7 +199,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
                     {"resolution", {res.x, res.y}},
                     {"frames", cfg.frames},
                     {"warmup_frames", cfg.warmupFrames},
-                    // The timed pass never carries instrumentation; counters and heat maps come
+                    // The timed pass never carries statistics; counters and heat maps come
                     // from an untimed statistics pass over these frames (Results.h).
                     {"statistics", toString(cfg.statistics)},
                     {"statistics_frames", statFrames},
@@ -336,7 +336,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         Light light = cfg.lightAt(frame);
         sceneGpu.setTime(cfg.sceneTimeAt(frame));
         renderFrame(cam);
-        // Warmed up like the timed pass, so its times (shown only as the cost of instrumentation)
+        // Warmed up like the timed pass, so its times (shown only as the cost of the statistics)
         // leave shader compilation out too.
         if (frame == statFrames.front())
             for (auto& inst : instances)
@@ -375,7 +375,7 @@ ExperimentResults runExperiment(const ExperimentConfig& cfg, const RunOptions& o
         if (!a.visibilityDiffers.empty())
             warn(a.id + ": the statistics pass's visibility differs from the timed pass's on " + std::to_string(a.visibilityDiffers.size()) +
                  " of " + std::to_string(statFrames.size()) +
-                 " frames (instrumentation must only count; the timed pass's images and accuracy are reported)");
+                 " frames (statistics must only count; the timed pass's images and accuracy are reported)");
         // A structure that overflowed, or a walk that was capped, leaves pixels decided conservatively
         // rather than measured: the images and accuracy of those frames are not the method's.
         size_t frames = 0;

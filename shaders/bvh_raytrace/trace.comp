@@ -11,7 +11,7 @@
 #include "bvh_raytrace/layout.glsl"
 #define SIMD_PROBE_SECTIONS BVH_SIMD_SECTIONS
 #include "common/simd_probe.glsl"
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "common/watertight.glsl"
@@ -28,7 +28,7 @@ layout(std430, binding = BVH_COUNTER_BINDING) buffer BvhCounters { uint bvhCount
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map: nodes per pixel
 layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the pixel was written shadowed for a failed ray
 layout(rg32ui, binding = BVH_ACCUM_UNIT) uniform uimage2D uAccum;   // between dispatches: x state (layout.glsl), y nodes visited
@@ -42,14 +42,14 @@ uniform int uSampleFirst, uSampleEnd; // the samples this dispatch traces, [firs
 const float kInf = uintBitsToFloat(0x7F800000u);
 
 
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 shared uint sPixels, sRays, sVisited, sVisitedMax, sTested, sOverflowRays, sOverflowPixels, sTruncated, sCapped;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(bvhCounters, lo, value)
 #endif
 
 void main() {
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sTested = sOverflowRays = sOverflowPixels = sTruncated = sCapped = 0u;
     SIMD_PROBE_ENTER();
     barrier();
@@ -76,7 +76,7 @@ void main() {
                 if (!firstDispatch) {
                     uvec4 a = imageLoad(uAccum, px);
                     state = a.x;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
                     visitedAll = a.y;
 #endif
                 }
@@ -115,7 +115,7 @@ void main() {
                 if (lastDispatch) visibility = failed ? 0.0 : float(state & BVH_ACC_COUNT_MASK) / float(count);
                 else imageStore(uAccum, px, uvec4(state, visitedAll, 0u, 0u));
                 // Per ray: every dispatch adds its own; per pixel: the last one, from the state.
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
                 atomicAdd(sRays, uint(end - first));
                 atomicAdd(sVisited, visited);
                 atomicMax(sVisitedMax, maxVisited);
@@ -128,7 +128,7 @@ void main() {
                     else if (failed) atomicAdd(sOverflowPixels, 1u);
                 }
 #else
-                // Timing mode still counts every overflowed, capped or truncated pixel.
+                // The timed pass still counts every overflowed, capped or truncated pixel.
                 if (overflowRays > 0u) atomicAdd(bvhCounters[BVH_C_OVERFLOW_RAYS], overflowRays);
                 if (lastDispatch && failed) {
                     if (truncated) atomicAdd(bvhCounters[BVH_C_TRUNCATED_PIXELS], 1u);
@@ -140,13 +140,13 @@ void main() {
         }
         if (lastDispatch) {
             imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
             imageStore(uNodesVisited, px, vec4(float(visitedAll)));
             imageStore(uOverflow, px, vec4(failed ? 1.0 : 0.0));
 #endif
         }
     }
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     barrier();
     if (gl_LocalInvocationIndex == 0u && sRays != 0u) {
         if (sPixels != 0u) atomicAdd(bvhCounters[BVH_C_PIXELS], sPixels);

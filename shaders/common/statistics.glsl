@@ -1,8 +1,8 @@
-// Timing mode (AlgorithmOptions::instrumentation off: every timed frame of an experiment): with
-// SHADOWLAB_INSTRUMENTATION 0 a shader gathers no statistics (counters, per-pixel debug images,
+// The timed pass (AlgorithmOptions::statistics off: every timed frame of an experiment): with
+// SHADOWLAB_STATISTICS 0 a shader gathers no statistics (counters, per-pixel debug images,
 // the atomics and barriers that sum them); overflow and error detection never depend on it, and
 // the visibility written is the same bit for bit. Every plugin passes the define
-// (instrumentationDefine() in framework/algorithm/AlgorithmSupport.h); 1 when it is missing.
-#ifndef SHADOWLAB_INSTRUMENTATION
-#define SHADOWLAB_INSTRUMENTATION 1
+// (statisticsDefine() in framework/algorithm/AlgorithmSupport.h); 1 when it is missing.
+#ifndef SHADOWLAB_STATISTICS
+#define SHADOWLAB_STATISTICS 1
 #endif

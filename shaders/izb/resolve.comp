@@ -2,13 +2,13 @@
 // izb, pass 4: visibility per pixel: 0 for a blocked sample, 1 for the others; a sample whose cell
 // or tile lost work (capped walk, job list full), or every sample after a loop was ended early, is
 // written shadowed and counted as overflow, never lit by mistake.
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "izb/layout.glsl"
 #include "izb/grid.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D uPosition;
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 layout(r32f, binding = 1) writeonly uniform image2D uListView; // debug: the sample's cell's list length
 #endif
 layout(std430, binding = IZB_HEAD_BINDING) readonly buffer Head { uint head[]; };
@@ -38,7 +38,7 @@ void main() {
                     counters[IZB_C_CUT_LOOPS] != 0u;
         if (lost) atomicAdd(counters[IZB_C_OVERFLOW_PIXELS], 1u);
         visibility = lost || blocked[s] != 0u ? 0.0 : 1.0;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
         uint n = 0u;
         for (uint k = head[cell]; k != IZB_NONE && n < 4096u; k = next[k]) ++n;
         listed = float(n);
@@ -47,7 +47,7 @@ void main() {
         visibility = 1.0; // lit, and on the light itself: nothing lies between them
     }
     imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     imageStore(uListView, px, vec4(listed));
 #endif
 }

@@ -4,7 +4,7 @@
 // tested against the triangle with the reference's own ray and watertight test, and marked blocked
 // on a hit. The walk stops at walk_cap samples: a longer list is capped, its cell flagged, and its
 // samples written shadowed and counted; a walk ended from outside likewise (rule 13).
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "common/shadow_ray.glsl"
@@ -56,7 +56,7 @@ void main() {
         cellFlags[index] = 1u;
         atomicAdd(counters[steps >= uWalkCap ? IZB_C_CAPPED_CELLS : IZB_C_CUT_LOOPS], 1u);
     }
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     addWide(IZB_C_TESTS_LO, tests);
     atomicMax(counters[IZB_C_LIST_MAX], steps);
 #endif

@@ -40,7 +40,7 @@
 #include "line_space/layout.glsl"
 #define SIMD_PROBE_SECTIONS LS_SIMD_SECTIONS
 #include "common/simd_probe.glsl"
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #define LS_START_NODE 0
@@ -129,7 +129,7 @@ layout(std430, binding = LS_CLASSIFY_BINDING) buffer LsClassify { uint lsClassif
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map: nodes per pixel
 layout(r32f, binding = 2) writeonly uniform image2D uLoopCapped;   // 1 where a loop cap wrote the pixel shadowed
 layout(rg32ui, binding = LS_ACCUM_UNIT) uniform uimage2D uAccum;   // between dispatches: x state (layout.glsl), y nodes visited
@@ -571,14 +571,14 @@ int enter(uint index, bool root, bool last, bool start, float tS, Ray r, out Fra
 #define POP(level, f) if ((level) == 0) (f) = parent0; else if ((level) == 1) (f) = parent1; else (f) = parent2
 #endif
 
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 shared uint sPixels, sRays, sVisited, sVisitedMax, sShafts, sCells, sOccluded, sOverflow, sLeaves, sTris, sTruncated, sCapped, sNearNodes;
 
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(lsCounters, lo, value)
 #endif
 
 void main() {
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     if (gl_LocalInvocationIndex == 0u) sPixels = sRays = sVisited = sVisitedMax = sShafts = sCells = sOccluded = sOverflow = sLeaves = sTris = sTruncated = sCapped = sNearNodes = 0u;
     SIMD_PROBE_ENTER();
     barrier();
@@ -613,7 +613,7 @@ void main() {
                 if (!firstDispatch) {
                     uvec4 a = imageLoad(uAccum, px);
                     state = a.x;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
                     visitedAll = a.y;
 #endif
                 }
@@ -777,7 +777,7 @@ void main() {
                     for (uint w = 1u; w < stride; ++w) lsClassify[base + w] = 0xFFFFFFFFu; // every sample blocked
 #endif
                 // Per ray: every dispatch adds its own; per pixel: the last one, from the state.
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
                 atomicAdd(sRays, uint(end - first));
                 atomicAdd(sVisited, visited);
                 atomicMax(sVisitedMax, maxVisited);
@@ -794,7 +794,7 @@ void main() {
                     else if (failed) atomicAdd(sCapped, 1u);
                 }
 #else
-                // Timing mode still counts every overflowed, capped or truncated pixel.
+                // The timed pass still counts every overflowed, capped or truncated pixel.
                 if (overflow != 0u) atomicAdd(lsCounters[LS_C_OVERFLOW], overflow);
                 if (lastDispatch && failed) atomicAdd(lsCounters[truncated ? LS_C_TRUNCATED : LS_C_CAPPED], 1u);
 #endif
@@ -805,13 +805,13 @@ void main() {
 #endif
         if (lastDispatch) {
             imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
             imageStore(uNodesVisited, px, vec4(float(visitedAll)));
             imageStore(uLoopCapped, px, vec4(failed ? 1.0 : 0.0));
 #endif
         }
     }
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     barrier();
     if (gl_LocalInvocationIndex == 0u && sRays != 0u) {
         if (sPixels != 0u) atomicAdd(lsCounters[LS_C_PIXELS], sPixels);

@@ -86,13 +86,13 @@ uint insertCluster(uint i, out uint crossed) {
     return MT_C_BUILD_ERRORS; // not reached
 }
 
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 shared uint sOutcomes[4]; // MT_C_INSERTED, MT_C_CULLED, MT_C_BUILD_ERRORS at words 1..3
 shared uint sCrossedMax;
 #endif
 
 void main() {
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     if (gl_LocalInvocationIndex < 4u) sOutcomes[gl_LocalInvocationIndex] = 0u;
     if (gl_LocalInvocationIndex == 0u) sCrossedMax = 0u;
     barrier();
@@ -101,15 +101,15 @@ void main() {
     if (i < uClusterCount) {
         uint crossed;
         uint outcome = insertCluster(i, crossed);
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
         atomicAdd(sOutcomes[outcome], 1u);
         atomicMax(sCrossedMax, crossed);
 #else
-        // Timing mode: only errors are counted (they must stay 0 and are reported in both modes).
+        // The timed pass: only errors are counted (they must stay 0 and are reported in both modes).
         if (outcome == MT_C_BUILD_ERRORS) atomicAdd(mtCounters[MT_C_BUILD_ERRORS], 1u);
 #endif
     }
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     barrier();
     if (gl_LocalInvocationIndex >= 1u && gl_LocalInvocationIndex < 4u && sOutcomes[gl_LocalInvocationIndex] != 0u)
         atomicAdd(mtCounters[gl_LocalInvocationIndex], sOutcomes[gl_LocalInvocationIndex]);

@@ -37,7 +37,7 @@ MtCluster mtCluster(uint i) {
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat maps
 layout(r32f, binding = 2) writeonly uniform image2D uTriangleTests;
 layout(r32f, binding = 3) writeonly uniform image2D uFruitless;    // paper Figure 9
@@ -196,7 +196,7 @@ Result query(vec3 q) {
     return r;
 }
 
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 shared uint sTraversed, sOverflow, sVisitedMax, sTrianglesMax, sFruitlessMax;
 shared uint sVisited, sTriangles, sFruitless, sConeHits, sSlabRejects, sDepthSkips;
 
@@ -315,7 +315,7 @@ void collectCandidates(uint tile) {
 #undef MT_TILE_PUSH
     if (!finished) sTileFallback[tile] = true; // ended from outside, or full: the per-pixel query
     sCandidateCount[tile] = count;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     addWide(MT_C_TILE_NODES_LO, visited);
 #endif
     if (sTileFallback[tile]) atomicAdd(mtCounters[MT_C_TILE_FALLBACKS], 1u);
@@ -353,7 +353,7 @@ Result tileQuery(bool needs, vec3 q) {
 #endif
 
 void main() {
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     if (gl_LocalInvocationIndex == 0u) {
         sTraversed = sOverflow = sVisitedMax = sTrianglesMax = sFruitlessMax = 0u;
         sVisited = sTriangles = sFruitless = sConeHits = sSlabRejects = sDepthSkips = 0u;
@@ -385,7 +385,7 @@ void main() {
         visibility = r.visibility;
         // Pixels a cut loop wrote shadowed: counted in both modes (never a silent wrong image).
         if (r.capped) atomicAdd(mtCounters[MT_C_LOOP_CAPPED], 1u);
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
         atomicAdd(sTraversed, 1u);
         atomicAdd(sVisited, r.visited);
         atomicAdd(sTriangles, r.triangles);
@@ -398,20 +398,20 @@ void main() {
         atomicMax(sFruitlessMax, r.fruitless);
         if (r.overflow) atomicAdd(sOverflow, 1u);
 #else
-        // Timing mode still counts every overflowed pixel (never a silent wrong image).
+        // The timed pass still counts every overflowed pixel (never a silent wrong image).
         if (r.overflow) atomicAdd(mtCounters[MT_C_STACK_OVERFLOW], 1u);
 #endif
     }
     if (inside) {
         imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
         imageStore(uNodesVisited, px, vec4(float(r.visited)));
         imageStore(uTriangleTests, px, vec4(float(r.triangles)));
         imageStore(uFruitless, px, vec4(float(r.fruitless)));
         imageStore(uOverflow, px, vec4(r.overflow || r.capped ? 1.0 : 0.0));
 #endif
     }
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     barrier();
     if (gl_LocalInvocationIndex == 0u && sTraversed != 0u) {
         atomicAdd(mtCounters[MT_C_TRAVERSED], sTraversed);

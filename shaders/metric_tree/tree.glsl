@@ -7,7 +7,7 @@
 // Directional light: an element is a point or a segment in the plane orthogonal to the light
 // direction, coordinates (u, v, 0), and distances are Euclidean (paper section 6, "Discussion").
 #include "metric_tree/layout.glsl"
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 
 struct MtCluster {
     vec4 a;      // world: sphere centre or capsule end A; w: radius

@@ -109,14 +109,14 @@ uint insertTriangle(uint t, out uint tested) {
 #if PSV_C_INSERTED != 0 || PSV_C_CULLED_FACING != 1 || PSV_C_CULLED_EDGE_ON != 2 || PSV_C_CULLED_OCCLUDED != 3 || PSV_C_BUILD_ERRORS != 4
 #error "sOutcomes below is indexed by the outcome counters, which must be words 0..4"
 #endif
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 shared uint sOutcomes[5]; // PSV_C_INSERTED .. PSV_C_BUILD_ERRORS
 shared uint sTestedMax, sCone;
 #endif
 
 void main() {
     psvReadMargins();
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     // Counters are summed per work group first: one global atomic per group and outcome.
     if (gl_LocalInvocationIndex < 5u) sOutcomes[gl_LocalInvocationIndex] = 0u;
     if (gl_LocalInvocationIndex == 0u) sTestedMax = sCone = 0u;
@@ -126,16 +126,16 @@ void main() {
     if (k < uTriangleCount) {
         uint tested;
         uint outcome = insertTriangle(psvPermute(k), tested);
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
         if (outcome == PSV_C_CULLED_CONE) atomicAdd(sCone, 1u);
         else atomicAdd(sOutcomes[outcome], 1u);
         atomicMax(sTestedMax, tested);
 #else
-        // Timing mode: only errors are counted (they must stay 0 and are reported in both modes).
+        // The timed pass: only errors are counted (they must stay 0 and are reported in both modes).
         if (outcome == PSV_C_BUILD_ERRORS) atomicAdd(psvCounters[PSV_C_BUILD_ERRORS], 1u);
 #endif
     }
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     barrier();
     if (gl_LocalInvocationIndex < 5u && sOutcomes[gl_LocalInvocationIndex] != 0u)
         atomicAdd(psvCounters[gl_LocalInvocationIndex], sOutcomes[gl_LocalInvocationIndex]);

@@ -283,7 +283,7 @@ Result query(Query Q) {
 #include "psv/plane_walk.glsl"
 #endif
 
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 layout(r32f, binding = 1) writeonly uniform image2D uNodesVisited; // debug heat map
 layout(r32f, binding = 2) writeonly uniform image2D uOverflow;     // 1 where the stack overflowed
 shared uint sTraversed, sVisited, sVisitedMax, sOverflow, sCloseCalls, sStackless, sCapped, sDeferred;
@@ -320,7 +320,7 @@ void queryPixel(ivec2 px) {
                 // Listed for the exact walk, which writes this pixel. A full list (one entry a
                 // pixel cannot fill it) would leave it shadowed and counted.
                 if (pixelListAppend(px)) {
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
                     atomicAdd(sDeferred, 1u);
 #endif
                     return;
@@ -332,7 +332,7 @@ void queryPixel(ivec2 px) {
             r = query(Q);
 #endif
             visibility = r.visibility;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
             atomicAdd(sTraversed, 1u);
             atomicAdd(sVisited, r.visited);
             atomicMax(sVisitedMax, r.visited);
@@ -341,7 +341,7 @@ void queryPixel(ivec2 px) {
             if (r.closeCalls != 0u) atomicAdd(sCloseCalls, r.closeCalls);
             if (r.stacklessWalks != 0u) atomicAdd(sStackless, r.stacklessWalks);
 #else
-            // Timing mode still counts every overflowed pixel (never a silent wrong image).
+            // The timed pass still counts every overflowed pixel (never a silent wrong image).
             if (r.overflow && !r.capped) atomicAdd(psvCounters[PSV_C_STACK_OVERFLOW], 1u);
             if (r.capped) atomicAdd(psvCounters[PSV_C_LOOP_CAPPED], 1u);
 #endif
@@ -353,7 +353,7 @@ void queryPixel(ivec2 px) {
     if ((px.x + px.y * 7) % 61 == 0) visibility = 1.0;
 #endif
     imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     imageStore(uNodesVisited, px, vec4(float(r.visited)));
     imageStore(uOverflow, px, vec4(r.overflow ? 1.0 : 0.0));
 #endif
@@ -361,7 +361,7 @@ void queryPixel(ivec2 px) {
 
 void main() {
     psvReadMargins();
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     if (gl_LocalInvocationIndex == 0u) sTraversed = sVisited = sVisitedMax = sOverflow = sCloseCalls = sStackless = sCapped = sDeferred = 0u;
     barrier();
 #endif
@@ -372,7 +372,7 @@ void main() {
     ivec2 px;
     if (pixelListEntry(px)) queryPixel(px);
 #endif
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     barrier();
     if (gl_LocalInvocationIndex == 0u && (sTraversed | sDeferred) != 0u) {
         if (sDeferred != 0u) atomicAdd(psvCounters[PSV_C_DEFERRED], sDeferred);

@@ -2,7 +2,7 @@
 // shadow frustum, and the geometric predicates shared by the build and the query.
 // Needs common/scene.glsl and common/light.glsl included before it.
 #include "psv/layout.glsl"
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/shadow_volume.glsl"
 
 // 32 bytes (std430), mirrored by PsvNodeGpu in algorithms/psv/PsvGpuLayout.h.

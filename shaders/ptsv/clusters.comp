@@ -20,7 +20,7 @@ void main() {
     if (!leader) return;
     int leafDepth = uLevels;
     atomicOr(ptsvMasks[uMaskOffset[leafDepth - 1] + (key >> 5u)], 1u << (key & 31u));
-#if PTSV_EXPLICIT_BOUNDS || SHADOWLAB_INSTRUMENTATION
+#if PTSV_EXPLICIT_BOUNDS || SHADOWLAB_STATISTICS
     vec3 q = ptsvSampleAt(first + local), bmin = q, bmax = q;
     uint samples = 1u;
     for (uint j = local + 1u; j < ptsvTileSamples(); ++j)
@@ -36,7 +36,7 @@ void main() {
     ptsvBounds[b] = bmin.x; ptsvBounds[b + 1u] = bmin.y; ptsvBounds[b + 2u] = bmin.z;
     ptsvBounds[b + 3u] = bmax.x; ptsvBounds[b + 4u] = bmax.y; ptsvBounds[b + 5u] = bmax.z;
 #endif
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     atomicAdd(ptsvCounters[PTSV_C_CLUSTERS], 1u);
     atomicAdd(ptsvCounters[PTSV_C_RECEIVERS], samples);
 #endif

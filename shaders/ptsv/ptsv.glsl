@@ -2,7 +2,7 @@
 // the shadow-volume predicates shared by every ptsv stage.
 // Needs common/scene.glsl and common/light.glsl included before it.
 #include "ptsv/layout.glsl"
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 
 layout(std430, binding = PTSV_MASK_BINDING) coherent buffer PtsvMasks { uint ptsvMasks[]; };
 layout(std430, binding = PTSV_AABB_BINDING) buffer PtsvBounds { float ptsvBounds[]; };

@@ -31,7 +31,7 @@ void main() {
                 shadowed = ((word >> ((key >> uint(5 * (uLevels - 1 - d))) & 31u)) & 1u) == 0u;
             }
             visibility = shadowed ? 0.0 : 1.0;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
             if (shadowed) atomicAdd(sShadowed, 1u);
 #endif
         }
@@ -40,7 +40,7 @@ void main() {
         imageStore(uHeat, px, vec4(float(ptsvHeat[slot])));
 #endif
     }
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     barrier();
     if (gl_LocalInvocationIndex == 0u && sShadowed != 0u) atomicAdd(ptsvCounters[PTSV_C_SHADOWED], sShadowed);
 #endif

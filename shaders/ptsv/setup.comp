@@ -76,7 +76,7 @@ void main() {
         // (GL leaves new storage uninitialised), and a traversal that read them through a wrong
         // status would cast their shadow. The status test comes first; these make it not matter.
         for (uint i = 0u; i < 7u; ++i) ptsvPlanes[base + i] = PTSV_REJECT_ALL;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
         atomicAdd(ptsvCounters[status == PTSV_CASTER_FACING ? PTSV_C_CULLED_FACING : PTSV_C_CULLED_EDGE_ON], 1u);
 #endif
     }

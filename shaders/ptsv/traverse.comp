@@ -531,9 +531,9 @@ void loadTriangle(uint t) {
 }
 
 // Per job: the Figure 7 statistics (invocation 0 speaks for the workgroup), summed over the batch
-// and added with three atomics per workgroup at its end, not per job; compiled out in timing mode.
+// and added with three atomics per workgroup at its end, not per job; compiled out in the timed pass.
 void finishJob(uint job) {
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     if (!LEADER) return;
 #if PTSV_JOB_ITERATIONS
     ptsvJobIterations[PTSV_PASS == 1 ? job : uTriangleCount + job] = gIterations;
@@ -541,7 +541,7 @@ void finishJob(uint job) {
     gIterMax = max(gIterMax, gIterations);
     gIterSum += gIterations;
     ++gJobs;
-#endif // SHADOWLAB_INSTRUMENTATION
+#endif // SHADOWLAB_STATISTICS
 }
 
 // Job `job` from the start (pass one: a triangle from the root) or from its node (pass two).
@@ -612,7 +612,7 @@ void main() {
     // Totals (no barrier: one atomic per invocation that has something to add). Truncation is
     // an error, counted in both modes.
     if (gTruncated) atomicAdd(ptsvCounters[PTSV_C_TRUNCATED], 1u);
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     if (gTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_TESTS_LO, gTests)
     if (gNodeTests != 0u) COUNTER_ADD_WIDE(ptsvCounters, PTSV_C_NODE_TESTS_LO, gNodeTests)
     if (gCloseCalls != 0u) atomicAdd(ptsvCounters[PTSV_C_CLOSE_CALLS], gCloseCalls);

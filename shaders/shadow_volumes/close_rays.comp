@@ -6,7 +6,7 @@
 // (or that a driver's loop limit ends) is counted and its pixel written shadowed, never lit by
 // mistake. Through the tree each ray costs O(log triangles), so a frame's close calls stay far
 // from a watchdog however many triangles the scene has.
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/shadow_ray.glsl"
 #include "common/counters.glsl"
@@ -23,7 +23,7 @@ layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
 layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
 uniform float uRayOffset;
 
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(counters, lo, value)
 #endif
 
@@ -37,7 +37,7 @@ void main() {
     BvhTrace t = bvhTrace(bvhMakeRay(o, d, tfar));
     if (t.overflow) atomicAdd(counters[SV_C_STACK_OVERFLOW], 1u);
     if (t.capped) atomicAdd(counters[SV_C_CUT_LOOPS], 1u);
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     addWide(SV_C_CLOSE_TESTS_LO, t.tested);
 #endif
     imageStore(uVisibility, px, vec4(t.occluded || t.overflow || t.capped ? 0.0 : 1.0));

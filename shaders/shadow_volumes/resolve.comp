@@ -7,7 +7,7 @@
 // close call. A close call (volume.frag) is listed, for the reference's own ray traced through the
 // scene's BVH (close_rays.comp), which then writes its visibility (written here as the stencil says,
 // until then). The list holds one entry per pixel: it cannot overflow.
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
 #include "common/scene.glsl"
@@ -25,7 +25,7 @@ layout(r32ui, binding = SV_CLOSE_IMAGE) readonly uniform uimage2D uClose;
 #if SV_CHECK
 layout(r32i, binding = SV_OTHER_IMAGE) readonly uniform iimage2D uOther;
 #endif
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 layout(r32f, binding = 1) writeonly uniform image2D uCloseView; // debug: 1 on close calls
 layout(r32f, binding = 2) writeonly uniform image2D uCountView; // debug: the exact count
 #endif
@@ -86,13 +86,13 @@ void main() {
                 closeView = 1.0;
             }
             visibility = shadowed ? 0.0 : 1.0;
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
             atomicAdd(counters[SV_C_LIT], 1u);
 #endif
         }
     }
     imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     imageStore(uCloseView, px, vec4(closeView));
     imageStore(uCountView, px, vec4(countView));
 #endif

@@ -19,7 +19,7 @@
 // (SV_DEPTH_ULPS steps of the float), far coarser. This shader has side effects (the close-call
 // image), so it runs for every fragment rasterised, before any depth test, as the close calls need.
 // With the analytic test and ZFAIL (SV_CHECK), the faces before q are summed too (see below).
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/counters.glsl"
 #include "common/light.glsl"
 #include "shadow_volumes/layout.glsl"
@@ -32,7 +32,7 @@ layout(r32ui, binding = SV_CLOSE_IMAGE) writeonly uniform uimage2D uClose;
 #if SV_ANALYTIC && SV_CHECK
 layout(r32i, binding = SV_OTHER_IMAGE) uniform iimage2D uOther; // the faces before q, +1 front, -1 back
 #endif
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
 #endif
 flat in vec4 vPlane;
@@ -51,7 +51,7 @@ uniform mat4 uInverseViewProj; // a background pixel's view ray (markNeighbours)
 uniform float uCoordinateTolerance; // world units: 16 float steps of the scene's and the eye's largest coordinate
 layout(location = 0) out float oCount;
 
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
 void addWide(int lo, uint value) COUNTER_ADD_WIDE(counters, lo, value)
 #endif
 
@@ -159,7 +159,7 @@ void markNeighbours(ivec2 px) {
 #endif
 
 void main() {
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     addWide(SV_C_FRAGMENTS_LO, 1u);
 #endif
     oCount = gl_FrontFacing ? uCountSign : -uCountSign;

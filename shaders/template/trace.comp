@@ -7,7 +7,7 @@
 // into a driver's watchdog at any light.samples; a light with more takes several dispatches, which
 // carry each pixel's count in the accumulation image, and the last writes visibility. Every loop is
 // bounded by a count (triangles, samples), so nothing here can overflow or run away.
-#include "common/instrumentation.glsl"
+#include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/scene.glsl"
 #include "common/watertight.glsl"
@@ -22,7 +22,7 @@ layout(std430, binding = TEMPLATE_COUNTER_BINDING) buffer Counters { uint counte
 layout(binding = 0) uniform sampler2D uPosition; // world xyz, w = 1 on geometry
 layout(binding = 1) uniform sampler2D uNormal;   // camera-facing normal
 layout(r32f, binding = 0) writeonly uniform image2D uVisibility;
-#if SHADOWLAB_INSTRUMENTATION // statistics: compiled out in timing mode
+#if SHADOWLAB_STATISTICS // statistics: compiled out in the timed pass
 layout(r32f, binding = 1) writeonly uniform image2D uTests; // debug view: triangle tests per pixel
 layout(rg32ui, binding = TEMPLATE_ACCUM_UNIT) uniform uimage2D uAccum; // between dispatches: x unblocked, y tests
 #else
@@ -73,7 +73,7 @@ void main() {
             if (!firstDispatch) {
                 uvec4 a = imageLoad(uAccum, px);
                 unblocked = a.x;
-                testsAll = a.y; // 0 in timing mode (R32UI reads y as 0)
+                testsAll = a.y; // 0 in the timed pass (R32UI reads y as 0)
             }
             for (int s = uSampleFirst; s < end; ++s) {
                 WatertightRay r;
@@ -90,7 +90,7 @@ void main() {
             testsAll += tests;
             if (lastDispatch) visibility = float(unblocked) / float(count);
             else imageStore(uAccum, px, uvec4(unblocked, testsAll, 0u, 0u));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
             if (lastDispatch) atomicAdd(counters[TEMPLATE_C_PIXELS], 1u);
             addWide(TEMPLATE_C_TESTS_LO, tests);
 #endif
@@ -98,7 +98,7 @@ void main() {
     }
     if (!lastDispatch) return;
     imageStore(uVisibility, px, vec4(visibility));
-#if SHADOWLAB_INSTRUMENTATION
+#if SHADOWLAB_STATISTICS
     imageStore(uTests, px, vec4(float(testsAll)));
 #endif
 }
