@@ -20,12 +20,14 @@ namespace {
 /// The grid's side for the parameter `grid` (0 = auto) at image size r: see the schema.
 int gridSide(int grid, glm::ivec2 r) { return grid > 0 ? grid : std::clamp((std::max(r.x, r.y) / 2 + 7) / 8 * 8, 64, 1024); }
 
+enum class IzbGridFit { Scene, Samples };
+
 struct IzbParams {
     int grid;        ///< cells per face side
     int jobCapacity; ///< jobs the list holds
     int walkCap;     ///< samples one cell's walk may test against one triangle
     bool cellTest;   ///< test each cell against the projected triangle, not only its box
-    std::string gridFit; ///< "samples" | "scene"
+    IzbGridFit gridFit;
     float rayOffset;
 };
 
@@ -53,7 +55,7 @@ const ParamStruct<IzbParams>& izbParams() {
         // 2.5× the occupied tiles, so 2.5× the jobs, for the same tests per sample (2.6 s against
         // 1.1 s a frame); they pay where the view crowds a small part of the light's field
         // (docs/algorithms/izb.md, "Where the grid lies").
-        .choice("grid_fit", &P::gridFit, "scene", {"scene", "samples"},
+        .choice("grid_fit", &P::gridFit, IzbGridFit::Scene, {{"scene", IzbGridFit::Scene}, {"samples", IzbGridFit::Samples}},
                 "where each face's grid lies: fitted every frame to the box of that face's samples (samples: the "
                 "paper's reprojection of crowded regions, one fitted grid per face) or over the whole face (scene)",
                 ParamChange::Recompile)
@@ -127,7 +129,7 @@ public:
         occupied_.clearUint(0);
         jobCount_.clearUint(0);
         bindPixelPassInputs(f);
-        if (p_.gridFit == "samples") {
+        if (p_.gridFit == IzbGridFit::Samples) {
             // Empty boxes: min words at the top of the order, max words at the bottom.
             uint32_t empty[24];
             for (int face = 0; face < 6; ++face)
@@ -228,7 +230,7 @@ private:
     void compile() {
         const auto instr = statisticsDefine(options_);
         const std::pair<std::string, std::string> texels{"SCENE_POSITION_TEXELS", "1"};
-        const std::pair<std::string, std::string> fit{"IZB_FIT_SAMPLES", p_.gridFit == "samples" ? "1" : "0"};
+        const std::pair<std::string, std::string> fit{"IZB_FIT_SAMPLES", p_.gridFit == IzbGridFit::Samples ? "1" : "0"};
         bounds_ = ShaderProgram::compute("izb/bounds.comp", {});
         insert_ = ShaderProgram::compute("izb/insert.comp", {fit});
         jobsPass_ = ShaderProgram::compute("izb/jobs.comp", {texels, fit});

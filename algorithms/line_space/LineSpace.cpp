@@ -23,13 +23,17 @@
 namespace shadowlab {
 namespace {
 
+enum class LineSpaceLastLevel { Leaves, Shaft };
+enum class LineSpaceStartTriangles { Culled, All };
+
 struct LineSpaceParams {
     int n, d;          ///< N-tree branching factor and depth
     bool cache, classify;
     int maxBlockMib;   ///< 0 = the context's storage block limit
     float rayOffset;   ///< × scene radius
-    std::string startRegion, lastLevel;  ///< "exact" | "distance" | "node"; "leaves" | "shaft"
-    std::string startTriangles;          ///< "culled" | "all": how the exact start region tests a leaf's triangles
+    ls::StartMode startRegion;
+    LineSpaceLastLevel lastLevel;
+    LineSpaceStartTriangles startTriangles; ///< how the exact start region tests a leaf's triangles
     int leafSplit;                       ///< sub-cells per axis of an occupied leaf (1: the leaf decides)
     float startCells, startMaxCells;     ///< leaf widths
     bool rebuildEveryFrame;              ///< allows moving scenes: the whole precomputation each frame
@@ -68,7 +72,9 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
         // surfaces shadow themselves (docs/algorithms/line_space.md, "Where the error comes from").
         // "bvh" by measurement (docs/algorithms/line_space.md, "Cost model"): as accurate as "exact"
         // at about half its trace time here.
-        .choice("start_region", &P::startRegion, "bvh", {"exact", "distance", "node", "bvh"},
+        .choice("start_region", &P::startRegion, ls::StartMode::Bvh,
+                {{"exact", ls::StartMode::Exact}, {"distance", ls::StartMode::Distance}, {"node", ls::StartMode::Node},
+                 {"bvh", ls::StartMode::Bvh}},
                 "where the line space is not used next to the receiver: the last-level nodes a ray enters before "
                 "rising start_cells leaf widths above the receiver's tangent plane, tested against their triangles "
                 "(exact: a hybrid that keeps the scene's triangles on the GPU) or with geometry before that height "
@@ -78,7 +84,8 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
                 ParamChange::Rebuild)
         // "shaft" is Algorithm 1's "deep enough": the shaft of a last-level node stands for its
         // leaves, so shadows grow by up to a shaft's width around every occluder.
-        .choice("last_level", &P::lastLevel, "leaves", {"leaves", "shaft"},
+        .choice("last_level", &P::lastLevel, LineSpaceLastLevel::Leaves,
+                {{"leaves", LineSpaceLastLevel::Leaves}, {"shaft", LineSpaceLastLevel::Shaft}},
                 "a non-empty shaft of a last-level node: leaves = the leaves the ray crosses there decide "
                 "(occupancy mask); shaft = the ray is blocked (the paper's)",
                 ParamChange::Rebuild)
@@ -94,7 +101,8 @@ const ParamStruct<LineSpaceParams>& lineSpaceParams() {
                  ParamChange::Rebuild)
         // "culled" by measurement (docs/algorithms/line_space.md, "Cost model"): the same decisions
         // for a fraction of the watertight tests; "all" is the leaf walk as it was, for the A/B.
-        .choice("start_triangles", &P::startTriangles, "culled", {"culled", "all"},
+        .choice("start_triangles", &P::startTriangles, LineSpaceStartTriangles::Culled,
+                {{"culled", LineSpaceStartTriangles::Culled}, {"all", LineSpaceStartTriangles::All}},
                 "start_region exact: how a start-region leaf's triangles are tested: culled = empty leaves skipped "
                 "in a loop of their own, then a plane test of the segment's part in the leaf against each "
                 "triangle's plane and the watertight test only for those it cannot rule out; all = every "
@@ -417,19 +425,15 @@ private:
                 statisticsDefine(options_)};
     }
 
-    bool lastLeaves() const { return p_.lastLevel == "leaves"; }
+    bool lastLeaves() const { return p_.lastLevel == LineSpaceLastLevel::Leaves; }
     /// The occupancy pool is read by every start region but the paper's, and by last_level leaves.
     bool readsOccupancy() const { return startMode() != ls::StartMode::Node || lastLeaves(); }
     /// Sub-cells per axis of an occupied leaf where occupancy is read at all (1 elsewhere).
     int leafSplit() const { return readsOccupancy() ? p_.leafSplit : 1; }
     /// The exact start region with its triangles culled by their planes.
-    bool culledStart() const { return startMode() == ls::StartMode::Exact && p_.startTriangles == "culled"; }
+    bool culledStart() const { return startMode() == ls::StartMode::Exact && p_.startTriangles == LineSpaceStartTriangles::Culled; }
 
-    ls::StartMode startMode() const {
-        const std::string& m = p_.startRegion;
-        return m == "exact" ? ls::StartMode::Exact : m == "distance" ? ls::StartMode::Distance
-                              : m == "bvh"   ? ls::StartMode::Bvh : ls::StartMode::Node;
-    }
+    ls::StartMode startMode() const { return p_.startRegion; }
 
     /// The start region the shader uses (valid after setScene()); leaf cells from the root's size.
     ls::StartRegion startRegion() const {
@@ -566,18 +570,17 @@ size_t lineSpacePoolBound(int n, int d, size_t triangles, size_t blockBytes) {
 /// leaf (at most about one per triangle).
 Footprint lineSpaceFootprint(const FootprintQuery& q) {
     Footprint f;
-    const std::string& region = std::get<std::string>(q.params->get("start_region"));
-    const bool exact = region == "exact";
-    const bool culled = exact && std::get<std::string>(q.params->get("start_triangles")) == "culled";
-    const bool split = std::get<int>(q.params->get("leaf_split")) > 1;
+    const LineSpaceParams p = lineSpaceParams().read(*q.params);
+    const bool exact = p.startRegion == ls::StartMode::Exact;
+    const bool culled = exact && p.startTriangles == LineSpaceStartTriangles::Culled;
+    const bool split = p.leafSplit > 1;
     const size_t n = q.triangles;
-    const size_t pools = lineSpacePoolBound(std::get<int>(q.params->get("n")), std::get<int>(q.params->get("d")), n,
-                                            q.reportedStorageBlockBytes);
+    const size_t pools = lineSpacePoolBound(p.n, p.d, n, q.reportedStorageBlockBytes);
     // The pools are built on the host and uploaded: both copies are held while setScene() runs.
     f.bytes = saturatingSum({saturatingMul(8 + (culled ? 16 : 0) + (split ? 8 : 0), n), pools});
     f.peakBytes = saturatingSum({pools, saturatingMul(8, n)});
     if (exact) f.refusal = storageRefusal(q, "the scene positions its exact start region reads", saturatingMul(36, n), true);
-    if (region == "bvh") {
+    if (p.startRegion == ls::StartMode::Bvh) {
         // bvh_raytrace's tree with its default leaves of 4: triangles 48 bytes, nodes ~32 bytes a triangle.
         f.bytes = saturatingSum({f.bytes, saturatingMul(80, n)});
         f.peakBytes = saturatingSum({f.peakBytes, saturatingMul(152, n)});
@@ -589,9 +592,10 @@ Footprint lineSpaceFootprint(const FootprintQuery& q) {
 /// limits build() checks, and with start_region exact the leaf lists' triangles: a parameter set the
 /// build would refuse is refused here, in the time of its occupancy tests.
 std::string lineSpaceSceneCheck(const Scene& scene, const ParamValues& params) {
-    const size_t limit = poolBlockLimit(std::get<int>(params.get("max_block_mib")));
-    const int n = std::get<int>(params.get("n")), d = std::get<int>(params.get("d"));
-    const bool exact = std::get<std::string>(params.get("start_region")) == "exact";
+    const LineSpaceParams p = lineSpaceParams().read(params);
+    const size_t limit = poolBlockLimit(p.maxBlockMib);
+    const int n = p.n, d = p.d;
+    const bool exact = p.startRegion == ls::StartMode::Exact;
     // Where even the bound of the tree's nodes fits every pool (the build's checks), no tree can fail
     // them: the shape is built only for the leaf lists, or when the bound does not fit.
     const size_t nodes = lineSpaceNodeBound(n, d, scene.triangleCount());

@@ -25,18 +25,26 @@
 namespace shadowlab {
 namespace {
 
+enum class MtTreeBuilder { Gpu, Cpu };
+enum class MtQuery { Pixel, Tile };
+/// A tile's shape; the value is its pixels (MT_TILE_PIXELS), 0 for auto.
+enum class MtTile { Auto = 0, T4x2 = 8, T8x2 = 16, T8x4 = 32, T8x8 = 64 };
+const std::vector<Choice<MtTile>> kTiles = {
+    {"auto", MtTile::Auto}, {"4x2", MtTile::T4x2}, {"8x2", MtTile::T8x2}, {"8x4", MtTile::T8x4}, {"8x8", MtTile::T8x8}};
+enum class MtMotion { Rigid, Recluster };
+
 struct MetricTreeParams {
     int clusterSize, chunkTriangles, kmeansIterations; ///< the clustering (cached on disk)
     bool capsules, randomOrder, cache;
     int seed;
     bool slabs, overlapInterval, depthSkip, normalConeCulling; ///< the query's tests (shader defines)
-    std::string treeBuilder;                                   ///< "gpu" | "cpu"
+    MtTreeBuilder treeBuilder;
     int stackSize;                                             ///< query stack, nodes
-    std::string query;                                         ///< "pixel" | "tile"
+    MtQuery query;
     int tileCandidates;                                        ///< tile query: clusters per tile list
-    std::string tile;                                          ///< tile query: "auto" | "4x2" ... "8x8"
+    MtTile tile;                                               ///< tile query's shape
     float rayOffset;                                           ///< × scene radius
-    std::string motion;                                        ///< "rigid" | "recluster"
+    MtMotion motion;
     int geometryBlock;                                         ///< triangles per geometry block, 0 = the device's largest
 };
 
@@ -71,17 +79,17 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                  ParamChange::Rebuild)
         .integer("seed", &P::seed, 1, 0, INT_MAX, "", "seed of the k-means seeding and of the insertion order",
                  ParamChange::Rebuild)
-        .choice("tree_builder", &P::treeBuilder, "gpu", {"gpu", "cpu"},
+        .choice("tree_builder", &P::treeBuilder, MtTreeBuilder::Gpu, {{"gpu", MtTreeBuilder::Gpu}, {"cpu", MtTreeBuilder::Cpu}},
                 "gpu: concurrent insertion with the delta-halving heuristic (paper 5.3); cpu: median partitioning "
                 "with Yianilos pivots (the paper's Table 2 reference, slow)",
                 ParamChange::Update)
         .apply(stackSizeRow(&P::stackSize, 64))
-        .choice("query", &P::query, "tile", {"pixel", "tile"},
+        .choice("query", &P::query, MtQuery::Tile, {{"pixel", MtQuery::Pixel}, {"tile", MtQuery::Tile}},
                 "pixel: every pixel walks the tree (paper 5.4); tile: a tile of pixels walks it once with the cap "
                 "enclosing its points, and each pixel tests the clusters the walk gathered with the per-pixel "
                 "query's own tests (the same image; no divergent walk)",
                 ParamChange::Recompile)
-        .choice("tile", &P::tile, "auto", {"auto", "4x2", "8x2", "8x4", "8x8"},
+        .choice("tile", &P::tile, MtTile::Auto, kTiles,
                 "tile query: the pixels that share one walk; auto = the tile whose walkers (one invocation per tile) "
                 "fill one subgroup: 8x2 on 4 lanes, else 4x2 (8 walkers)",
                 ParamChange::Recompile)
@@ -93,7 +101,7 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
         .apply(rayOffsetRow(&P::rayOffset))
         // The paper's answer to rigid motion: clusters never span two moving parts, and each moves
         // with its part; "recluster" is the alternative it avoids, timed for comparison.
-        .choice("motion", &P::motion, "rigid", {"rigid", "recluster"},
+        .choice("motion", &P::motion, MtMotion::Rigid, {{"rigid", MtMotion::Rigid}, {"recluster", MtMotion::Recluster}},
                 "moving parts: rigid = clusters are made per part (never spanning two) and their spheres, capsules, "
                 "cones and slabs move with it each frame; recluster = the whole clustering is redone on the posed "
                 "triangles every frame they move (the `recluster` stage)",
@@ -139,7 +147,7 @@ public:
         clusters_ = GlBuffer(), nodes_ = GlBuffer();
         for (GlBuffer& g : geometry_) g = GlBuffer();
         // A moving scene: clusters per part in the part's own space, posed each frame (sceneMoved).
-        if (!scene.dynamic() || p_.motion != "rigid") {
+        if (!scene.dynamic() || p_.motion != MtMotion::Rigid) {
             upload(cluster(scene.cpu(), p_.cache), scene.cpu());
             return;
         }
@@ -158,7 +166,7 @@ public:
     }
 
     void sceneMoved(const FrameInputs& f) override {
-        if (p_.motion == "recluster") {
+        if (p_.motion == MtMotion::Recluster) {
             f.timer.begin("recluster", false);
             const Scene posed = scene_->posedScene();
             upload(cluster(posed, false), posed);  // no cache: a pose is never seen twice
@@ -251,7 +259,7 @@ public:
             dispatchPerCluster(prepare_);
             // The insertion and the query read the nodes through their buffer texture.
             glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-            if (p_.treeBuilder == "cpu") {
+            if (p_.treeBuilder == MtTreeBuilder::Cpu) {
                 buildOnCpu(f.light);
             } else {
                 dispatchPerCluster(insert_);
@@ -342,9 +350,7 @@ public:
 
     /// The tile shape tilePixels() gives on this device (used by the tile query).
     std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
-        if (p_.tile != "auto") return {{"tile", p_.tile}};
-        const int n = tilePixels();
-        return {{"tile", n == 8 ? "4x2" : n == 16 ? "8x2" : n == 32 ? "8x4" : "8x8"}};
+        return {{"tile", choiceName(kTiles, MtTile(tilePixels()))}};
     }
 
 private:
@@ -355,7 +361,7 @@ private:
                                        {"MT_DEPTH_SKIP", flag(p_.depthSkip)},
                                        {"MT_NORMAL_CONE_CULLING", flag(p_.normalConeCulling)},
                                        {"MT_STACK_SIZE", std::to_string(p_.stackSize)},
-                                       {"MT_QUERY_TILE", flag(p_.query == "tile")},
+                                       {"MT_QUERY_TILE", flag(p_.query == MtQuery::Tile)},
                                        {"MT_TILE_CANDIDATES", std::to_string(p_.tileCandidates)},
                                        {"MT_TILE_PIXELS", std::to_string(tilePixels())},
                                        {"MT_GEOMETRY_USED", std::to_string(geometryUsed_)},
@@ -370,7 +376,7 @@ private:
     /// lets the passes that touch it address. Rigid motion writes the blocks as storage blocks.
     size_t blockTriangles(const SceneGpu& scene) const {
         if (p_.geometryBlock > 0) return size_t(p_.geometryBlock);
-        const bool written = scene.dynamic() && p_.motion == "rigid";
+        const bool written = scene.dynamic() && p_.motion == MtMotion::Rigid;
         // A multiple of 16 triangles keeps every block's byte offset 16-byte aligned.
         const size_t block = written ? maxShaderStorageBlockBytes() / (9 * sizeof(float)) : maxTextureBufferTexels() / 3;
         return std::max<size_t>(16, block / 16 * 16);
@@ -378,11 +384,11 @@ private:
 
     /// Pixels per tile of the tile query: "WxH" -> W * H; auto -> autoTilePixels().
     int tilePixels() const {
-        if (p_.tile != "auto") return (p_.tile[0] - '0') * (p_.tile[2] - '0');
+        if (p_.tile != MtTile::Auto) return int(p_.tile);
         return autoTilePixels(subgroupSize_);
     }
     /// The counter tile_pixels: pixels per tile, 0 with the per-pixel query.
-    double tileQueryPixels() const { return p_.query == "tile" ? double(tilePixels()) : 0.0; }
+    double tileQueryPixels() const { return p_.query == MtQuery::Tile ? double(tilePixels()) : 0.0; }
 
     mt::ClusteringOptions clusteringOptions() const {
         mt::ClusteringOptions o;
@@ -605,7 +611,7 @@ Footprint metricTreeFootprint(const FootprintQuery& q) {
     const MetricTreeParams p = metricTreeParams().read(*q.params);
     const size_t n = q.triangles, pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
     const size_t clusters = std::min(n, saturatingMul(2, n) / size_t(p.clusterSize) + 1);
-    const bool rigid = q.moving && p.motion == "rigid";
+    const bool rigid = q.moving && p.motion == MtMotion::Rigid;
     Footprint f;
     f.bytes = saturatingSum({saturatingMul(36, n), saturatingMul(128, clusters), 16 * pixels,
                              rigid ? saturatingSum({saturatingMul(68, clusters), saturatingMul(4, n)}) : 0});

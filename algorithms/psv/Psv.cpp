@@ -18,10 +18,21 @@
 namespace shadowlab {
 namespace {
 
+/// The values are the shaders' PSV_WEDGE_BOUND.
+enum class PsvWedgeBound { Exact = 0, Distance = 1, Vertices = 2 };
+const std::vector<Choice<PsvWedgeBound>> kWedgeBounds = {
+    {"exact", PsvWedgeBound::Exact}, {"distance", PsvWedgeBound::Distance}, {"vertices", PsvWedgeBound::Vertices}};
+/// The values are the shaders' PSV_TRAVERSAL; auto resolves to one of them (Psv::traversal()).
+enum class PsvTraversal { Auto = -1, Stack = 0, Stackless = 1, Hybrid = 2 };
+const std::vector<Choice<PsvTraversal>> kTraversals = {{"auto", PsvTraversal::Auto},
+                                                       {"stack", PsvTraversal::Stack},
+                                                       {"stackless", PsvTraversal::Stackless},
+                                                       {"hybrid", PsvTraversal::Hybrid}};
+
 struct PsvParams {
     bool wedge, randomOrder, frontFaceCulling, depthSkip, transparency;
-    std::string wedgeBound; ///< "exact" | "distance" | "vertices"
-    std::string traversal;  ///< "auto" | "stack" | "stackless" | "hybrid"
+    PsvWedgeBound wedgeBound;
+    PsvTraversal traversal;
     int hybridStack; ///< hybrid traversal's stack, nodes
     int seed;        ///< of the insertion order
     int stackSize;   ///< query stack, nodes
@@ -38,7 +49,7 @@ const ParamStruct<PsvParams>& psvParams() {
         // that value can be too small and miss an occluder: not exact, measured, never the default.
         // "distance" by default: conservative (exact images) and, on the peer engine scene at 512²,
         // a third cheaper to build than "exact" for 5 % more traversal (docs/algorithms/psv.md).
-        .choice("wedge_bound", &P::wedgeBound, "distance", {"exact", "distance", "vertices"},
+        .choice("wedge_bound", &P::wedgeBound, PsvWedgeBound::Distance, kWedgeBounds,
                 "point light: the wedge as the largest angle over the whole triangle seen from the light "
                 "(exact), as the vertices' largest plane distance over the triangle's distance to the light "
                 "(distance: wider, cheaper, still conservative) or over its vertices only (vertices: the "
@@ -60,7 +71,7 @@ const ParamStruct<PsvParams>& psvParams() {
                  ParamChange::Recompile)
         // auto: stackless on every device (docs/algorithms/psv.md, "Traversals": it cannot overflow
         // and was the fastest measured); the stack walk for x-ray shadows, which need it.
-        .choice("traversal", &P::traversal, "auto", {"auto", "stack", "stackless", "hybrid"},
+        .choice("traversal", &P::traversal, PsvTraversal::Auto, kTraversals,
                 "query walk (Mora et al. 2016): an explicit stack (the 2015 paper; may overflow), none "
                 "(stackless: each triangle's escape node, written by the build, leads back up), or a "
                 "short stack that walks stacklessly where it is full (hybrid); the same image; auto: "
@@ -78,8 +89,8 @@ const ParamStruct<PsvParams>& psvParams() {
                  ParamChange::Recompile)
         .apply(rayOffsetRow(&P::rayOffset))
         .rule("traversal", [](const P& p) {
-            return p.transparency && (p.traversal == "stackless" || p.traversal == "hybrid")
-                       ? "traversal = " + p.traversal + " cannot take transparency (a capping plane's negative child would be "
+            return p.transparency && (p.traversal == PsvTraversal::Stackless || p.traversal == PsvTraversal::Hybrid)
+                       ? "traversal = " + std::string(choiceName(kTraversals, p.traversal)) + " cannot take transparency (a capping plane's negative child would be "
                          "a second pending side of one node): use traversal = stack or auto"
                        : std::string();
         });
@@ -195,7 +206,9 @@ public:
         return {{"nodes_visited", nodesVisited_.id(), 0.0f, "nodes"}, {"stack_overflow", overflow_.id(), 1.0f, "flag"}};
     }
 
-    std::vector<std::pair<std::string, std::string>> resolvedParams() const override { return {{"traversal", traversal()}}; }
+    std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
+        return {{"traversal", choiceName(kTraversals, traversal())}};
+    }
 
     /// The tree (4n + 1 nodes of 32 bytes) plus the 96-byte counter block: exactly 128 (n + 1) bytes.
     /// Not counted: the per-pixel debug images (nodes_visited, stack_overflow), which every image
@@ -222,29 +235,29 @@ private:
     }
 
     /// `auto`: stackless, or the stack walk for x-ray shadows (docs/algorithms/psv.md, "Traversals").
-    std::string traversal() const {
-        if (p_.traversal != "auto") return p_.traversal;
-        return p_.transparency ? "stack" : "stackless";
+    PsvTraversal traversal() const {
+        if (p_.traversal != PsvTraversal::Auto) return p_.traversal;
+        return p_.transparency ? PsvTraversal::Stack : PsvTraversal::Stackless;
     }
 
     void compile() {
         auto flag = [](bool on) { return on ? std::string("1") : std::string("0"); };
-        const std::string walk = traversal();
-        if (p_.transparency && walk != "stack")
-            throw RuntimeError("psv: traversal = " + walk + " cannot take transparency (a capping plane's negative "
+        const PsvTraversal walk = traversal();
+        if (p_.transparency && walk != PsvTraversal::Stack)
+            throw RuntimeError("psv: traversal = " + std::string(choiceName(kTraversals, walk)) + " cannot take transparency (a capping plane's negative "
                                "child would be a second pending side of one node): use traversal = stack");
         // The plane walk first where the walk can stop at a close call and leave the pixel to the
         // exact walk: not with x-ray shadows (a close call's transmission is a factor of the
         // product) nor the hybrid walk (whose stackless subtrees return to the stack walk).
-        planeWalk_ = !p_.transparency && walk != "hybrid";
+        planeWalk_ = !p_.transparency && walk != PsvTraversal::Hybrid;
         ShaderDefines defines = {{"PSV_WEDGE", flag(p_.wedge)},
-                                 {"PSV_WEDGE_BOUND", p_.wedgeBound == "vertices" ? "2" : p_.wedgeBound == "distance" ? "1" : "0"},
+                                 {"PSV_WEDGE_BOUND", std::to_string(int(p_.wedgeBound))},
                                  {"PSV_RANDOM_ORDER", flag(p_.randomOrder)},
                                  {"PSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
                                  {"PSV_DEPTH_SKIP", flag(p_.depthSkip)},
                                  {"PSV_TRANSPARENCY", flag(p_.transparency)},
                                  {"PSV_STACK_SIZE", std::to_string(p_.stackSize)},
-                                 {"PSV_TRAVERSAL", walk == "stackless" ? "1" : walk == "hybrid" ? "2" : "0"},
+                                 {"PSV_TRAVERSAL", std::to_string(int(walk))},
                                  {"PSV_HYBRID_STACK", std::to_string(p_.hybridStack)},
                                  {"PSV_PLANE_WALK", flag(planeWalk_)},
                                  statisticsDefine(options_)};

@@ -16,14 +16,23 @@
 namespace shadowlab {
 namespace {
 
+enum class PtsvBounds { Explicit, Implicit };
+enum class PtsvVote { Auto, Ballot, Shared };
+enum class PtsvLeafSamples { Tile, Cluster };
+enum class PtsvTraversal { Auto, Cooperative, Invocation, Packet };
+const std::vector<Choice<PtsvTraversal>> kTraversals = {{"auto", PtsvTraversal::Auto},
+                                                        {"cooperative", PtsvTraversal::Cooperative},
+                                                        {"invocation", PtsvTraversal::Invocation},
+                                                        {"packet", PtsvTraversal::Packet}};
+
 struct PtsvParams {
-    std::string bounds;      ///< "explicit" | "implicit"
+    PtsvBounds bounds;
     bool cullingPlanes, twoPass, frontFaceCulling, jobIterations, heatMap;
     int splitLevel, tileSize, maxKeyBits, jobCapacity, jobsPerWorkgroup, lanes;
     float planeBias, rayOffset; ///< × scene radius
-    std::string vote;        ///< "auto" | "ballot" | "shared"
-    std::string leafSamples; ///< "tile" | "cluster"
-    std::string traversal;   ///< "auto" | "cooperative" | "invocation" | "packet"
+    PtsvVote vote;
+    PtsvLeafSamples leafSamples;
+    PtsvTraversal traversal;
 };
 
 const ParamStruct<PtsvParams>& ptsvParams() {
@@ -31,7 +40,7 @@ const ParamStruct<PtsvParams>& ptsvParams() {
     // Shader variants are Recompile: the per-frame layout (ensureLayout) follows them without a
     // setScene(). Buffer capacities are Rebuild.
     static const ParamStruct<P> s = ParamStruct<P>()
-        .choice("bounds", &P::bounds, "explicit", {"explicit", "implicit"},
+        .choice("bounds", &P::bounds, PtsvBounds::Explicit, {{"explicit", PtsvBounds::Explicit}, {"implicit", PtsvBounds::Implicit}},
                 "node bounds: the tight box of its samples (paper 2.1) or the cluster frustum its key implies",
                 ParamChange::Recompile)
         .boolean("culling_planes", &P::cullingPlanes, true,
@@ -83,7 +92,7 @@ const ParamStruct<PtsvParams>& ptsvParams() {
         // packet: pass one's walks of neighbouring triangles share their nodes, so the lanes of a
         // subgroup loop over one node's children together (traverse 10-12 % less than invocation at
         // 512² on the peer engine scene, the same at 1024²).
-        .choice("traversal", &P::traversal, "auto", {"auto", "cooperative", "invocation", "packet"},
+        .choice("traversal", &P::traversal, PtsvTraversal::Auto, kTraversals,
                 "who walks a job: cooperative (paper: a subgroup per job, its lanes testing a node's 32 children "
                 "together, see vote and lanes), invocation (each invocation its own job, testing a node's "
                 "existing children in turn; no votes), packet (as invocation, but in pass one the lanes of a "
@@ -91,7 +100,8 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                 "ARB_shader_ballot), auto (with two passes on subgroups narrower than 32 lanes packet, or invocation "
                 "without ARB_shader_ballot; else cooperative)",
                 ParamChange::Recompile)
-        .choice("vote", &P::vote, "auto", {"auto", "ballot", "shared"},
+        .choice("vote", &P::vote, PtsvVote::Auto,
+                {{"auto", PtsvVote::Auto}, {"ballot", PtsvVote::Ballot}, {"shared", PtsvVote::Shared}},
                 "how a node's 32 children are tested together: ballot (ARB_shader_ballot: one subgroup, each "
                 "invocation testing 32 / width children, no barrier), shared (32 invocations, shared memory and a "
                 "barrier per node), auto (ballot where the driver has it)",
@@ -101,7 +111,8 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  "4, 8, 16, 32 or 64 compiles for that width (ballot workgroups whose subgroups differ at run "
                  "time are reported as overflow, and ptsv switches to shared votes from the next frame)",
                  ParamChange::Recompile)
-        .choice("leaf_samples", &P::leafSamples, "tile", {"tile", "cluster"},
+        .choice("leaf_samples", &P::leafSamples, PtsvLeafSamples::Tile,
+                {{"tile", PtsvLeafSamples::Tile}, {"cluster", PtsvLeafSamples::Cluster}},
                 "samples tested at a leaf: the whole tile (paper) or only the cluster's (its key compared first)",
                 ParamChange::Recompile)
         .boolean("job_iterations", &P::jobIterations, false,
@@ -324,7 +335,8 @@ public:
     /// traversal), the workgroup width, and the split depth (its rule, "levels" or "levels - 1",
     /// until a frame has laid out the tree) and jobs per workgroup that 0 stands for.
     std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
-        const std::string traversal = packet_ ? "packet" : perInvocation_ ? "invocation" : "cooperative";
+        const PtsvTraversal traversal = packet_ ? PtsvTraversal::Packet : perInvocation_ ? PtsvTraversal::Invocation
+                                                                                     : PtsvTraversal::Cooperative;
         const std::string vote = vote_ == kVoteBallot ? "ballot" : vote_ == kVoteShared ? "shared" : "none";
         const std::string split = layout_.levels > 0     ? std::to_string(splitDepth())
                                   : p_.splitLevel != 0   ? std::to_string(p_.splitLevel)
@@ -332,7 +344,7 @@ public:
                                                          : "levels - 1";
         return {{"split_level", split},
                 {"jobs_per_workgroup", std::to_string(jobsPerWorkgroup())},
-                {"traversal", traversal},
+                {"traversal", choiceName(kTraversals, traversal)},
                 {"vote", vote},
                 {"lanes", std::to_string(lanes_)}};
     }
@@ -363,26 +375,25 @@ private:
         if (p_.lanes != 0 && !supported(p_.lanes))
             throw RuntimeError("ptsv: lanes must be 0 (auto), 4, 8, 16, 32 or 64, not " + std::to_string(p_.lanes));
         const bool ballotUsable = supported(subgroupSize_);
-        const std::string vote = p_.vote;
-        if (vote == "ballot" && !ballotUsable)
+        if (p_.vote == PtsvVote::Ballot && !ballotUsable)
             throw RuntimeError("ptsv: vote = ballot needs ARB_shader_ballot with a subgroup width of 4, 8, 16, 32 or "
                                "64 (this context: " + std::to_string(subgroupSize_) + ")");
-        if (p_.traversal == "packet" && !ballotUsable)
+        if (p_.traversal == PtsvTraversal::Packet && !ballotUsable)
             throw RuntimeError("ptsv: traversal = packet needs ARB_shader_ballot (this context: subgroup width " +
                                std::to_string(subgroupSize_) + ")");
-        const bool narrow = p_.traversal == "auto" && p_.twoPass && !(ballotUsable && subgroupSize_ >= 32);
-        packet_ = p_.traversal == "packet" || (narrow && ballotUsable);
-        perInvocation_ = packet_ || p_.traversal == "invocation" || narrow;
-        vote_ = perInvocation_ ? kVoteNone : vote != "shared" && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
+        const bool narrow = p_.traversal == PtsvTraversal::Auto && p_.twoPass && !(ballotUsable && subgroupSize_ >= 32);
+        packet_ = p_.traversal == PtsvTraversal::Packet || (narrow && ballotUsable);
+        perInvocation_ = packet_ || p_.traversal == PtsvTraversal::Invocation || narrow;
+        vote_ = perInvocation_ ? kVoteNone : p_.vote != PtsvVote::Shared && ballotUsable && !fellBack_ ? kVoteBallot : kVoteShared;
         lanes_ = perInvocation_ ? 1 : p_.lanes != 0 ? p_.lanes : vote_ == kVoteBallot ? subgroupSize_ : 32;
         auto flag = [&](bool b) { return b ? std::string("1") : std::string("0"); };
         ShaderDefines defines = {statisticsDefine(options_),
                                  {"PTSV_TILE", std::to_string(p_.tileSize)},
-                                 {"PTSV_EXPLICIT_BOUNDS", flag(p_.bounds == "explicit")},
+                                 {"PTSV_EXPLICIT_BOUNDS", flag(p_.bounds == PtsvBounds::Explicit)},
                                  {"PTSV_CULLING_PLANES", flag(p_.cullingPlanes)},
                                  {"PTSV_TWO_PASS", flag(p_.twoPass)},
                                  {"PTSV_FRONT_FACE_CULLING", flag(p_.frontFaceCulling)},
-                                 {"PTSV_LEAF_CLUSTER_ONLY", flag(p_.leafSamples == "cluster")},
+                                 {"PTSV_LEAF_CLUSTER_ONLY", flag(p_.leafSamples == PtsvLeafSamples::Cluster)},
                                  {"PTSV_HEAT_MAP", flag(p_.heatMap)},
                                  {"PTSV_JOB_ITERATIONS", flag(p_.jobIterations)},
                                  {"PTSV_PER_INVOCATION", flag(perInvocation_)},
@@ -413,7 +424,7 @@ private:
         const int tile = p_.tileSize;
         layout_ = ptsv::makeKeyLayout(resolution_, tile, camera.fovYDeg, camera.nearPlane, camera.farPlane,
                                       p_.maxKeyBits);
-        const bool explicitBounds = p_.bounds == "explicit";
+        const bool explicitBounds = p_.bounds == PtsvBounds::Explicit;
         const size_t boundsBytes = explicitBounds ? layout_.boundsNodes * 6 * sizeof(float) : 4;
         if (boundsBytes > maxShaderStorageBlockBytes())
             throw RuntimeError("ptsv: explicit bounds of a full tree with " + std::to_string(layout_.keyBits) +
@@ -543,24 +554,24 @@ private:
 /// slots of whole tiles (a resolution that is no multiple of tile_size is padded), the job list.
 Footprint ptsvFootprint(const FootprintQuery& q) {
     Footprint f;
-    const ParamValues& p = *q.params;
+    const PtsvParams p = ptsvParams().read(*q.params);
     const size_t planes = saturatingMul(q.triangles, PTSV_PLANES_PER_TRIANGLE * 16);
-    const bool twoPass = std::get<bool>(p.get("two_pass"));
-    const size_t capacity = size_t(std::get<int>(p.get("job_capacity")));
+    const bool twoPass = p.twoPass;
+    const size_t capacity = size_t(p.jobCapacity);
     const size_t jobs = twoPass ? capacity * 8 : 8;
-    const size_t jobIterations = std::get<bool>(p.get("job_iterations")) ? saturatingMul(saturatingSum({q.triangles, twoPass ? capacity : 0, 1}), 4) : 4;
-    const int tile = std::get<int>(p.get("tile_size"));
+    const size_t jobIterations = p.jobIterations ? saturatingMul(saturatingSum({q.triangles, twoPass ? capacity : 0, 1}), 4) : 4;
+    const int tile = p.tileSize;
     ptsv::KeyLayout layout;
     try {
-        layout = ptsv::makeKeyLayout(q.resolution, tile, q.fovYDeg, q.nearPlane, q.farPlane, std::get<int>(p.get("max_key_bits")));
+        layout = ptsv::makeKeyLayout(q.resolution, tile, q.fovYDeg, q.nearPlane, q.farPlane, p.maxKeyBits);
     } catch (const RuntimeError& e) {
         f.refusal = std::string(e.what()).substr(std::string("ptsv: ").size());
         return f;
     }
-    const size_t bounds = std::get<std::string>(p.get("bounds")) == "explicit" ? layout.boundsNodes * 6 * sizeof(float) : 4;
+    const size_t bounds = p.bounds == PtsvBounds::Explicit ? layout.boundsNodes * 6 * sizeof(float) : 4;
     const size_t slots = size_t(layout.tilesX) * size_t(layout.tilesY) * size_t(tile) * size_t(tile);
     const size_t pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
-    const size_t perSlot = 16 + 4 + (std::get<bool>(p.get("heat_map")) ? 4 : 0); // samples, shadow marks, heat counts
+    const size_t perSlot = 16 + 4 + (p.heatMap ? 4 : 0); // samples, shadow marks, heat counts
     f.bytes = saturatingSum({planes, layout.maskWords * 4, bounds, saturatingMul(slots, perSlot), 4 * pixels, jobs, jobIterations});
     f.refusal = storageRefusal(q, "its shadow-volume planes", planes, true);
     if (f.refusal.empty()) f.refusal = storageRefusal(q, "the explicit bounds of its view-sample hierarchy", bounds, true);

@@ -13,16 +13,22 @@
 namespace shadowlab {
 namespace {
 
+enum class ReferenceBvh { Auto, Fast, Compact };
+
 struct ReferenceParams {
     int threads;     ///< 0 = all hardware threads
     float rayOffset; ///< × scene radius
-    std::string motionUpdate; ///< refit | rebuild: how the BVH follows moving parts
-    std::string bvh;          ///< auto | fast | compact: Embree's data layout
+    EmbreeTracer::MotionUpdate motionUpdate; ///< how the BVH follows moving parts
+    ReferenceBvh bvh;                    ///< Embree's data layout
 };
 
 /// `bvh: auto` takes the compact layout from this many triangles (docs/memory.md: it saves about
 /// 40 bytes a triangle, and the reference's time per frame is small next to any GPU algorithm's).
 constexpr size_t kCompactBvhTriangles = 10'000'000;
+
+bool compactLayout(ReferenceBvh bvh, size_t triangles) {
+    return bvh == ReferenceBvh::Compact || (bvh == ReferenceBvh::Auto && triangles >= kCompactBvhTriangles);
+}
 
 const ParamStruct<ReferenceParams>& referenceParams() {
     using P = ReferenceParams;
@@ -30,11 +36,13 @@ const ParamStruct<ReferenceParams>& referenceParams() {
         .integer("threads", &P::threads, 0, 0, 256, "", "CPU threads tracing rays (0 = one per 65,536 pixels, at most all hardware threads)",
                  ParamChange::Update)
         .apply(rayOffsetRow(&P::rayOffset))
-        .choice("motion_update", &P::motionUpdate, "refit", {"refit", "rebuild"},
+        .choice("motion_update", &P::motionUpdate, EmbreeTracer::MotionUpdate::Refit,
+                {{"refit", EmbreeTracer::MotionUpdate::Refit}, {"rebuild", EmbreeTracer::MotionUpdate::Rebuild}},
                 "how the Embree BVH follows moving parts each frame: refit its boxes (fast; the tree degrades as "
                 "parts travel) or rebuild it (the CPU alternative's full cost); either is exact",
                 ParamChange::Rebuild)
-        .choice("bvh", &P::bvh, "auto", {"auto", "fast", "compact"},
+        .choice("bvh", &P::bvh, ReferenceBvh::Auto,
+                {{"auto", ReferenceBvh::Auto}, {"fast", ReferenceBvh::Fast}, {"compact", ReferenceBvh::Compact}},
                 "Embree's layout: fast (precomputed triangle leaves) or compact (indexed leaves reading the scene's "
                 "vertices, compact nodes: less memory, slower rays); auto: compact from 10 M triangles; either is exact",
                 ParamChange::Rebuild);
@@ -47,17 +55,13 @@ class Reference final : public ShadowAlgorithm {
 public:
     explicit Reference(const ParamValues& params) : p_(referenceParams().read(params)) {}
 
-    bool compactBvh(size_t triangles) const {
-        return p_.bvh == "compact" || (p_.bvh == "auto" && triangles >= kCompactBvhTriangles);
-    }
+    bool compactBvh(size_t triangles) const { return compactLayout(p_.bvh, triangles); }
 
     void setScene(const SceneGpu& scene) override {
         tracer_.reset(); // free the old BVH before building the new one
         scene_ = &scene;
         posed_.clear();
-        tracer_ = std::make_unique<EmbreeTracer>(scene.cpu(), p_.motionUpdate == "rebuild"
-                                                                  ? EmbreeTracer::MotionUpdate::Rebuild
-                                                                  : EmbreeTracer::MotionUpdate::Refit,
+        tracer_ = std::make_unique<EmbreeTracer>(scene.cpu(), p_.motionUpdate,
                                                // the SceneGpu's Scene lives as long as this scene is set
                                                EmbreeTracer::Vertices::Share, compactBvh(scene.triangleCount()));
     }
@@ -69,7 +73,7 @@ public:
         if (posed_.empty()) posed_ = scene_->cpu().positions;
         scene_->readMovingPositions(posed_);
         frame.timer.end();
-        frame.timer.begin(p_.motionUpdate == "rebuild" ? "rebuild" : "refit", false);
+        frame.timer.begin(p_.motionUpdate == EmbreeTracer::MotionUpdate::Rebuild ? "rebuild" : "refit", false);
         for (const MovingPart& part : scene_->cpu().moving)
             tracer_->moveTriangles(part.firstTriangle, &posed_[3 * part.firstTriangle], part.triangleCount);
         tracer_->commitMoves();
@@ -126,8 +130,7 @@ constexpr size_t kEmbreeCompactBytesPerTriangle = 92;
 Footprint referenceFootprint(const FootprintQuery& q) {
     Footprint f;
     const size_t pixels = size_t(q.resolution.x) * size_t(q.resolution.y);
-    const std::string layout = std::get<std::string>(q.params->get("bvh"));
-    const bool compact = layout == "compact" || (layout == "auto" && q.triangles >= kCompactBvhTriangles);
+    const bool compact = compactLayout(referenceParams().read(*q.params).bvh, q.triangles);
     const size_t perTriangle = (compact ? kEmbreeCompactBytesPerTriangle : kEmbreeBytesPerTriangle) + (q.moving ? 36 + 36 : 0);
     f.bytes = saturatingSum({saturatingMul(q.triangles, perTriangle), 48 * pixels});
     // Embree's builder holds primitive references and temporary nodes while it builds: at 74 M

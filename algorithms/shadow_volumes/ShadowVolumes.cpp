@@ -23,10 +23,14 @@
 namespace shadowlab {
 namespace {
 
+enum class SvMethod { Zfail, Zpass };
+enum class SvDepthTest { Analytic, Hardware };
+enum class SvVolumes { AllTriangles, LightFacing };
+
 struct ShadowVolumesParams {
-    std::string method;  ///< "zfail" | "zpass"
-    std::string depthTest; ///< "analytic" | "hardware"
-    std::string volumes; ///< "all_triangles" | "light_facing"
+    SvMethod method;
+    SvDepthTest depthTest;
+    SvVolumes volumes;
     bool closeCalls;
     float rayOffset;
 };
@@ -37,21 +41,23 @@ const ParamStruct<ShadowVolumesParams>& shadowVolumesParams() {
         // zfail by default: exact wherever the eye is (Carmack's reverse, with caps). zpass counts
         // the faces in front of the point and needs no caps, the papers' fast setting, but every
         // pixel is wrong whose view ray starts inside a volume (tests/ShadowVolumesGLTest.cpp).
-        .choice("method", &P::method, "zfail", {"zfail", "zpass"},
+        .choice("method", &P::method, SvMethod::Zfail, {{"zfail", SvMethod::Zfail}, {"zpass", SvMethod::Zpass}},
                 "count the volume faces behind the point, with caps (zfail: exact with the eye in shadow) or in "
                 "front of it, without caps (zpass: cheaper, wrong where the eye is inside a volume)",
                 ParamChange::Recompile)
         // analytic by default: the depth buffer's resolution far from the near plane makes every
         // face within centimetres of a point a close call on a big scene (13 % of the peer engine
         // orbit's pixels at 256², against 0.1 % analytic; docs/algorithms/shadow_volumes.md).
-        .choice("depth_test", &P::depthTest, "analytic", {"analytic", "hardware"},
+        .choice("depth_test", &P::depthTest, SvDepthTest::Analytic,
+                {{"analytic", SvDepthTest::Analytic}, {"hardware", SvDepthTest::Hardware}},
                 "which faces count: those the view ray meets beyond the point, decided in world space at float "
                 "precision (analytic) or by the depth test against the G-buffer's depth (hardware: the papers')",
                 ParamChange::Recompile)
         // all_triangles by default: every triangle bounds a volume (flipped when it faces away), so
         // open meshes, soups and two-sided planes cast as the reference sees them; light_facing is
         // the classic setting, half the caps and counts, exact for closed meshes only.
-        .choice("volumes", &P::volumes, "all_triangles", {"all_triangles", "light_facing"},
+        .choice("volumes", &P::volumes, SvVolumes::AllTriangles,
+                {{"all_triangles", SvVolumes::AllTriangles}, {"light_facing", SvVolumes::LightFacing}},
                 "which triangles bound a shadow volume: every one, wound to face the light (exact for open meshes "
                 "and soups), or only those facing the light (the classic setting: exact for closed meshes only)",
                 ParamChange::Recompile)
@@ -164,7 +170,7 @@ public:
     }
 
     void computeVisibility(const FrameInputs& f) override {
-        const bool zfail = p_.method == "zfail", analytic = p_.depthTest == "analytic";
+        const bool zfail = p_.method == SvMethod::Zfail, analytic = p_.depthTest == SvDepthTest::Analytic;
         const float offset = rayOffsetLength(p_.rayOffset, *scene_);
         const unsigned triangles = unsigned(scene_->triangleCount());
         counters_.clear();
@@ -372,18 +378,18 @@ private:
 
     /// The two-sided count check (volume.frag): analytic ZFAIL, the only mode that draws every face
     /// and classifies both sides of the test point.
-    bool checked() const { return p_.depthTest == "analytic" && p_.method == "zfail"; }
+    bool checked() const { return p_.depthTest == SvDepthTest::Analytic && p_.method == SvMethod::Zfail; }
 
     void compile() {
         const auto instr = statisticsDefine(options_);
         const std::pair<std::string, std::string> check{"SV_CHECK", checked() ? "1" : "0"};
-        const std::pair<std::string, std::string> facingOnly{"SV_LIGHT_FACING_ONLY", p_.volumes == "light_facing" ? "1" : "0"};
+        const std::pair<std::string, std::string> facingOnly{"SV_LIGHT_FACING_ONLY", p_.volumes == SvVolumes::LightFacing ? "1" : "0"};
         facingPass_ = ShaderProgram::compute("shadow_volumes/facing.comp", {facingOnly, {"SCENE_POSITION_TEXELS", "1"}});
         silhouettePass_ = ShaderProgram::compute("shadow_volumes/silhouettes.comp", {});
         depthPass_ = ShaderProgram::graphics("shading/fullscreen.vert", "shadow_volumes/depth.frag", {});
         volumePass_ = ShaderProgram::graphics("shadow_volumes/volume.vert", "shadow_volumes/volume.frag",
                                               {instr, check, {"SV_CLOSE_CALLS", p_.closeCalls ? "1" : "0"},
-                                               {"SV_ANALYTIC", p_.depthTest == "analytic" ? "1" : "0"}});
+                                               {"SV_ANALYTIC", p_.depthTest == SvDepthTest::Analytic ? "1" : "0"}});
         resolvePass_ = ShaderProgram::compute("shadow_volumes/resolve.comp",
                                               {instr, check, {"SV_CLOSE_CALLS", p_.closeCalls ? "1" : "0"}});
         eyePass_ = ShaderProgram::compute("shadow_volumes/eye_count.comp", {{"SCENE_POSITION_TEXELS", "1"}});

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -107,6 +108,19 @@ private:
 std::string toString(const ParamValue& v);
 const char* toString(ParamType t);
 
+/// One accepted name of a choice parameter and the enumerator it stands for (ParamStruct::choice).
+template <class E> struct Choice {
+    const char* name;
+    E value;
+};
+
+/// The config name of a choice's enumerator (resolved parameters, messages).
+template <class E> const char* choiceName(const std::vector<Choice<E>>& choices, E value) {
+    for (const Choice<E>& c : choices)
+        if (c.value == value) return c.name;
+    return "?";
+}
+
 /// A typed view of one algorithm's parameters: the schema's rows are declared with the member of
 /// `T` each one fills, so a key, its type, default, range, unit, doc and change kind are written
 /// once, and the algorithm reads plain fields (`params.rayOffset`) instead of strings.
@@ -139,10 +153,26 @@ public:
         schema_.real(std::move(key), def, min, max, std::move(unit), std::move(doc), change);
         return bind([member](T& t, const ParamValue& v) { t.*member = F(std::get<double>(v)); });
     }
-    ParamStruct& choice(std::string key, std::string T::*member, std::string def, std::vector<std::string> choices,
-                        std::string doc, ParamChange change) {
-        schema_.choice(std::move(key), std::move(def), std::move(choices), std::move(doc), change);
-        return bind([member](T& t, const ParamValue& v) { t.*member = std::get<std::string>(v); });
+    /// A choice stored as an enumerator: each accepted name is written once, beside the value it
+    /// binds, so an algorithm compares enumerators (a misspelt one does not compile) and configs,
+    /// `list`, docs and the GUI see the names.
+    template <class E>
+    ParamStruct& choice(std::string key, E T::*member, E def, std::vector<Choice<E>> choices, std::string doc,
+                        ParamChange change) {
+        static_assert(std::is_enum_v<E>, "a choice binds an enum class");
+        std::vector<std::string> names;
+        std::string defName;
+        for (const Choice<E>& c : choices) {
+            names.push_back(c.name);
+            if (c.value == def) defName = c.name;
+        }
+        schema_.choice(key, defName, std::move(names), std::move(doc), change);
+        return bind([member, choices, key](T& t, const ParamValue& v) {
+            const std::string& name = std::get<std::string>(v);
+            for (const Choice<E>& c : choices)
+                if (name == c.name) return void(t.*member = c.value);
+            throw std::logic_error("parameter " + key + ": \"" + name + "\" is not one of its choices"); // validated before
+        });
     }
     /// A rule over the typed values (see ParamRule); `key` names the parameter an error points at.
     ParamStruct& rule(std::string key, std::function<std::string(const T&)> problem) {
