@@ -152,7 +152,7 @@ INSTANTIATE_TEST_SUITE_P(Table, PsvAccuracyGLTest, ::testing::ValuesIn(kAccuracy
 // The paper's Figure 6 "No opt" comparison, in its configuration: front faces culled (exact here:
 // closed meshes, and a ground plane facing the light, which shadows nothing). Without culling the
 // gain is smaller (about ×4 on this scene): the two faces of a closed mesh straddle each other's
-// shadow planes, so wedges are wider; docs/algorithms/psv.md has the numbers.
+// shadow planes, so wedges are wider; results/reference/psv/ablation.md has the numbers.
 TEST_F(PsvGLTest, WedgeVisitsFiveTimesFewerNodes) {
     Shot s = thousandsOfTriangles();
     Outcome on = run(s, {{"front_face_culling", true}}), off = run(s, {{"front_face_culling", true}, {"wedge", false}});

@@ -48,7 +48,7 @@ const ParamStruct<BvhParams>& bvhParams() {
         .integer("leaf_size", &P::leafSize, 4, 1, BVH_MAX_LEAF, "triangles", "most triangles per BVH leaf",
                  ParamChange::Rebuild)
         // Off: on llvmpipe the shifts cost more than the scratch-memory stack they avoid (~10-20 %
-        // slower on the engine scenes, docs/algorithms/line_space.md); a GPU may differ.
+        // slower on the engine scenes, results/reference/line_space/earlier.md); a GPU may differ.
         .boolean("short_stack", &P::shortStack, false,
                  "keep the top 16 stack entries in registers (shifted on push/pop), spilling deeper ones to memory",
                  ParamChange::Recompile)

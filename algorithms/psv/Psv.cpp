@@ -48,7 +48,7 @@ const ParamStruct<PsvParams>& psvParams() {
         // The paper's wedge takes the vertices' angles; the largest angle can lie inside an edge, so
         // that value can be too small and miss an occluder: not exact, measured, never the default.
         // "distance" by default: conservative (exact images) and, on the peer engine scene at 512²,
-        // a third cheaper to build than "exact" for 5 % more traversal (docs/algorithms/psv.md).
+        // a third cheaper to build than "exact" for 5 % more traversal (results/reference/psv/ablation.md).
         .choice("wedge_bound", &P::wedgeBound, PsvWedgeBound::Distance, kWedgeBounds,
                 "point light: the wedge as the largest angle over the whole triangle seen from the light "
                 "(exact), as the vertices' largest plane distance over the triangle's distance to the light "
@@ -65,7 +65,7 @@ const ParamStruct<PsvParams>& psvParams() {
                  "only triangles facing away from the light cast (paper 4.2, its setting); exact for closed meshes only",
                  ParamChange::Recompile)
         // Off by default: measured slower on every scene it was tried on (its atomicMin per capping
-        // node crossed in the build, a compare per capping node in the query; docs/algorithms/psv.md).
+        // node crossed in the build, a compare per capping node in the query; results/reference/psv/ablation.md).
         .boolean("depth_skip", &P::depthSkip, false,
                  "skip a capping node's subtree when the point is nearer the light than all of it (Mora et al. 2016); off = the 2015 paper",
                  ParamChange::Recompile)

@@ -76,7 +76,7 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  "two-pass job list; jobs that find it full are finished by pass one (counted in overflow)",
                  ParamChange::Rebuild)
         // 0 = 16 with two passes: on the peer engine scene (512², the timed pass) 1240 / 1432 ms per
-        // frame against 1658 / 1592 with 1 and 1363 / 1683 with 64 (docs/algorithms/ptsv.md); 1 with
+        // frame against 1658 / 1592 with 1 and 1363 / 1683 with 64 (results/reference/ptsv/peer_engine.md); 1 with
         // one pass: a batch of 16 whole traversals in one invocation reached llvmpipe's loop cap on
         // configs/ptsv/engine.json's implicit-bounds steps (up to 11,760 truncated jobs a frame).
         .integer("jobs_per_workgroup", &P::jobsPerWorkgroup, 0, 0, 64, "jobs",
@@ -86,7 +86,7 @@ const ParamStruct<PtsvParams>& ptsvParams() {
                  ParamChange::Recompile)
         // auto: on llvmpipe's 8-lane subgroups a cooperative job takes 4 rounds per node for about 9
         // existing children; one job per invocation measured 3.1x less traversal time on the peer
-        // engine scene at 512² and 1024² (docs/algorithms/ptsv.md). Subgroups of 32 or more test a
+        // engine scene at 512² and 1024² (results/reference/ptsv/peer_engine.md). Subgroups of 32 or more test a
         // node in one round, the paper's case. One pass stays cooperative: a large triangle's whole traversal in one invocation can
         // reach llvmpipe's loop cap (configs/ptsv/engine.json's implicit-bounds rows did).
         // packet: pass one's walks of neighbouring triangles share their nodes, so the lanes of a

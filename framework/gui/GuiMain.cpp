@@ -25,7 +25,7 @@ std::string oneLine(const char* text) {
 static int guiMain(int argc, char** argv);
 
 // Nineteenth probe: --help and --version exited 0 with standard output full or closed, where
-// shadowlab reports it (exit 2), as the README says the two do alike.
+// shadowlab reports it (exit 2), as docs/getting_started.md says the two do alike.
 int main(int argc, char** argv) {
     reopenClosedStandardStreams();
     std::signal(SIGPIPE, SIG_IGN);  // a reader gone is a write error reported, not a silent death

@@ -43,7 +43,7 @@ void drawViewPanel(GuiState& s);
 /// Draws the legend of the current view over the viewport's lower-left corner.
 void drawViewLegend(GuiState& s, glm::vec2 viewportMin, glm::vec2 viewportMax);
 
-/// Keyboard shortcuts (also listed in the help window and README.md) for the keys pressed this frame.
+/// Keyboard shortcuts (also listed in the help window and docs/gui.md) for the keys pressed this frame.
 void handleShortcuts(GuiState& s, const std::vector<int>& keyPresses);
 void drawHelpWindow(GuiState& s);
 

@@ -1,4 +1,4 @@
-// Keyboard shortcuts: one table drives both the handler and the help window (README.md lists the same).
+// Keyboard shortcuts: one table drives both the handler and the help window (docs/gui.md lists the same).
 #include "framework/gui/GuiState.h"
 
 #define GLFW_INCLUDE_NONE // key codes only; GL headers would clash with framework/gl/Gl.h
