@@ -152,114 +152,16 @@ public:
         f.timer.end();
     }
 
+    /// The whole precomputation for `cpu`: the N-tree with its line spaces (from the disk cache when
+    /// allowed), what the start region reads, the pools uploaded, and the loop caps.
     void build(const Scene& cpu, bool useCache) {
-        tracer_.reset();
-        texels_ = {}; // the views first: a buffer texture keeps its buffer alive
-        nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(), occBuf_ = GlBuffer(); // free the old pools first
-        for (GlBuffer& b : bitsBuf_) b = GlBuffer();
-        const int n = p_.n, d = p_.d;
+        freePools();
         const size_t limit = poolBlockLimit(p_.maxBlockMib);
-        tree_ = obtainTree(cpu, n, d, limit, useCache);
-        // The occupancy pool is read (and counted) only by the distance and exact start regions; the
-        // leaf lists and the scene's triangles only by the exact one.
-        const ls::StartMode mode = startMode();
-        const bool occupancy = readsOccupancy(), exact = mode == ls::StartMode::Exact;
-        leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer(), triPlanes_ = GlBuffer(), leafSub_ = GlBuffer();
-        near_ = bvh::BvhGpu();
-        // start_region bvh: bvh_raytrace's tree of the scene with its default build (SAH, leaves of 4).
-        if (mode == ls::StartMode::Bvh) near_ = bvh::uploadBvh(bvh::buildBvh(cpu, bvh::BuildOptions{}), limit, 0, "line_space");
-        const size_t nearBytes = mode == ls::StartMode::Bvh ? near_.bytes() : 0;
-        const int split = leafSplit();
-        const bool lists_needed = exact || split > 1;
-        const bool culled = culledStart();
-        std::vector<glm::vec4> planes; // culled: per scene triangle its plane (unit normal, offset)
-        if (culled) planes = ls::trianglePlanes(cpu);
-        ls::LeafLists lists;
-        uint64_t longestList = 0; // triangles of the largest leaf list (exact)
-        if (lists_needed) {
-            lists = ls::buildLeafLists(cpu, tree_, 0, split);
-            for (size_t i = 1; i < lists.prefix.size(); ++i)
-                longestList = std::max<uint64_t>(longestList, lists.prefix[i] - lists.prefix[i - 1]);
-            // The shader numbers a leaf by the occupancy bits below it: one occupied leaf without a list
-            // (or the reverse) would shift every later list, so the two must agree exactly.
-            size_t occupied = 0;
-            const size_t words = ls::occupancyWords(n);
-            for (size_t i = 0; i < tree_.nodes.size(); ++i)
-                if (int(tree_.nodes[i].level) == d - 1)
-                    for (size_t w = 0; w < words; ++w) occupied += size_t(std::popcount(tree_.occupancy[i * words + w]));
-            if (occupied + 1 != lists.prefix.size())
-                throw RuntimeError("line_space: the leaf lists (" + std::to_string(lists.prefix.size() - 1) +
-                                   " leaves) disagree with the occupancy pool (" + std::to_string(occupied) + " leaves)");
-        }
-        poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
-                      tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0,
-                      (exact ? lists.bytes() + scene_->positions().size() + planes.size() * sizeof(glm::vec4)
-                             : lists_needed ? (lists.wordRank.size() + lists.sub.size()) * sizeof(uint32_t) : 0) + nearBytes};
-        // Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
-        // up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a
-        // GPU with a larger limit is caught here.
-        nodesPerChunk_ = ls::nodesPerChunk(n, limit);
-        const size_t words = ls::wordsPerNode(n), chunks = (tree_.nodes.size() + nodesPerChunk_ - 1) / nodesPerChunk_;
-        auto mib = [](size_t b) {
-            char text[32];
-            std::snprintf(text, sizeof text, "%.1f", double(b) / double(1u << 20));
-            return std::string(text);
-        };
-        if (poolBytes_[0] > limit || poolBytes_[1] > limit || chunks > LS_BIT_CHUNKS)
-            throw SceneRefusal("line_space: the pools of (N, d) = (" + std::to_string(n) + ", " + std::to_string(d) + ") need " +
-                               mib(poolBytes_[0]) + " + " + mib(poolBytes_[1]) + " + " + mib(poolBytes_[2]) +
-                               " MiB (node, tree, line space); one SSBO may hold " + mib(limit) +
-                               " MiB here (GL_MAX_SHADER_STORAGE_BLOCK_SIZE, or max_block_mib) and the line space may span " +
-                               std::to_string(LS_BIT_CHUNKS));
-        nodesBuf_ = GlBuffer::fromVector(tree_.nodes, 0);
-        treeBuf_ = GlBuffer::fromVector(tree_.tree, 0);
-        if (occupancy) occBuf_ = GlBuffer::fromVector(tree_.occupancy, 0);
-        if (exact) {
-            for (auto [what, bytes] : {std::pair{"leaf triangle lists", lists.tris.size() * sizeof(uint32_t)},
-                                       std::pair{"scene positions", scene_->positions().size()}})
-                if (bytes > limit)
-                    throw SceneRefusal(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
-                                       " MiB; one SSBO may hold " + mib(limit) + " MiB here");
-            leafPrefix_ = GlBuffer::fromVector(lists.prefix, 0);
-            leafTris_ = GlBuffer::fromVector(lists.tris, 0);
-            if (culled) triPlanes_ = GlBuffer::fromVector(planes, 0);
-        }
-        if (lists_needed) leafBase_ = GlBuffer::fromVector(lists.wordRank, 0);
-        if (split > 1) leafSub_ = GlBuffer::fromVector(lists.sub, 0);
-        for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
-            // Unused chunks get a 4-byte buffer so every buffer texture the shader may declare has one.
-            const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
-            const size_t last = std::min(tree_.bits.size(), (c + 1) * nodesPerChunk_ * words);
-            bitsBuf_[c] = GlBuffer((last - first) * sizeof(uint32_t), last > first ? tree_.bits.data() + first : nullptr, 0);
-        }
-        makeTexels(occupancy, exact, culled, split > 1);
-        // A point's distance to a triangle's plane, computed in float, is off by a few units in the
-        // last place of the coordinates (the plane's offset is of their size): 4e-5 of the largest
-        // coordinate is ~300 of them and far below a leaf (1/343 of the scene at (7, 3)).
-        planeEps_ = 0;
-        if (!tree_.nodes.empty()) {
-            const ls::NodeGpu& root = tree_.nodes[0];
-            for (int k = 0; k < 3; ++k)
-                planeEps_ = std::max({planeEps_, std::abs(root.lo[k]), std::abs(root.lo[k] + root.size[k])});
-            planeEps_ *= 4e-5f;
-        }
-        // The shader reads the line-space pool with one load when it is a single block; a tree that
-        // needs more blocks gets the program that picks the block per node.
-        const int usedChunks = int(std::max<size_t>(1, chunks));
-        if (usedChunks != bitChunks_) {
-            bitChunks_ = usedChunks;
-            compile();
-        }
-        // The loop caps of the trace (the reasoning is at its loops): a node's DDA visits at most
-        // 3N - 2 cells, one more pass leaves it; a ray walks each node above the last level at most
-        // once, and at most (3N - 2)^l nodes of level l.
-        const uint64_t cells = uint64_t(3 * n - 2);
-        uint64_t walked = 0, perLevel = 1, geometric = 0;
-        for (const ls::NodeGpu& node : tree_.nodes) walked += int(node.level) < d - 1;
-        for (int l = 0; l < d - 1; ++l, perLevel *= cells) geometric += perLevel;
-        auto clampCap = [](uint64_t v) { return uint32_t(std::clamp<uint64_t>(v, 1, UINT32_MAX)); };
-        walkCap_ = clampCap((cells + 1) * std::min(walked, geometric));
-        leafWalkCap_ = clampCap((cells + 1) * (1 + longestList));
+        tree_ = obtainTree(cpu, p_.n, p_.d, limit, useCache);
+        const StartData start = buildStartData(cpu, limit);
+        uploadPools(start, limit);
+        planeEps_ = planeEpsilon(tree_);
+        setLoopCaps(start.longestList);
         counters_.allocate();
         // The GPU holds the pools now; the CPU keeps only the node pool (start-node boxes for classify).
         tree_.tree = {};
@@ -412,6 +314,133 @@ public:
     }
 
 private:
+    /// What the start region reads besides the tree: the near field's BVH (start_region bvh), the
+    /// leaf lists (exact start region, or split leaves) and the triangles' planes (culled).
+    struct StartData {
+        ls::LeafLists lists;
+        std::vector<glm::vec4> planes; ///< culled: per scene triangle its plane (unit normal, offset)
+        uint64_t longestList = 0;      ///< triangles of the largest leaf list (exact)
+        size_t nearBytes = 0;          ///< the near field's BVH on the GPU
+    };
+
+    void freePools() {
+        tracer_.reset();
+        texels_ = {}; // the views first: a buffer texture keeps its buffer alive
+        nodesBuf_ = GlBuffer(), treeBuf_ = GlBuffer(), occBuf_ = GlBuffer(); // free the old pools first
+        for (GlBuffer& b : bitsBuf_) b = GlBuffer();
+        leafBase_ = GlBuffer(), leafPrefix_ = GlBuffer(), leafTris_ = GlBuffer(), triPlanes_ = GlBuffer(), leafSub_ = GlBuffer();
+        near_ = bvh::BvhGpu();
+    }
+
+    bool listsNeeded() const { return startMode() == ls::StartMode::Exact || leafSplit() > 1; }
+
+    StartData buildStartData(const Scene& cpu, size_t limit) {
+        StartData out;
+        // start_region bvh: bvh_raytrace's tree of the scene with its default build (SAH, leaves of 4).
+        if (startMode() == ls::StartMode::Bvh) {
+            near_ = bvh::uploadBvh(bvh::buildBvh(cpu, bvh::BuildOptions{}), limit, 0, "line_space");
+            out.nearBytes = near_.bytes();
+        }
+        if (culledStart()) out.planes = ls::trianglePlanes(cpu);
+        if (!listsNeeded()) return out;
+        out.lists = ls::buildLeafLists(cpu, tree_, 0, leafSplit());
+        for (size_t i = 1; i < out.lists.prefix.size(); ++i)
+            out.longestList = std::max<uint64_t>(out.longestList, out.lists.prefix[i] - out.lists.prefix[i - 1]);
+        // The shader numbers a leaf by the occupancy bits below it: one occupied leaf without a list
+        // (or the reverse) would shift every later list, so the two must agree exactly.
+        size_t occupied = 0;
+        const size_t words = ls::occupancyWords(p_.n);
+        for (size_t i = 0; i < tree_.nodes.size(); ++i)
+            if (int(tree_.nodes[i].level) == p_.d - 1)
+                for (size_t w = 0; w < words; ++w) occupied += size_t(std::popcount(tree_.occupancy[i * words + w]));
+        if (occupied + 1 != out.lists.prefix.size())
+            throw RuntimeError("line_space: the leaf lists (" + std::to_string(out.lists.prefix.size() - 1) +
+                               " leaves) disagree with the occupancy pool (" + std::to_string(occupied) + " leaves)");
+        return out;
+    }
+
+    static std::string mib(size_t bytes) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.1f", double(bytes) / double(1u << 20));
+        return std::string(text);
+    }
+
+    /// Node and tree pools are one SSBO each; the line-space pool is split at node boundaries over
+    /// up to LS_BIT_CHUNKS SSBOs. buildNTree() stops at these limits; a cache file written on a GPU
+    /// with a larger limit is caught here.
+    void uploadPools(const StartData& start, size_t limit) {
+        // The occupancy pool is read (and counted) only by the distance and exact start regions; the
+        // leaf lists and the scene's triangles only by the exact one.
+        const bool occupancy = readsOccupancy(), exact = startMode() == ls::StartMode::Exact;
+        const int split = leafSplit();
+        const ls::LeafLists& lists = start.lists;
+        poolBytes_ = {tree_.nodes.size() * sizeof(ls::NodeGpu), tree_.tree.size() * sizeof(uint32_t),
+                      tree_.bits.size() * sizeof(uint32_t), occupancy ? tree_.occupancy.size() * sizeof(uint32_t) : 0,
+                      (exact ? lists.bytes() + scene_->positions().size() + start.planes.size() * sizeof(glm::vec4)
+                             : listsNeeded() ? (lists.wordRank.size() + lists.sub.size()) * sizeof(uint32_t) : 0) + start.nearBytes};
+        nodesPerChunk_ = ls::nodesPerChunk(p_.n, limit);
+        const size_t words = ls::wordsPerNode(p_.n), chunks = (tree_.nodes.size() + nodesPerChunk_ - 1) / nodesPerChunk_;
+        if (poolBytes_[0] > limit || poolBytes_[1] > limit || chunks > LS_BIT_CHUNKS)
+            throw SceneRefusal("line_space: the pools of (N, d) = (" + std::to_string(p_.n) + ", " + std::to_string(p_.d) + ") need " +
+                               mib(poolBytes_[0]) + " + " + mib(poolBytes_[1]) + " + " + mib(poolBytes_[2]) +
+                               " MiB (node, tree, line space); one SSBO may hold " + mib(limit) +
+                               " MiB here (GL_MAX_SHADER_STORAGE_BLOCK_SIZE, or max_block_mib) and the line space may span " +
+                               std::to_string(LS_BIT_CHUNKS));
+        nodesBuf_ = GlBuffer::fromVector(tree_.nodes, 0);
+        treeBuf_ = GlBuffer::fromVector(tree_.tree, 0);
+        if (occupancy) occBuf_ = GlBuffer::fromVector(tree_.occupancy, 0);
+        if (exact) {
+            for (auto [what, bytes] : {std::pair{"leaf triangle lists", lists.tris.size() * sizeof(uint32_t)},
+                                       std::pair{"scene positions", scene_->positions().size()}})
+                if (bytes > limit)
+                    throw SceneRefusal(std::string("line_space: the ") + what + " of start_region exact need " + mib(bytes) +
+                                       " MiB; one SSBO may hold " + mib(limit) + " MiB here");
+            leafPrefix_ = GlBuffer::fromVector(lists.prefix, 0);
+            leafTris_ = GlBuffer::fromVector(lists.tris, 0);
+            if (culledStart()) triPlanes_ = GlBuffer::fromVector(start.planes, 0);
+        }
+        if (listsNeeded()) leafBase_ = GlBuffer::fromVector(lists.wordRank, 0);
+        if (split > 1) leafSub_ = GlBuffer::fromVector(lists.sub, 0);
+        for (size_t c = 0; c < LS_BIT_CHUNKS; ++c) {
+            // Unused chunks get a 4-byte buffer so every buffer texture the shader may declare has one.
+            const size_t first = std::min(tree_.bits.size(), c * nodesPerChunk_ * words);
+            const size_t last = std::min(tree_.bits.size(), (c + 1) * nodesPerChunk_ * words);
+            bitsBuf_[c] = GlBuffer((last - first) * sizeof(uint32_t), last > first ? tree_.bits.data() + first : nullptr, 0);
+        }
+        makeTexels(occupancy, exact, culledStart(), split > 1);
+        // The shader reads the line-space pool with one load when it is a single block; a tree that
+        // needs more blocks gets the program that picks the block per node.
+        const int usedChunks = int(std::max<size_t>(1, chunks));
+        if (usedChunks != bitChunks_) {
+            bitChunks_ = usedChunks;
+            compile();
+        }
+    }
+
+    /// A point's distance to a triangle's plane, computed in float, is off by a few units in the
+    /// last place of the coordinates (the plane's offset is of their size): 4e-5 of the largest
+    /// coordinate is ~300 of them and far below a leaf (1/343 of the scene at (7, 3)).
+    static float planeEpsilon(const ls::NTree& tree) {
+        if (tree.nodes.empty()) return 0.0f;
+        float eps = 0.0f;
+        const ls::NodeGpu& root = tree.nodes[0];
+        for (int k = 0; k < 3; ++k) eps = std::max({eps, std::abs(root.lo[k]), std::abs(root.lo[k] + root.size[k])});
+        return eps * 4e-5f;
+    }
+
+    /// The loop caps of the trace (the reasoning is at its loops): a node's DDA visits at most
+    /// 3N - 2 cells, one more pass leaves it; a ray walks each node above the last level at most
+    /// once, and at most (3N - 2)^l nodes of level l.
+    void setLoopCaps(uint64_t longestList) {
+        const uint64_t cells = uint64_t(3 * p_.n - 2);
+        uint64_t walked = 0, perLevel = 1, geometric = 0;
+        for (const ls::NodeGpu& node : tree_.nodes) walked += int(node.level) < p_.d - 1;
+        for (int l = 0; l < p_.d - 1; ++l, perLevel *= cells) geometric += perLevel;
+        auto clampCap = [](uint64_t v) { return uint32_t(std::clamp<uint64_t>(v, 1, UINT32_MAX)); };
+        walkCap_ = clampCap((cells + 1) * std::min(walked, geometric));
+        leafWalkCap_ = clampCap((cells + 1) * (1 + longestList));
+    }
+
     ShaderDefines defines(bool classify) const {
         return {{"LS_N", std::to_string(p_.n)},
                 {"LS_DEPTH", std::to_string(p_.d)},

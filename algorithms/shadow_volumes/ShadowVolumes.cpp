@@ -170,13 +170,62 @@ public:
     }
 
     void computeVisibility(const FrameInputs& f) override {
-        const bool zfail = p_.method == SvMethod::Zfail, analytic = p_.depthTest == SvDepthTest::Analytic;
-        const float offset = rayOffsetLength(p_.rayOffset, *scene_);
-        const unsigned triangles = unsigned(scene_->triangleCount());
         counters_.clear();
         scene_->bindStorage();
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_COUNTER_BINDING);
+        findSilhouettes(f);
+        drawVolumes(f);
+        resolve(f);
+        traceCloseCalls(f);
+        counters_.markStale();
+        zfailLast_ = p_.method == SvMethod::Zfail;
+    }
 
+    std::vector<Counter> counters() const override {
+        const auto& c = counters_.read();
+        std::vector<Counter> out = {{"silhouette_edges", double(c[SV_C_SILHOUETTES])},
+                                    {"silhouette_quads", double(c[SV_C_QUADS])},
+                                    {"cap_triangles", zfailLast_ ? 2.0 * double(scene_->triangleCount()) : 0.0},
+                                    {"close_call_pixels", double(c[SV_C_CLOSE_PIXELS])},
+                                    {"stencil_wrapped_pixels", double(c[SV_C_WRAPPED])},
+                                    {"loop_capped_pixels", double(c[SV_C_CUT_LOOPS])},
+                                    {"stack_overflow_pixels", double(c[SV_C_STACK_OVERFLOW])},
+                                    {"eye_in_volumes", double(c[SV_C_EYE])},
+                                    {"inconsistent_pixels", double(c[SV_C_INCONSISTENT])},
+                                    {"open_edges", double(openEdges_)},
+                                    {"non_manifold_edges", double(nonManifold_)},
+                                    {"max_triangles_per_edge", double(maxSides_)},
+                                    {"subpixel_bits", double(subpixelBits_)}};
+        if (options_.statistics) {
+            const double pixels = double(resolution_.x) * double(resolution_.y);
+            const double fragments = double(counters_.wide(SV_C_FRAGMENTS_LO));
+            const double close = double(c[SV_C_CLOSE_PIXELS]);
+            out.push_back({"volume_fragments", fragments});
+            out.push_back({"fill_per_pixel", pixels > 0 ? fragments / pixels : 0.0});
+            out.push_back({"close_call_tests_mean", close > 0 ? double(counters_.wide(SV_C_CLOSE_TESTS_LO)) / close : 0.0});
+            out.push_back({"lit_pixels", double(c[SV_C_LIT])});
+        }
+        return out;
+    }
+    std::vector<DebugView> debugViews() const override {
+        if (!options_.statistics) return {};
+        return {{"close_calls", closeView_.id(), 1.0f, "decided by the ray"}, {"volume_count", countView_.id(), 0.0f, "volumes"}};
+    }
+    size_t memoryBytes() const override {
+        const size_t pixels = size_t(resolution_.x) * size_t(resolution_.y);
+        return sides_.size() + first_.size() + facing_.size() + records_.size() + draw_.size() + counters_.size() +
+               bvh_.gpu().bytes() + pixels * (8 + 4 + 4 + 4 + 4); // depth-stencil, count, other side, close-call image and list
+    }
+    uint64_t overflowCount() const override {
+        const auto& c = counters_.read();
+        return uint64_t(c[SV_C_RECORD_OVERFLOW]) + c[SV_C_WRAPPED] + c[SV_C_CUT_LOOPS] + c[SV_C_STACK_OVERFLOW];
+    }
+
+private:
+    /// Each triangle's facing, then the silhouette edges (with their multiplicity) written as the
+    /// indirect draw's quads; with the analytic ZFAIL check, the volumes holding the eye.
+    void findSilhouettes(const FrameInputs& f) {
+        const unsigned triangles = unsigned(scene_->triangleCount());
         f.timer.begin("silhouettes");
         const uint32_t command[4] = {6u, 0u, 0u, 0u};
         glNamedBufferSubData(draw_.id(), 0, sizeof(command), command);
@@ -205,10 +254,15 @@ public:
         }
         glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
         f.timer.end();
+    }
 
+    /// The stencil (and count) targets cleared, the G-buffer bound, with the hardware depth test
+    /// its depth buffer written, and the volumes drawn: one stage.
+    void drawVolumes(const FrameInputs& f) {
+        const bool zfail = p_.method == SvMethod::Zfail, analytic = p_.depthTest == SvDepthTest::Analytic;
+        const float offset = rayOffsetLength(p_.rayOffset, *scene_);
+        const unsigned triangles = unsigned(scene_->triangleCount());
         const glm::ivec2 r = f.gbuffer.resolution();
-        // The targets cleared, the G-buffer bound, with the hardware depth test its depth buffer
-        // written, and the volumes drawn: one stage.
         f.timer.begin("volumes");
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
         glViewport(0, 0, r.x, r.y);
@@ -272,7 +326,11 @@ public:
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
         f.timer.end();
+    }
 
+    /// Each pixel's count read: shadowed, lit, or listed as a close call.
+    void resolve(const FrameInputs& f) {
+        const float offset = rayOffsetLength(p_.rayOffset, *scene_);
         f.timer.begin("resolve");
         glBindTextureUnit(SV_STENCIL_UNIT, depthStencil_.id());
         glBindTextureUnit(SV_COUNT_UNIT, count_.id());
@@ -287,8 +345,11 @@ public:
         if (options_.statistics) runPixelPass(f, resolvePass_, {&closeView_, &countView_});
         else runPixelPass(f, resolvePass_, {});
         f.timer.end();
+    }
 
-        // The close calls: one ray each through the BVH, an indirect dispatch sized by the list.
+    /// The close calls: one ray each through the BVH, an indirect dispatch sized by the list.
+    void traceCloseCalls(const FrameInputs& f) {
+        const float offset = rayOffsetLength(p_.rayOffset, *scene_);
         f.timer.begin("close_calls");
         bindPixelPassInputs(f);
         bvh_.gpu().bind(SV_BVH_NODE_UNIT, SV_BVH_TRI_UNIT);
@@ -299,51 +360,8 @@ public:
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         finishPixelPass();
         f.timer.end();
-        counters_.markStale();
-        zfailLast_ = zfail;
     }
 
-    std::vector<Counter> counters() const override {
-        const auto& c = counters_.read();
-        std::vector<Counter> out = {{"silhouette_edges", double(c[SV_C_SILHOUETTES])},
-                                    {"silhouette_quads", double(c[SV_C_QUADS])},
-                                    {"cap_triangles", zfailLast_ ? 2.0 * double(scene_->triangleCount()) : 0.0},
-                                    {"close_call_pixels", double(c[SV_C_CLOSE_PIXELS])},
-                                    {"stencil_wrapped_pixels", double(c[SV_C_WRAPPED])},
-                                    {"loop_capped_pixels", double(c[SV_C_CUT_LOOPS])},
-                                    {"stack_overflow_pixels", double(c[SV_C_STACK_OVERFLOW])},
-                                    {"eye_in_volumes", double(c[SV_C_EYE])},
-                                    {"inconsistent_pixels", double(c[SV_C_INCONSISTENT])},
-                                    {"open_edges", double(openEdges_)},
-                                    {"non_manifold_edges", double(nonManifold_)},
-                                    {"max_triangles_per_edge", double(maxSides_)},
-                                    {"subpixel_bits", double(subpixelBits_)}};
-        if (options_.statistics) {
-            const double pixels = double(resolution_.x) * double(resolution_.y);
-            const double fragments = double(counters_.wide(SV_C_FRAGMENTS_LO));
-            const double close = double(c[SV_C_CLOSE_PIXELS]);
-            out.push_back({"volume_fragments", fragments});
-            out.push_back({"fill_per_pixel", pixels > 0 ? fragments / pixels : 0.0});
-            out.push_back({"close_call_tests_mean", close > 0 ? double(counters_.wide(SV_C_CLOSE_TESTS_LO)) / close : 0.0});
-            out.push_back({"lit_pixels", double(c[SV_C_LIT])});
-        }
-        return out;
-    }
-    std::vector<DebugView> debugViews() const override {
-        if (!options_.statistics) return {};
-        return {{"close_calls", closeView_.id(), 1.0f, "decided by the ray"}, {"volume_count", countView_.id(), 0.0f, "volumes"}};
-    }
-    size_t memoryBytes() const override {
-        const size_t pixels = size_t(resolution_.x) * size_t(resolution_.y);
-        return sides_.size() + first_.size() + facing_.size() + records_.size() + draw_.size() + counters_.size() +
-               bvh_.gpu().bytes() + pixels * (8 + 4 + 4 + 4 + 4); // depth-stencil, count, other side, close-call image and list
-    }
-    uint64_t overflowCount() const override {
-        const auto& c = counters_.read();
-        return uint64_t(c[SV_C_RECORD_OVERFLOW]) + c[SV_C_WRAPPED] + c[SV_C_CUT_LOOPS] + c[SV_C_STACK_OVERFLOW];
-    }
-
-private:
     /// The rasteriser's subpixel precision (GL_SUBPIXEL_BITS; GL guarantees 4, today's GPUs and
     /// llvmpipe have 8). The test fault SHADOWLAB_FAULT_SUBPIXEL_BITS stands for a device with 4.
     static int subpixelBits() {
