@@ -7,6 +7,7 @@
 #include "tests/SweepTestData.h"
 #include "tests/TestSupport.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -407,6 +408,45 @@ TEST(HistoryTest, NeitherHistoryNorCompareReplacesARunItReads) {
     }
     const std::string report = test::makeTempDir("history-report") + "/cmp";
     for (int i = 0; i < 2; ++i) EXPECT_EQ(test::runArgs({SHADOWLAB_BINARY, "compare", a, b, "--out", report, "--force"}).rc, 0);
+}
+
+// Twenty-first probe: a full standard output was said twice (the command's error, then the
+// program's check of the same stream); one line, exit 2, as every other command.
+TEST(HistoryTest, AFullStandardOutputIsOneLine) {
+    const std::string dir = test::makeTempDir("history-full");
+    writeRuns(dir, std::vector<double>(3, 20.0), std::vector<double>(3, 0.0), kSpread);
+    const std::string bin = SHADOWLAB_BINARY;
+    for (const std::string& command : {bin + " history " + dir, bin + " compare " + dir + "/run-99 " + dir + "/run-100"}) {
+        std::string out;
+        EXPECT_EQ(test::runCommand("{ " + command + " > /dev/full; }", out), 2) << command << "\n" << out; // stderr kept
+        const std::string trimmed = out.substr(0, out.find_last_not_of('\n') + 1);
+        EXPECT_EQ(std::count(trimmed.begin(), trimmed.end(), '\n'), 0) << command << "\n" << out;
+        EXPECT_NE(out.find("standard output"), std::string::npos) << out;
+    }
+}
+
+// Twenty-first probe: sweep merge tabulated a negative and a 309-digit stage time, and
+// multiplied a tampered resolution into a wrapped (or zero) pixel count. What compare, history and
+// merge read is held to what a run writes.
+TEST(HistoryTest, ATimeOrResolutionNoRunWritesIsBadInput) {
+    const std::vector<std::pair<std::function<void(Json&)>, std::string>> edits = {
+        {[](Json& s) { s["algorithms"]["psv"]["time_ms"]["total"]["mean"] = -5.0; }, "/algorithms/psv/time_ms/total/mean"},
+        {[](Json& s) { s["algorithms"]["psv"]["time_ms"]["total"]["mean"] = 1e308; }, "/algorithms/psv/time_ms/total/mean"},
+        {[](Json& s) { s["algorithms"]["psv"]["counters"] = {{"nodes", {{"mean", 1e300}}}}; }, "/algorithms/psv/counters/nodes/mean"},
+        {[](Json& s) { s["resolution"] = Json::array({8589934593ull, 2147483648ull}); }, "/resolution"},
+        {[](Json& s) { s["resolution"] = Json::array({0, 0}); }, "/resolution"},
+    };
+    for (const auto& [change, path] : edits) {
+        const std::string dir = test::makeTempDir("history-bad-number");
+        writeRuns(dir, {20, 20}, {0, 0}, kSpread);
+        Json s = Json::parse(std::ifstream(dir + "/run-99/summary.json"));
+        change(s);
+        std::ofstream(dir + "/run-99/summary.json") << s.dump();
+        const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "compare", dir + "/run-100", dir + "/run-99"});
+        EXPECT_EQ(ran.rc, 2) << path << ": " << ran.err;
+        EXPECT_NE(ran.err.find(path), std::string::npos) << ran.err;
+        EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
+    }
 }
 
 } // namespace

@@ -37,6 +37,11 @@ std::vector<BadCase> badCases() {
         {"ConfigNestedTwentyThousandDeep", "c.json", configWith({{"name", deep}}), {"/name/", "nesting deeper than 64"}},
         {"LightBeyondFloat", "c.json", configWith({{"light", R"({"position": [1e39, 4, 2]})"}}), {"/light/position", "float"}},
         {"LightAt1e30", "c.json", configWith({{"light", R"({"position": [1e30, 4, 2]})"}}), {"/light/position", "1e15"}},
+        // Twenty-first probe: a triangle whose edges are too long for its normal in float was called
+        // collinear; the error names the cause.
+        {"MeshEdgesTooLongForFloat", "c.json",
+         configWith({{"scene", R"({"objects": [{"procedural": "mesh", "vertices": [[0, 1, 0], [1e15, 1, 0], [0, 1, 1e15]]}]})"}}),
+         {"/scene/objects/0/vertices/0", "too long for float"}},
         // Ninth probe: a 0.001-unit triangle of a moving mesh lost its area where its path took it
         // (x = 1e5, frame 1), and the run went on without it; placed there statically it is refused.
         // Tenth probe: exact algorithms drew opaque shadows under a caster of opacity 0, which the
@@ -74,6 +79,13 @@ std::vector<BadCase> badCases() {
              {"procedural": "mesh", "vertices": [[-1, 0, -0.5], [1, 0, -0.5], [1, 1.5, -0.5], [-1, 0, -0.5], [1, 1.5, -0.5], [-1, 1.5, -0.5]]}]})"},
                      {"light", R"({"position": [0.3, 1.0, -0.5000001]})"}}),
          {"/light/position", "from triangle 3", "frame 0", "1.25 x the ray offset"}},
+        // Twenty-first probe: keys within ±1e15 whose spline overshoots them (the light at 1.19e15 on a
+        // sampled frame) validated and ran.
+        {"LightPathOvershootsTheCoordinateBound", "c.json",
+         configWith({{"light", R"({"path": {"keyframes": [{"time": 0, "position": [0, 4, 0]}, {"time": 1, "position": [1e15, 4, 0]},
+             {"time": 2, "position": [1e15, 4, 0]}, {"time": 3, "position": [-1e15, 4, 0]}]}})"},
+                     {"frames", "31"}}),
+         {"/light/path", "beyond ±1e15", "frame"}},
         {"LightPathOntoTheGround", "c.json",
          configWith({{"light", R"({"type": "spot", "target": [0, 0, 0], "path": {"keyframes": [
              {"time": 0, "position": [0, 4, 0]}, {"time": 1, "position": [0.5, 0, 0.5]}]}})"},

@@ -213,6 +213,31 @@ TEST(SweepInputTest, EmptyOutIsRefusedAndNothingIsCreated) {
     EXPECT_EQ(runArgs(sweep({"merge", ""})).rc, 2);
 }
 
+// Twenty-first probe: `sweep plan` called every config valid for output folders `sweep run` then
+// refused (a run's output, a file, a folder of the user's): plan checks the folder as run does.
+TEST(SweepInputTest, PlanRefusesTheOutputFoldersRunRefuses) {
+    const std::string dir = test::makeTempDir("sweep-plan-out");
+    fs::create_directories(dir + "/a_run");
+    std::ofstream(dir + "/a_run/summary.json") << "{}";
+    std::ofstream(dir + "/a_file") << "x";
+    fs::create_directories(dir + "/mine");
+    std::ofstream(dir + "/mine/notes.txt") << "mine";
+    for (const char* out : {"a_run", "a_file", "mine"}) {
+        const std::string file = smallFile(dir, {{"output", {{"dir", dir + "/" + out}}}});
+        const Ran plan = runArgs(sweep({"plan", file}));
+        EXPECT_EQ(plan.rc, 2) << out << ": " << plan.err;
+        EXPECT_NE(plan.err.find("/output/dir"), std::string::npos) << plan.err;
+        expectOneShortLine(plan);
+        EXPECT_EQ(runArgs(sweep({"run", file})).rc, 2) << out << ": what plan refuses, run refuses";
+    }
+    // Another sweep's folder: run would refuse to mix its runs with that sweep's.
+    ASSERT_FALSE(test::fakeSweepRuns(kBin, smallFile(dir), dir + "/theirs").is_null());
+    const Ran other = runArgs(sweep({"plan", smallFile(dir, {{"name", "another"}, {"output", {{"dir", dir + "/theirs"}}}})}));
+    EXPECT_EQ(other.rc, 2) << other.err;
+    EXPECT_NE(other.err.find("holds another sweep"), std::string::npos) << other.err;
+    EXPECT_EQ(runArgs(sweep({"plan", smallFile(dir, {{"output", {{"dir", dir + "/new"}}}})})).rc, 0);
+}
+
 TEST(SweepInputTest, RelativeGltfInAnAxisValueIsTheSweepFilesNeighbour) {
     const std::string dir = test::makeTempDir("sweep-gltf"), models = dir + "/models";
     fs::create_directories(models);
@@ -332,6 +357,27 @@ TEST(SweepMergeEdgeTest, TheReportScriptGetsTheFolderAsAnArgument) {
     EXPECT_FALSE(fs::exists(dir + "/X"));
     EXPECT_TRUE(fs::exists(out + "/sweep.md"));
     EXPECT_TRUE(fs::exists(out + "/sweep_tris.png"));
+}
+
+// Twenty-first probe: a link planted at sweep.csv was refused with exit 2 and one line, the same
+// link at sweep.md with exit 1 and two lines (the script's refusal reported as its failure). Both
+// are the same bad input; neither file behind the link is touched.
+TEST(SweepMergeEdgeTest, ALinkAtAReportFileIsRefusedLikeOneAtTheTable) {
+    const std::string dir = test::makeTempDir("merge-link");
+    const std::string out = dir + "/sw";
+    ASSERT_FALSE(test::fakeSweepRuns(kBin, smallFile(dir), out).is_null());
+    std::ofstream(dir + "/victim.txt") << "keep";
+    for (const char* name : {"sweep.csv", "sweep.md", "sweep.html"}) {
+        fs::remove(out + "/" + name);
+        fs::create_symlink(dir + "/victim.txt", out + "/" + name);
+        const Ran r = runArgs(sweep({"merge", out, "--no-plots"}));
+        EXPECT_EQ(r.rc, 2) << name << ": " << r.err;
+        expectOneShortLine(r);
+        EXPECT_NE(r.err.find(std::string(name) + ": "), std::string::npos) << r.err;
+        fs::remove(out + "/" + name);
+        std::ifstream victim(dir + "/victim.txt");
+        EXPECT_EQ(std::string(std::istreambuf_iterator<char>(victim), {}), "keep") << name;
+    }
 }
 
 /// Sweeps that plan accepts at the edges of what it accepts; the report must take each of them.

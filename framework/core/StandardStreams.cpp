@@ -1,5 +1,7 @@
 #include "framework/core/StandardStreams.h"
 
+#include "framework/core/Error.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -21,10 +23,23 @@ void reopenClosedStandardStreams() {
         }
 }
 
+namespace {
+bool failureReported = false; ///< writeStandardOutput() already said the stream cannot be written
+} // namespace
+
+void writeStandardOutput(const std::string& text) {
+    std::cout << text;
+    std::cout.flush();
+    if (std::cout) return;
+    failureReported = true;
+    throw InputError("standard output", "", "cannot be written (a full disk or a closed stream)");
+}
+
 int checkStandardOutput(const char* program, int rc) {
     std::cout.flush();
     errno = 0;
     if (std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good()) return rc;
+    if (failureReported) return rc == 0 ? 2 : rc;
     std::fprintf(stderr, "%s: error: standard output: cannot write what the command printed (%s)\n", program,
                  errno ? std::strerror(errno) : "write error");
     return rc == 0 ? 2 : rc;

@@ -43,15 +43,44 @@ bool isUtcTimestamp(const Json& j) {
 } // namespace
 
 namespace {
+/// Counts and counters a run writes stay below 2^64 (1.8e19).
+constexpr double kMaxRunNumber = 1e20;
+
 /// Every leaf of `j` is a number (or null): else bad input, naming its JSON path.
 void checkNumbersOnly(const Json& j, const std::string& file, const std::string& path) {
     if (j.is_object() || j.is_array()) {
         size_t i = 0;
         for (auto it = j.begin(); it != j.end(); ++it, ++i)
             checkNumbersOnly(*it, file, path + "/" + (j.is_object() ? shortText(it.key(), 60) : std::to_string(i)));
-    } else if (!j.is_number() && !j.is_null()) {
-        throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a number");
+    } else if (!j.is_null() && !(j.is_number() && std::abs(j.get<double>()) <= kMaxRunNumber)) {
+        throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a number (of at most 1e20)");
     }
+}
+
+/// A time in ms a run measured: null (not measured) or finite, 0 or more, below 1e12 (30 years)
+/// (twenty-first probe: sweep merge tabulated -5 and a 309-digit time).
+void checkTime(const Json& j, const std::string& file, const std::string& path) {
+    if (!j.is_null() && !(j.is_number() && j.get<double>() >= 0 && j.get<double>() <= 1e12))
+        throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a time in ms (0 to 1e12)");
+}
+
+/// Every time of one algorithm entry: the stage statistics, the frames' totals, the repetitions'.
+void checkTimes(const Json& entry, const std::string& file, const std::string& at) {
+    for (const char* key : {"time_ms", "cpu_time_ms"})
+        if (entry.contains(key) && entry[key].is_object())
+            for (const auto& [stage, stats] : entry[key].items())
+                if (stats.is_object())
+                    for (const auto& [stat, v] : stats.items())
+                        checkTime(v, file, at + "/" + key + "/" + shortText(stage, 60) + "/" + shortText(stat, 60));
+    if (entry.contains("total_ms_per_frame") && entry["total_ms_per_frame"].is_array())
+        for (size_t i = 0; i < entry["total_ms_per_frame"].size(); ++i)
+            checkTime(entry["total_ms_per_frame"][i], file, at + "/total_ms_per_frame/" + std::to_string(i));
+    if (entry.contains("repetitions") && entry["repetitions"].is_object() && entry["repetitions"].contains("time_ms") &&
+        entry["repetitions"]["time_ms"].is_object())
+        for (const auto& [stage, times] : entry["repetitions"]["time_ms"].items())
+            if (times.is_array())
+                for (size_t i = 0; i < times.size(); ++i)
+                    checkTime(times[i], file, at + "/repetitions/time_ms/" + shortText(stage, 60) + "/" + std::to_string(i));
 }
 
 /// A count: an integer, 0 or more (1e30, -1 and 0.5 are no run's).
@@ -123,6 +152,19 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
             throw InputError(file, "/build", "is not a run's build record ({\"commit\": text, \"dirty\": true or false})");
     }
     if (s.contains("triangles")) checkCount(s["triangles"], file, "/triangles");
+    // Each side what a config may ask (twenty-first probe: sweep merge multiplied 2^33 + 1 by 2^31
+    // into a wrapped pixel count, and took 0 x 0).
+    if (s.contains("resolution")) {
+        const Json& r = s["resolution"];
+        const auto side = [](const Json& v) {
+            return v.is_number_unsigned() && v.get<uint64_t>() >= uint64_t(configlimits::kResolutionMin) &&
+                   v.get<uint64_t>() <= uint64_t(configlimits::kResolutionMax);
+        };
+        if (!r.is_array() || r.size() != 2 || !side(r[0]) || !side(r[1]))
+            throw InputError(file, "/resolution", "holds " + shortText(r.dump(), 40) + " where a run writes [width, height] of " +
+                                                      std::to_string(configlimits::kResolutionMin) + " to " +
+                                                      std::to_string(configlimits::kResolutionMax) + " pixels each");
+    }
     for (const auto& [id, entry] : s["algorithms"].items()) {
         const std::string at = "/algorithms/" + shortText(id, 60);
         // Ids reach file names, tables and JUnit classnames (eleventh probe: control characters
@@ -148,9 +190,10 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
             if (entry.contains(key)) checkCount(entry[key], file, at + "/" + key);
         if (entry.contains("accuracy")) checkAccuracy(entry["accuracy"], file, at + "/accuracy");
         // A time a run measured is finite and not negative (fourteenth probe: sweep merge tabulated -3).
-        if (entry.contains("preprocess_ms") &&
-            !(entry["preprocess_ms"].is_number() && entry["preprocess_ms"].get<double>() >= 0 && std::isfinite(entry["preprocess_ms"].get<double>())))
+        if (entry.contains("preprocess_ms") && !entry["preprocess_ms"].is_number())
             throw InputError(file, at + "/preprocess_ms", "is not a time a run writes (finite, 0 or more)");
+        if (entry.contains("preprocess_ms")) checkTime(entry["preprocess_ms"], file, at + "/preprocess_ms");
+        checkTimes(entry, file, at);
     }
 }
 } // namespace

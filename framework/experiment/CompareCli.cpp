@@ -1,6 +1,7 @@
 #include "framework/experiment/CompareCli.h"
 
 #include "framework/core/Error.h"
+#include "framework/core/StandardStreams.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/Interrupt.h"
 #include "framework/core/Text.h"
@@ -100,12 +101,6 @@ bool sharedOption(const std::vector<std::string>& args, size_t& i, double& thres
         return false;
     }
     return true;
-}
-
-void writeStandardOutput(const std::string& text) {
-    std::cout << text;
-    std::cout.flush();
-    if (!std::cout) throw InputError("standard output", "", "cannot be written (a full disk or a closed stream)");
 }
 
 } // namespace

@@ -66,6 +66,11 @@ void checkViews(const ExperimentConfig& c, JsonNode& camera, JsonNode& light) {
         float len = glm::length(d);
         return !(len > 0.0f) || !std::isfinite(len) || !std::isfinite(glm::length(d / len));
     };
+    auto beyond = [](glm::vec3 p) {
+        for (int a = 0; a < 3; ++a)
+            if (!(std::abs(double(p[a])) <= kMaxCoordinate)) return true; // NaN too
+        return false;
+    };
     auto where = [&](const Path& path, int frame) {
         return path.empty() ? std::string() : " at frame " + std::to_string(frame) + " of its path";
     };
@@ -74,7 +79,15 @@ void checkViews(const ExperimentConfig& c, JsonNode& camera, JsonNode& light) {
         if (degenerate(cam.position, cam.target))
             (c.cameraPath.empty() ? camera.fail("target", "the camera's target equals its position")
                                   : camera.fail("path", "the camera's target equals its position" + where(c.cameraPath, f)));
+        // A spline between keyframes within ±1e15 can overshoot them (twenty-first probe: keys 0,
+        // 1e15, 1e15, -1e15 put the light at 1.19e15): held to the same bound at every frame.
+        if (!c.cameraPath.empty() && (beyond(cam.position) || beyond(cam.target)))
+            camera.fail("path", "the camera's path reaches beyond ±1e15 scene units" + where(c.cameraPath, f) +
+                                    " (its spline overshoots the keyframes there)");
         Light l = c.lightAt(f);
+        if (!c.lightPath.empty() && (beyond(l.position) || beyond(l.target)))
+            light.fail("path", "the light's path reaches beyond ±1e15 scene units" + where(c.lightPath, f) +
+                                   " (its spline overshoots the keyframes there)");
         if (l.type != LightType::Point && degenerate(l.position, l.target))
             (c.lightPath.empty()
                  ? light.fail("target", "must differ from position (it sets the light's direction)")

@@ -245,9 +245,14 @@ Builder parseMesh(JsonNode& node, const Material& m, int budget) {
     for (size_t t = 0; t < triangles.size(); ++t) {
         glm::vec3 n;
         const glm::ivec3 i = triangles[t];
-        if (!unitNormal(vertices[size_t(i.x)], vertices[size_t(i.y)], vertices[size_t(i.z)], n))
-            node.fail(indexed ? "indices/" + std::to_string(t) : "vertices/" + std::to_string(3 * t),
-                      "triangle " + std::to_string(t) + " has no area at float precision (its vertices are collinear or repeated)");
+        const glm::vec3 &a = vertices[size_t(i.x)], &b = vertices[size_t(i.y)], &c = vertices[size_t(i.z)];
+        if (unitNormal(a, b, c, n)) continue;
+        // Two causes, told apart (twenty-first probe: edges of 1e15 were called collinear).
+        const bool overflows = !std::isfinite(glm::length(glm::cross(b - a, c - a)));
+        node.fail(indexed ? "indices/" + std::to_string(t) : "vertices/" + std::to_string(3 * t),
+                  "triangle " + std::to_string(t) +
+                      (overflows ? " has edges too long for float (past about 1e9 units its normal's length overflows)"
+                                 : " has no area at float precision (its vertices are collinear or repeated)"));
     }
     checkWrittenShapes(node, vertices, triangles, indexed);
     const size_t count = triangles.size();

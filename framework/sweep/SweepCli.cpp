@@ -147,6 +147,15 @@ int plan(const std::vector<std::string>& args) {
     Args a = parseArgs(args, {}, {"--json", "--check"});
     if (a.help) return printUsage("plan");
     const Sweep s = loadSweep(one(a, "sweep file", "plan"));
+    // The output folder as `sweep run` checks it before writing (twenty-first probe: plan called
+    // "/", a run's output or a folder of the user's valid, and run refused them).
+    const std::string folder = snapshotFolder(s);
+    try {
+        checkSweepFolder(folder);
+        checkSweepSnapshot(s, folder);
+    } catch (const InputError& e) {
+        throw InputError(shortText(s.file, 300), "/output/dir", "\"" + shortText(folder, 200) + "\": " + e.cause());
+    }
     const bool checked = a.options.count("--check") > 0;
     if (checked)
         if (const std::string why = checkSweepRuns(s, selfBinary()); !why.empty()) throw InputError(s.file, "", why);
@@ -167,7 +176,7 @@ int plan(const std::vector<std::string>& args) {
     // Without --check only the configs are checked: said so, as a run can still be refused on its scene.
     std::fprintf(stderr, "%s: %zu runs, %s; output %s\n", shortText(s.file, 300).c_str(), s.runs.size(),
                  checked ? "each validated on this device" : "every config valid (--check also validates each run's memory plan and scene)",
-                 shortText(s.outputDir, 300).c_str());
+                 shortText(folder, 300).c_str());
     return 0;
 }
 

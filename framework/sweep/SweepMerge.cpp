@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <set>
 #include <sstream>
+#include <sys/statvfs.h>
 
 namespace shadowlab {
 
@@ -213,9 +214,19 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
         }
         while (!tail.empty() && tail.back() == '\n') tail.pop_back();
         const size_t nl = tail.find_last_of('\n');
+        const std::string last = shortText(nl == std::string::npos ? tail : tail.substr(nl + 1), 300);
+        // Exit 2 is the scripts' refusal of a path that is not a regular file (scripts/safe_files.py):
+        // bad input, said once, as the same refusal of sweep.csv is (twenty-first probe: exit 1 and
+        // two lines for sweep.md, exit 2 and one for sweep.csv).
+        if (rc == 2) throw InputError(shortText(dir, 300), "", "the report was refused: " + last + "; sweep.csv is complete");
+        // A full disk is a failed write with a reason, not an empty one (the script may have had no
+        // room to say anything).
+        struct statvfs disk {};
+        if (::statvfs(dir.c_str(), &disk) == 0 && uint64_t(disk.f_bavail) * uint64_t(disk.f_frsize) < (uint64_t(1) << 20))
+            throw RuntimeError("the disk holding " + shortText(dir, 300) + " is full: the report could not be written; sweep.csv is complete");
         std::fprintf(stderr, "sweep merge: the report script failed (%s): %s; sweep.csv is complete (log: %s)\n",
                      rc < 0 ? "it could not start, or died of a signal" : ("exit code " + std::to_string(rc)).c_str(),
-                     shortText(nl == std::string::npos ? tail : tail.substr(nl + 1), 300).c_str(), shortText(log, 300).c_str());
+                     last.empty() ? "it printed nothing" : last.c_str(), shortText(log, 300).c_str());
     }
     return r;
 }

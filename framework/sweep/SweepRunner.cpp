@@ -68,6 +68,17 @@ std::string describeStatus(int status) {
 
 /// DIR and DIR/runs, made where absent; InputError where something else than a folder is there.
 void makeFolders(const std::string& outputDir) {
+    checkSweepFolder(outputDir);
+    for (const std::string& d : {outputDir, outputDir + "/runs"}) {
+        std::error_code ec;
+        fs::create_directories(d, ec);
+        if (ec) throw InputError(shortText(d, 300), "", "cannot create the folder: " + ec.message());
+    }
+}
+
+} // namespace
+
+void checkSweepFolder(const std::string& outputDir) {
     if (outputDir.empty()) throw InputError("--out", "", "the output folder must not be empty");
     // A run's output is not a sweep's folder: writing runs/ and plan.json into it would leave a
     // mixture that neither a run's --force nor a sweep can use. Inside a run's output or another
@@ -81,12 +92,8 @@ void makeFolders(const std::string& outputDir) {
         std::error_code ec;
         const fs::file_status st = fs::status(d, ec);
         if (fs::exists(st) && !fs::is_directory(st)) throw InputError(shortText(d, 300), "", "is not a folder (the sweep's output folder goes there)");
-        fs::create_directories(d, ec);
-        if (ec) throw InputError(shortText(d, 300), "", "cannot create the folder: " + ec.message());
     }
 }
-
-} // namespace
 
 RunPaths::RunPaths(const std::string& outputDir, const std::string& id)
     : id(id), dir(outputDir + "/runs/" + id), config(dir + ".config.json"), log(dir + ".log"), error(dir + ".error.json"),
@@ -152,33 +159,36 @@ bool RunPaths::expectationsFailed() const {
 
 std::string selfBinary() { return fs::read_symlink("/proc/self/exe").string(); }
 
+bool checkSweepSnapshot(const Sweep& sweep, const std::string& outputDir) {
+    const std::string path = outputDir + "/sweep.json";
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(path, ec))) return false;
+    Json old;
+    try {
+        old = JsonNode::parseFile(path);
+    } catch (const InputError& e) {
+        throw InputError(shortText(path, 300), "", e.cause() + " (not a sweep's snapshot: remove it, or choose another --out)");
+    }
+    // The same sweep, whatever folder it was written from: resume. Another one: refuse, since
+    // replacing sweep.json would make the runs already there belong to a sweep they are not of.
+    Json a = old, b = sweep.snapshot(outputDir);
+    if (a.is_object()) a.erase("output");
+    b.erase("output");
+    if (a != b) {
+        const std::string oldName = old.is_object() && old.contains("name") && old["name"].is_string() ? old["name"].get<std::string>() : "?";
+        throw InputError(shortText(path, 300), "",
+                         "holds another sweep (\"" + shortText(oldName, 60) + "\") than " + shortText(sweep.file, 200) + " (\"" +
+                             shortText(sweep.name, 60) + "\"): choose another --out, or remove " + shortText(path, 200) +
+                             " to give the folder to the new sweep (its complete runs with equal ids are kept)");
+    }
+    return true;
+}
+
 void writeSweepSnapshot(const Sweep& sweep, const std::string& outputDir) {
     makeFolders(outputDir);
     const std::string path = outputDir + "/sweep.json";
-    const Json snapshot = sweep.snapshot(outputDir);
-    const std::string text = snapshot.dump(2) + "\n";
-    std::error_code ec;
-    if (fs::exists(fs::symlink_status(path, ec))) {
-        Json old;
-        try {
-            old = JsonNode::parseFile(path);
-        } catch (const InputError& e) {
-            throw InputError(shortText(path, 300), "", e.cause() + " (not a sweep's snapshot: remove it, or choose another --out)");
-        }
-        // The same sweep, whatever folder it was written from: resume. Another one: refuse, since
-        // replacing sweep.json would make the runs already there belong to a sweep they are not of.
-        Json a = old, b = snapshot;
-        if (a.is_object()) a.erase("output");
-        b.erase("output");
-        if (a != b) {
-            const std::string oldName = old.is_object() && old.contains("name") && old["name"].is_string() ? old["name"].get<std::string>() : "?";
-            throw InputError(shortText(path, 300), "",
-                             "holds another sweep (\"" + shortText(oldName, 60) + "\") than " + shortText(sweep.file, 200) + " (\"" +
-                                 shortText(sweep.name, 60) + "\"): choose another --out, or remove " + shortText(path, 200) +
-                                 " to give the folder to the new sweep (its complete runs with equal ids are kept)");
-        }
-        if (readInputFile(path) == text) return;
-    }
+    const std::string text = sweep.snapshot(outputDir).dump(2) + "\n";
+    if (checkSweepSnapshot(sweep, outputDir) && readInputFile(path) == text) return;
     writeFileAtomic(path, text);
 }
 

@@ -39,6 +39,14 @@ struct RunPaths {
 /// same sweep). DIR must be a folder or absent (then it is made).
 void writeSweepSnapshot(const Sweep& sweep, const std::string& outputDir);
 
+/// The checks `sweep run` makes of its output folder before writing anything (`sweep plan` makes
+/// them too): not empty, not a run's output, not inside a run's output or another sweep, not a
+/// folder of the user's (OutputPlace::checkSweepPlace), and no file where DIR or DIR/runs go.
+void checkSweepFolder(const std::string& outputDir);
+/// Whether DIR/sweep.json is there (false: a new folder); InputError when it is not this sweep's
+/// snapshot (another sweep's runs are there).
+bool checkSweepSnapshot(const Sweep& sweep, const std::string& outputDir);
+
 /// Runs the selected runs that are not complete and prints a line per run on stderr. A failed run
 /// leaves DIR/runs/ID.error.json and the others go on. Returns the exit code: 0 when every
 /// selected run is complete, 1 when one failed, 2 when one was being run by another sweep process,
