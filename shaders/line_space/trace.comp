@@ -210,6 +210,12 @@ bool sampleRay(vec3 o, int s, bool directional, out Ray r) {
     return true;
 }
 
+// `cur` walks the children of the node on level `level`; its ancestors' walks wait in parent0..2
+// (only LS_PARENTS of them are used). Per invocation, set once and reused by every ray: each ray's
+// walk sets `cur` before reading it and pushes a parent before popping it.
+Frame cur = Frame(0u, ivec3(0), 0, vec3(0.0), vec3(1.0), vec3(0.0), kInf, 0.0, false);
+Frame parent0 = cur, parent1 = cur, parent2 = cur;
+
 // One ray's walk through the tree from the root, then (LS_START_BVH) the near field: true when
 // something blocks it. The walk ends as the method ends it (the ray free past the root, occluded,
 // or an overflow) or not at all: then its cap, or the driver, stopped it, and the ray counts as
@@ -229,10 +235,6 @@ bool rayBlocked(Ray r, vec3 nu, inout uint cells, inout uint overflow, out bool 
 #else
     float tS = -kInf;
 #endif
-    // `cur` walks the children of the node on level `level`; its ancestors' walks wait in
-    // parent0..2.
-    Frame cur = Frame(0u, ivec3(0), 0, vec3(0.0), vec3(1.0), vec3(0.0), kInf, 0.0, false);
-    Frame parent0 = cur, parent1 = cur, parent2 = cur; // only LS_PARENTS of them are used
     Frame f;
     int e = uNodeCount == 0u ? ENTER_SKIP : enter(0u, true, LS_DEPTH == 1, false, tS, r, f);
     if (e == ENTER_OCCLUDED) blocked = true;
