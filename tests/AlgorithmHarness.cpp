@@ -34,7 +34,7 @@ AlgorithmRun runAlgorithm(const AlgorithmInfo& info, const Shot& shot, const std
     const FrameMeasurement m = host.computeFrame(frame, timer);
     o.stages = m.stages;
     o.visibility = host.readVisibility();
-    for (const Counter& c : m.counters) o.counters[c.name] = c.value;
+    for (const Counter& c : m.counters) o.counters.set(c.name, c.value);
     o.overflow = m.overflow;
     o.memory = m.memoryBytes;
     for (const DebugView& v : host.algorithm().debugViews())

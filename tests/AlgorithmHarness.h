@@ -12,6 +12,8 @@
 #include <functional>
 #include <iosfwd>
 #include <map>
+#include <gtest/gtest.h>
+
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,11 +23,39 @@ namespace shadowlab::test {
 /// The tests' resolution: small, since GLSL runs on the CPU (llvmpipe) here.
 inline constexpr int kRes = 96;
 
+/// The counters an algorithm reported for a frame, by name. Reading one it did not report is a
+/// test failure naming it: with a plain map a misspelt, renamed or statistics-only counter read as
+/// 0, and a test expecting 0 passed whatever the algorithm did. count() asks whether it is there.
+class ReportedCounters {
+public:
+    using Map = std::map<std::string, double>;
+    double operator[](const std::string& name) const { return at(name); }
+    double at(const std::string& name) const {
+        const auto it = values_.find(name);
+        if (it != values_.end()) return it->second;
+        ADD_FAILURE() << "the algorithm reported no counter \"" << name << "\" (it reported: " << names() << ")";
+        return 0.0;
+    }
+    size_t count(const std::string& name) const { return values_.count(name); }
+    void set(const std::string& name, double value) { values_[name] = value; }
+    Map::const_iterator begin() const { return values_.begin(); }
+    Map::const_iterator end() const { return values_.end(); }
+    operator const Map&() const { return values_; }
+    std::string names() const {
+        std::string out;
+        for (const auto& [name, value] : values_) out += (out.empty() ? "" : ", ") + name;
+        return out;
+    }
+
+private:
+    Map values_;
+};
+
 /// What one frame of an algorithm produced, next to the reference.
 struct AlgorithmRun {
     std::vector<float> visibility, reference;
     std::vector<uint8_t> lit;
-    std::map<std::string, double> counters;
+    ReportedCounters counters;
     uint64_t overflow = 0;
     size_t memory = 0;
     std::vector<float> overflowMask;                 ///< the "stack_overflow" debug view, where there is one

@@ -1,6 +1,10 @@
 // Rules of the source tree that no compiler checks (docs/architecture.md): a plugin depends on the
-// framework, never on another plugin, in C++ and in GLSL; and one concept keeps one name, so the
-// retired names of the statistics pass come back nowhere.
+// framework, never on another plugin, in C++ and in GLSL; one concept keeps one name, so the
+// retired names of the statistics pass come back nowhere; and a test cannot read a counter that
+// was not reported.
+#include "tests/AlgorithmHarness.h"
+
+#include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -106,6 +110,16 @@ TEST(HouseRulesTest, RetiredNamesOfTheStatisticsPassAppearNowhere) {
         }
     }
     EXPECT_GT(checked, 300u);
+}
+
+/// The tests read an algorithm's counters by name: one it did not report (misspelt, renamed, or
+/// compiled out of the timed pass) fails the test instead of reading as 0.
+TEST(HouseRulesTest, ACounterTheAlgorithmDidNotReportFailsTheTest) {
+    test::ReportedCounters counters;
+    counters.set("nodes_visited_mean", 3.0);
+    EXPECT_EQ(counters["nodes_visited_mean"], 3.0);
+    EXPECT_NONFATAL_FAILURE(counters["node_visited_mean"], "reported no counter \"node_visited_mean\"");
+    EXPECT_EQ(counters.count("node_visited_mean"), 0u);
 }
 
 } // namespace
