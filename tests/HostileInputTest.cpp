@@ -36,6 +36,9 @@ std::vector<BadCase> badCases() {
     return {
         {"ConfigNestedTwentyThousandDeep", "c.json", configWith({{"name", deep}}), {"/name/", "nesting deeper than 64"}},
         {"LightBeyondFloat", "c.json", configWith({{"light", R"({"position": [1e39, 4, 2]})"}}), {"/light/position", "float"}},
+        // Twenty-second probe: "SCENE" beside the memory table's "scene" (only "scene" was refused).
+        {"IdNamingTheSceneInAnotherCase", "c.json",
+         configWith({{"algorithms", R"([{"id": "SCENE", "algorithm": "shadow_map"}])"}}), {"/algorithms/0/id", "SCENE"}},
         {"LightAt1e30", "c.json", configWith({{"light", R"({"position": [1e30, 4, 2]})"}}), {"/light/position", "1e15"}},
         // Twenty-first probe: a triangle whose edges are too long for its normal in float was called
         // collinear; the error names the cause.

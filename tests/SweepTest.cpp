@@ -95,6 +95,11 @@ const BadSweep kBadSweeps[] = {
     {"LabelWithTab", R"({"axes": [{"name": "f", "values": {"frames": [1, 2]}, "labels": ["a", "b\tc"]}]})",
      "/axes/0/labels/1|control character (a tab)"},
     {"NameWithNewline", R"({"name": "small\n#SBATCH --wrap=id"})", "/name|control character (a newline)"},
+    // Twenty-second probe: axis names become plot files, one file for "res" and "RES" (or for
+    // "STAGES" and the stages figure) on a case-insensitive file system.
+    {"AxisNamesDifferingInCase", R"({"axes": [{"name": "res", "values": {"frames": [1, 2]}}, {"name": "RES", "values": {"warmup_frames": [0, 1]}}]})",
+     "/axes/1/name|only in case"},
+    {"AxisNamedStagesInCapitals", R"({"axes": [{"name": "STAGES", "values": {"frames": [1, 2]}}]})", "/axes/0/name|sweep_stages.png"},
     {"EmptyOutputDir", R"({"output": {"dir": ""}})", "/output/dir|must not be empty"},
     // Parsed by a walker that would wrap such an index (std::stoul) or throw something else than bad input.
     {"ArrayIndexPastAnyArray", R"({"axes": [{"name": "pcf", "values": {"algorithms.99999999999999999999.params.pcf": [0, 1]}}]})",

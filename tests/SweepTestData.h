@@ -195,7 +195,11 @@ inline bool fakeRunFolder(const std::string& binary, const std::string& snapshot
     if (resolved.rc != 0) return false;
     std::filesystem::create_directories(runDir);
     std::ofstream(runDir + "/config.resolved.json") << resolved.out;
-    std::ofstream(runDir + "/summary.json") << summary.dump(2);
+    // The run's own resolution, as a run writes it (compare and merge hold the summary to its config).
+    Json own = summary;
+    const Json r = Json::parse(resolved.out, nullptr, false);
+    if (own.is_object() && own.contains("resolution") && r.is_object() && r.contains("resolution")) own["resolution"] = r["resolution"];
+    std::ofstream(runDir + "/summary.json") << own.dump(2);
     return true;
 }
 

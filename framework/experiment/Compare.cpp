@@ -64,23 +64,52 @@ void checkTime(const Json& j, const std::string& file, const std::string& path) 
         throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a time in ms (0 to 1e12)");
 }
 
-/// Every time of one algorithm entry: the stage statistics, the frames' totals, the repetitions'.
-void checkTimes(const Json& entry, const std::string& file, const std::string& at) {
+/// A statistic of a stage or counter: a run always computes it, so null is no run's (twenty-second
+/// probe: a null mean stopped compare with the JSON library's message and exit 1).
+void checkMeasured(const Json& j, const std::string& file, const std::string& path) {
+    if (j.is_null()) throw InputError(file, path, "holds null where a run writes a number");
+}
+
+/// Every time of one algorithm entry: the stage statistics, the frames' totals, the repetitions'
+/// (as many as the repetitions' count, which a config holds to 1000).
+void checkTimes(const Json& entry, const std::string& file, const std::string& at, const Json& frames) {
+    if (!entry.contains("time_ms") || !entry["time_ms"].is_object() || !entry["time_ms"].contains("total"))
+        throw InputError(file, at + "/time_ms/total", "is missing: every run times each algorithm's total");
     for (const char* key : {"time_ms", "cpu_time_ms"})
         if (entry.contains(key) && entry[key].is_object())
             for (const auto& [stage, stats] : entry[key].items())
                 if (stats.is_object())
-                    for (const auto& [stat, v] : stats.items())
-                        checkTime(v, file, at + "/" + key + "/" + shortText(stage, 60) + "/" + shortText(stat, 60));
+                    for (const auto& [stat, v] : stats.items()) {
+                        const std::string path = at + "/" + key + "/" + shortText(stage, 60) + "/" + shortText(stat, 60);
+                        checkMeasured(v, file, path);
+                        checkTime(v, file, path);
+                    }
+    if (entry.contains("counters") && entry["counters"].is_object())
+        for (const auto& [name, stats] : entry["counters"].items())
+            if (stats.is_object())
+                for (const auto& [stat, v] : stats.items())
+                    checkMeasured(v, file, at + "/counters/" + shortText(name, 60) + "/" + shortText(stat, 60));
+    if (entry.contains("total_ms_per_frame") && entry["total_ms_per_frame"].is_array() && frames.is_number_unsigned() &&
+        entry["total_ms_per_frame"].size() != frames.get<uint64_t>())
+        throw InputError(file, at + "/total_ms_per_frame", "holds " + std::to_string(entry["total_ms_per_frame"].size()) +
+                                                               " times where the run has " + std::to_string(frames.get<uint64_t>()) + " frames");
     if (entry.contains("total_ms_per_frame") && entry["total_ms_per_frame"].is_array())
         for (size_t i = 0; i < entry["total_ms_per_frame"].size(); ++i)
             checkTime(entry["total_ms_per_frame"][i], file, at + "/total_ms_per_frame/" + std::to_string(i));
     if (entry.contains("repetitions") && entry["repetitions"].is_object() && entry["repetitions"].contains("time_ms") &&
         entry["repetitions"]["time_ms"].is_object())
-        for (const auto& [stage, times] : entry["repetitions"]["time_ms"].items())
-            if (times.is_array())
-                for (size_t i = 0; i < times.size(); ++i)
-                    checkTime(times[i], file, at + "/repetitions/time_ms/" + shortText(stage, 60) + "/" + std::to_string(i));
+        for (const auto& [stage, times] : entry["repetitions"]["time_ms"].items()) {
+            if (!times.is_array()) continue;
+            const std::string path = at + "/repetitions/time_ms/" + shortText(stage, 60);
+            const Json& count = entry["repetitions"].value("count", Json());
+            if (count.is_number_unsigned() && times.size() != count.get<uint64_t>())
+                throw InputError(file, path, "holds " + std::to_string(times.size()) + " times where the repetitions' count is " +
+                                                 std::to_string(count.get<uint64_t>()));
+            for (size_t i = 0; i < times.size(); ++i) {
+                checkMeasured(times[i], file, path + "/" + std::to_string(i));
+                checkTime(times[i], file, path + "/" + std::to_string(i));
+            }
+        }
 }
 
 /// A count: an integer, 0 or more (1e30, -1 and 0.5 are no run's).
@@ -146,6 +175,14 @@ void checkRunFieldShapes(const Json& entry, const std::string& file, const std::
 void checkRunFieldTypes(const Json& s, const std::string& file) {
     for (const char* key : {"renderer", "name"})
         if (s.contains(key) && !s[key].is_string()) throw InputError(file, std::string("/") + key, "is not text, as a run writes it");
+    // Text that reaches tables and reports is one short line of visible characters (twenty-second
+    // probe: sweep merge copied a 1 MB renderer, bidi overrides and zero-width spaces into sweep.md).
+    for (const char* key : {"renderer", "gl_version", "backend", "stage_time_source"})
+        if (s.contains(key) && s[key].is_string())
+            if (const std::string why = userTextProblem(s[key].get<std::string>()); !why.empty())
+                throw InputError(file, std::string("/") + key, "is not text a run writes: " + why);
+    if (s.contains("memory") && !s["memory"].is_object()) throw InputError(file, "/memory", "is not an object, as a run writes it");
+    if (s.contains("frames")) checkCount(s["frames"], file, "/frames");
     if (s.contains("build")) {
         const Json& b = s["build"];
         if (!b.is_object() || (b.contains("commit") && !b["commit"].is_string()) || (b.contains("dirty") && !b["dirty"].is_boolean()))
@@ -193,8 +230,27 @@ void checkRunFieldTypes(const Json& s, const std::string& file) {
         if (entry.contains("preprocess_ms") && !entry["preprocess_ms"].is_number())
             throw InputError(file, at + "/preprocess_ms", "is not a time a run writes (finite, 0 or more)");
         if (entry.contains("preprocess_ms")) checkTime(entry["preprocess_ms"], file, at + "/preprocess_ms");
-        checkTimes(entry, file, at);
+        checkTimes(entry, file, at, s.value("frames", Json()));
     }
+}
+} // namespace
+
+namespace {
+/// The summary's resolution is the run's config's, when the folder holds it (twenty-second probe:
+/// a summary saying 64 x 64 beside a 32 x 32 config gave sweep.csv four times the pixels).
+void checkAgainstConfig(const Json& s, const std::string& dir, const std::string& file) {
+    const std::string config = dir + "/config.resolved.json";
+    std::error_code ec;
+    if (!s.contains("resolution") || !fs::is_regular_file(fs::symlink_status(config, ec))) return;
+    Json c;
+    try {
+        c = Json::parse(readInputFile(config, size_t(16) << 20));
+    } catch (const std::exception&) {
+        return; // not a run's config: what is checked of the summary stands alone
+    }
+    if (c.is_object() && c.contains("resolution") && c["resolution"] != s["resolution"])
+        throw InputError(file, "/resolution", "holds " + shortText(s["resolution"].dump(), 40) + " where the run's config.resolved.json says " +
+                                                  shortText(c["resolution"].dump(), 40));
 }
 } // namespace
 
@@ -203,6 +259,10 @@ Json readRunSummary(const std::string& dir) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec) || !fs::exists(file, ec))
         throw InputError(shortText(dir, 300), "", "is not a run's output folder (it holds no summary.json)");
+    // The run's own file, as sweep merge holds it (twenty-second probe: compare followed a link to
+    // another run's summary).
+    if (fs::is_symlink(fs::symlink_status(file, ec)))
+        throw InputError(shortText(file, 300), "", "is a symbolic link, not the run's own file");
     const Json s = JsonNode::parseFile(file);
     if (!s.is_object() || s.value("complete", false) != true || !s.contains("algorithms") || !s["algorithms"].is_object())
         throw InputError(shortText(file, 300), "", "is not a complete run's summary (no \"complete\": true and \"algorithms\")");
@@ -227,6 +287,7 @@ Json readRunSummary(const std::string& dir) {
                                      "holds a time of " + shortText(t.dump(), 40) + " ms: a run's times are finite and not negative");
         }
     }
+    checkAgainstConfig(s, dir, shortText(file, 300));
     return s;
 }
 

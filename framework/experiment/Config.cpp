@@ -339,15 +339,15 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
         AlgorithmEntry e = parseEntry(node, "");
         // The memory tables list the scene's own parts beside the algorithms by name (nineteenth
         // probe: an id "scene" replaced the scene's bytes in summary.json and the report).
-        if (e.id == "scene" || e.id == "scene_gpu")
-            throw InputError(file, node.childPath("id"), "the id \"" + e.id + "\" names the scene's own entry in the memory tables; choose another");
-        if (!ids.insert(e.id).second)
-            throw InputError(file, node.childPath("id"), "duplicate id \"" + e.id + "\" (ids label results, so each must be unique)");
         // Ids name files (images, plots): two that differ only in case are one file on a
         // case-insensitive file system (macOS, Windows shares), and one algorithm's images would
         // overwrite the other's.
         std::string lower = e.id;
         for (char& ch : lower) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+        if (lower == "scene" || lower == "scene_gpu") // in any case (twenty-second probe: "SCENE" beside "scene")
+            throw InputError(file, node.childPath("id"), "the id \"" + e.id + "\" names the scene's own entry in the memory tables; choose another");
+        if (!ids.insert(e.id).second)
+            throw InputError(file, node.childPath("id"), "duplicate id \"" + e.id + "\" (ids label results, so each must be unique)");
         if (auto [it, fresh] = folded.emplace(lower, e.id); !fresh)
             throw InputError(file, node.childPath("id"), "id \"" + e.id + "\" differs from \"" + it->second +
                                                            "\" only in case (ids name files, and case-insensitive file systems would take them for one)");

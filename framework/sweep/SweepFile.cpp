@@ -124,6 +124,11 @@ void absolutiseAxisValue(Json& value, const std::string& path, const std::string
     }
 }
 
+std::string lowerCase(std::string text) {
+    for (char& ch : text) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    return text;
+}
+
 /// A label of a "value" axis is x of a plot: a positive number (JSON syntax, which every reader of
 /// sweep.csv parses the same way).
 bool isPositiveNumber(const std::string& label) {
@@ -138,10 +143,13 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
     if (!isIdentifier(axis.name))
         node.fail("name", "\"" + shortText(axis.name, 80) + "\" is not a name of 1 to " + std::to_string(kMaxAxisNameChars) +
                               " letters, digits and _ (it becomes a column name)");
-    if (kReservedNames.count(axis.name)) node.fail("name", "\"" + axis.name + "\" is a column of sweep.csv already; choose another name");
+    // Compared in lower case: names become plot files (sweep_NAME.png), and on a case-insensitive
+    // file system "RES" and "res", or "STAGES" and the stages figure, are one file (twenty-second probe).
+    const std::string lower = lowerCase(axis.name);
+    if (kReservedNames.count(lower)) node.fail("name", "\"" + axis.name + "\" is a column of sweep.csv already; choose another name");
     // Its plot would be sweep_stages.png, the stages figure's file (eleventh probe: one replaced the other).
-    if (axis.name == "stages") node.fail("name", "\"stages\" would name its plot sweep_stages.png, the stages figure's file; choose another name");
-    if (names.count(axis.name)) node.fail("name", "two axes are named \"" + axis.name + "\"");
+    if (lower == "stages") node.fail("name", "\"" + axis.name + "\" would name its plot sweep_stages.png, the stages figure's file; choose another name");
+    if (names.count(lower)) node.fail("name", "two axes are named \"" + axis.name + "\" (names that differ only in case name one plot file)");
     const std::string where = axisWhere(a, axis);
 
     if (!node.has("values")) node.fail("values", "required key is missing: {\"dotted.path\": [value, ...], ...}");
@@ -430,7 +438,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     std::vector<JsonNode> axisNodes = root.objectArray("axes");
     for (size_t a = 0; a < axisNodes.size(); ++a) {
         s.axes.push_back(parseAxis(axisNodes[a], a, names, paths, sweepDir));
-        names.insert(s.axes.back().name);
+        names.insert(lowerCase(s.axes.back().name));
         // The snapshot carries the values as the runs use them (glTF paths absolute), so that
         // DIR/sweep.json, read from DIR, gives the same runs.
         Json& values = s.axesJson[a]["values"];
