@@ -29,7 +29,7 @@ enum class MtTreeBuilder { Gpu, Cpu };
 enum class MtQuery { Pixel, Tile };
 /// A tile's shape; the value is its pixels (MT_TILE_PIXELS), 0 for auto.
 enum class MtTile { Auto = 0, T4x2 = 8, T8x2 = 16, T8x4 = 32, T8x8 = 64 };
-const std::vector<Choice<MtTile>> kTiles = {
+const std::vector<Choice<MtTile>> kMtTiles = {
     {"auto", MtTile::Auto}, {"4x2", MtTile::T4x2}, {"8x2", MtTile::T8x2}, {"8x4", MtTile::T8x4}, {"8x8", MtTile::T8x8}};
 enum class MtMotion { Rigid, Recluster };
 
@@ -89,7 +89,7 @@ const ParamStruct<MetricTreeParams>& metricTreeParams() {
                 "enclosing its points, and each pixel tests the clusters the walk gathered with the per-pixel "
                 "query's own tests (the same image; no divergent walk)",
                 ParamChange::Recompile)
-        .choice("tile", &P::tile, MtTile::Auto, kTiles,
+        .choice("tile", &P::tile, MtTile::Auto, kMtTiles,
                 "tile query: the pixels that share one walk; auto = the tile whose walkers (one invocation per tile) "
                 "fill one subgroup: 8x2 on 4 lanes, else 4x2 (8 walkers)",
                 ParamChange::Recompile)
@@ -350,7 +350,7 @@ public:
 
     /// The tile shape tilePixels() gives on this device (used by the tile query).
     std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
-        return {{"tile", choiceName(kTiles, MtTile(tilePixels()))}};
+        return {{"tile", choiceName(kMtTiles, MtTile(tilePixels()))}};
     }
 
 private:

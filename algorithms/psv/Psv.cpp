@@ -20,11 +20,11 @@ namespace {
 
 /// The values are the shaders' PSV_WEDGE_BOUND.
 enum class PsvWedgeBound { Exact = 0, Distance = 1, Vertices = 2 };
-const std::vector<Choice<PsvWedgeBound>> kWedgeBounds = {
+const std::vector<Choice<PsvWedgeBound>> kPsvWedgeBounds = {
     {"exact", PsvWedgeBound::Exact}, {"distance", PsvWedgeBound::Distance}, {"vertices", PsvWedgeBound::Vertices}};
 /// The values are the shaders' PSV_TRAVERSAL; auto resolves to one of them (Psv::traversal()).
 enum class PsvTraversal { Auto = -1, Stack = 0, Stackless = 1, Hybrid = 2 };
-const std::vector<Choice<PsvTraversal>> kTraversals = {{"auto", PsvTraversal::Auto},
+const std::vector<Choice<PsvTraversal>> kPsvTraversals = {{"auto", PsvTraversal::Auto},
                                                        {"stack", PsvTraversal::Stack},
                                                        {"stackless", PsvTraversal::Stackless},
                                                        {"hybrid", PsvTraversal::Hybrid}};
@@ -49,7 +49,7 @@ const ParamStruct<PsvParams>& psvParams() {
         // that value can be too small and miss an occluder: not exact, measured, never the default.
         // "distance" by default: conservative (exact images) and, on the peer engine scene at 512²,
         // a third cheaper to build than "exact" for 5 % more traversal (results/reference/psv/ablation.md).
-        .choice("wedge_bound", &P::wedgeBound, PsvWedgeBound::Distance, kWedgeBounds,
+        .choice("wedge_bound", &P::wedgeBound, PsvWedgeBound::Distance, kPsvWedgeBounds,
                 "point light: the wedge as the largest angle over the whole triangle seen from the light "
                 "(exact), as the vertices' largest plane distance over the triangle's distance to the light "
                 "(distance: wider, cheaper, still conservative) or over its vertices only (vertices: the "
@@ -71,7 +71,7 @@ const ParamStruct<PsvParams>& psvParams() {
                  ParamChange::Recompile)
         // auto: stackless on every device (docs/algorithms/psv.md, "Traversals": it cannot overflow
         // and was the fastest measured); the stack walk for x-ray shadows, which need it.
-        .choice("traversal", &P::traversal, PsvTraversal::Auto, kTraversals,
+        .choice("traversal", &P::traversal, PsvTraversal::Auto, kPsvTraversals,
                 "query walk (Mora et al. 2016): an explicit stack (the 2015 paper; may overflow), none "
                 "(stackless: each triangle's escape node, written by the build, leads back up), or a "
                 "short stack that walks stacklessly where it is full (hybrid); the same image; auto: "
@@ -90,7 +90,7 @@ const ParamStruct<PsvParams>& psvParams() {
         .apply(rayOffsetRow(&P::rayOffset))
         .rule("traversal", [](const P& p) {
             return p.transparency && (p.traversal == PsvTraversal::Stackless || p.traversal == PsvTraversal::Hybrid)
-                       ? "traversal = " + std::string(choiceName(kTraversals, p.traversal)) + " cannot take transparency (a capping plane's negative child would be "
+                       ? "traversal = " + std::string(choiceName(kPsvTraversals, p.traversal)) + " cannot take transparency (a capping plane's negative child would be "
                          "a second pending side of one node): use traversal = stack or auto"
                        : std::string();
         });
@@ -207,7 +207,7 @@ public:
     }
 
     std::vector<std::pair<std::string, std::string>> resolvedParams() const override {
-        return {{"traversal", choiceName(kTraversals, traversal())}};
+        return {{"traversal", choiceName(kPsvTraversals, traversal())}};
     }
 
     /// The tree (4n + 1 nodes of 32 bytes) plus the 96-byte counter block: exactly 128 (n + 1) bytes.
@@ -244,7 +244,7 @@ private:
         auto flag = [](bool on) { return on ? std::string("1") : std::string("0"); };
         const PsvTraversal walk = traversal();
         if (p_.transparency && walk != PsvTraversal::Stack)
-            throw RuntimeError("psv: traversal = " + std::string(choiceName(kTraversals, walk)) + " cannot take transparency (a capping plane's negative "
+            throw RuntimeError("psv: traversal = " + std::string(choiceName(kPsvTraversals, walk)) + " cannot take transparency (a capping plane's negative "
                                "child would be a second pending side of one node): use traversal = stack");
         // The plane walk first where the walk can stop at a close call and leave the pixel to the
         // exact walk: not with x-ray shadows (a close call's transmission is a factor of the

@@ -20,7 +20,7 @@ enum class PtsvBounds { Explicit, Implicit };
 enum class PtsvVote { Auto, Ballot, Shared };
 enum class PtsvLeafSamples { Tile, Cluster };
 enum class PtsvTraversal { Auto, Cooperative, Invocation, Packet };
-const std::vector<Choice<PtsvTraversal>> kTraversals = {{"auto", PtsvTraversal::Auto},
+const std::vector<Choice<PtsvTraversal>> kPtsvTraversals = {{"auto", PtsvTraversal::Auto},
                                                         {"cooperative", PtsvTraversal::Cooperative},
                                                         {"invocation", PtsvTraversal::Invocation},
                                                         {"packet", PtsvTraversal::Packet}};
@@ -92,7 +92,7 @@ const ParamStruct<PtsvParams>& ptsvParams() {
         // packet: pass one's walks of neighbouring triangles share their nodes, so the lanes of a
         // subgroup loop over one node's children together (traverse 10-12 % less than invocation at
         // 512² on the peer engine scene, the same at 1024²).
-        .choice("traversal", &P::traversal, PtsvTraversal::Auto, kTraversals,
+        .choice("traversal", &P::traversal, PtsvTraversal::Auto, kPtsvTraversals,
                 "who walks a job: cooperative (paper: a subgroup per job, its lanes testing a node's 32 children "
                 "together, see vote and lanes), invocation (each invocation its own job, testing a node's "
                 "existing children in turn; no votes), packet (as invocation, but in pass one the lanes of a "
@@ -344,7 +344,7 @@ public:
                                                          : "levels - 1";
         return {{"split_level", split},
                 {"jobs_per_workgroup", std::to_string(jobsPerWorkgroup())},
-                {"traversal", choiceName(kTraversals, traversal)},
+                {"traversal", choiceName(kPtsvTraversals, traversal)},
                 {"vote", vote},
                 {"lanes", std::to_string(lanes_)}};
     }

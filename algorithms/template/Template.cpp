@@ -148,7 +148,8 @@ private:
 /// storage block.
 Footprint templateFootprint(const FootprintQuery& q) {
     Footprint f;
-    f.bytes = saturatingMul(4, q.triangles);
+    // The triangle order and the counter block: what memoryBytes() reports.
+    f.bytes = saturatingSum({saturatingMul(4, q.triangles), size_t(TEMPLATE_COUNTER_WORDS) * 4});
     f.refusal = storageRefusal(q, "the scene positions it reads", saturatingMul(36, q.triangles));
     return f;
 }
