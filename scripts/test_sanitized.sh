@@ -27,8 +27,9 @@ export LSAN_OPTIONS="suppressions=$PWD/scripts/sanitizers/lsan.supp:print_suppre
 # And the exactness fuzzer's tests: they run the binary on hundreds of scenes, whose work is Mesa's
 # (not instrumented); the smoke runs below take the same binary's paths under the sanitizers. For
 # the same reason `info` (CliTest.InfoPrintsTheDeviceAndTheResolvedAutos compiles every algorithm's
-# shaders in Mesa: 22-54 s here against 3 s plain) and the example CI jobs (CiExamplesPython: runs
-# on Mesa; their compare and history steps are HistoryTest's, which runs here) stay in the plain tier.
+# shaders in Mesa, many times slower instrumented: results/reference/ci_time_llvmpipe.md) and the
+# example CI jobs (CiExamplesPython: runs on Mesa; their compare and history steps are
+# HistoryTest's, which runs here) stay in the plain tier.
 (cd build-asan && ctest --output-on-failure -j"$(nproc)" \
     -E "GLTest|GuiTest|gl_tests|EglRunner|EglInfo|SweepMemoryTest|EveryShippedConfigValidates|ExactnessFuzz|InfoPrintsTheDevice|CiExamplesPython" "$@")
 

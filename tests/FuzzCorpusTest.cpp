@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 #if defined(__SANITIZE_ADDRESS__)
 constexpr long kMaxRssKiB = 2L << 20;  // ASan's shadow and quarantine add to every allocation
-// A fork of an instrumented process costs ~15× a plain one (the config corpus: 165 s against 10 s),
+// A fork of an instrumented process costs many times a plain one (results/reference/ci_time_llvmpipe.md),
 // so the sanitized tier runs every third case, a different third per loader; the plain tier
 // (scripts/test.sh) runs them all.
 constexpr size_t kCaseStride = 3;

@@ -173,10 +173,11 @@ public:
         counters_.clear();
         scene_->bindStorage();
         counters_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_COUNTER_BINDING);
+        const float offset = rayOffsetLength(p_.rayOffset, *scene_); // the reference's, in world units
         findSilhouettes(f);
-        drawVolumes(f);
-        resolve(f);
-        traceCloseCalls(f);
+        drawVolumes(f, offset);
+        resolve(f, offset);
+        traceCloseCalls(f, offset);
         counters_.markStale();
         zfailLast_ = p_.method == SvMethod::Zfail;
     }
@@ -258,9 +259,8 @@ private:
 
     /// The stencil (and count) targets cleared, the G-buffer bound, with the hardware depth test
     /// its depth buffer written, and the volumes drawn: one stage.
-    void drawVolumes(const FrameInputs& f) {
+    void drawVolumes(const FrameInputs& f, float offset) {
         const bool zfail = p_.method == SvMethod::Zfail, analytic = p_.depthTest == SvDepthTest::Analytic;
-        const float offset = rayOffsetLength(p_.rayOffset, *scene_);
         const unsigned triangles = unsigned(scene_->triangleCount());
         const glm::ivec2 r = f.gbuffer.resolution();
         f.timer.begin("volumes");
@@ -329,8 +329,7 @@ private:
     }
 
     /// Each pixel's count read: shadowed, lit, or listed as a close call.
-    void resolve(const FrameInputs& f) {
-        const float offset = rayOffsetLength(p_.rayOffset, *scene_);
+    void resolve(const FrameInputs& f, float offset) {
         f.timer.begin("resolve");
         glBindTextureUnit(SV_STENCIL_UNIT, depthStencil_.id());
         glBindTextureUnit(SV_COUNT_UNIT, count_.id());
@@ -348,8 +347,7 @@ private:
     }
 
     /// The close calls: one ray each through the BVH, an indirect dispatch sized by the list.
-    void traceCloseCalls(const FrameInputs& f) {
-        const float offset = rayOffsetLength(p_.rayOffset, *scene_);
+    void traceCloseCalls(const FrameInputs& f, float offset) {
         f.timer.begin("close_calls");
         bindPixelPassInputs(f);
         bvh_.gpu().bind(SV_BVH_NODE_UNIT, SV_BVH_TRI_UNIT);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 namespace shadowlab {
@@ -132,6 +133,11 @@ void writeFileAtomic(const std::string& path, const std::string& text) {
         throw InputError(path, "", "is " + late + ": refusing to replace it with a file");
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) fail("rename a temporary file to", errno);
+}
+
+bool diskNearlyFull(const std::string& dir) {
+    struct statvfs disk {};
+    return ::statvfs(dir.c_str(), &disk) == 0 && uint64_t(disk.f_bavail) * uint64_t(disk.f_frsize) < (uint64_t(1) << 20);
 }
 
 } // namespace shadowlab

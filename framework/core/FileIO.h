@@ -36,4 +36,8 @@ std::string shortPath(const std::string& path);
 /// the target is not a regular file (the caller named a place that cannot hold a file).
 void writeFileAtomic(const std::string& path, const std::string& text);
 
+/// Whether the disk holding `dir` has less than 1 MiB left: a child process that wrote nothing (the
+/// plotters) failed for a full disk, which is said as such rather than as an empty reason.
+bool diskNearlyFull(const std::string& dir);
+
 } // namespace shadowlab

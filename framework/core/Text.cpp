@@ -1,5 +1,7 @@
 #include "framework/core/Text.h"
 
+#include <cctype>
+
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
@@ -231,6 +233,11 @@ bool plainDecimal(const std::string& s) {
         if (!digits()) return false;
     }
     return i == s.size();
+}
+
+std::string asciiLowerCase(std::string text) {
+    for (char& ch : text) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    return text;
 }
 
 } // namespace shadowlab

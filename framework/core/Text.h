@@ -73,4 +73,8 @@ std::string validUtf8(const std::string& text);
 /// for a formula, a name or another number.
 bool plainDecimal(const std::string& s);
 
+/// `text` with its ASCII letters in lower case (ids and names compared as a case-insensitive file
+/// system would compare the files they name).
+std::string asciiLowerCase(std::string text);
+
 } // namespace shadowlab

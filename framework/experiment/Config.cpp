@@ -342,8 +342,7 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
         // Ids name files (images, plots): two that differ only in case are one file on a
         // case-insensitive file system (macOS, Windows shares), and one algorithm's images would
         // overwrite the other's.
-        std::string lower = e.id;
-        for (char& ch : lower) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+        const std::string lower = asciiLowerCase(e.id);
         if (lower == "scene" || lower == "scene_gpu") // in any case (twenty-second probe: "SCENE" beside "scene")
             throw InputError(file, node.childPath("id"), "the id \"" + e.id + "\" names the scene's own entry in the memory tables; choose another");
         if (!ids.insert(e.id).second)

@@ -3,6 +3,7 @@
 #include "framework/algorithm/AlgorithmHost.h"
 #include "framework/core/BuildInfo.h"
 #include "framework/core/Error.h"
+#include "framework/core/FileIO.h"
 #include "framework/core/Interrupt.h"
 #include "framework/core/SystemMemory.h"
 #include "framework/core/Text.h"
@@ -24,7 +25,6 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
-#include <sys/statvfs.h>
 
 namespace shadowlab {
 
@@ -86,8 +86,7 @@ void runPlots(const std::string& dir, const std::string& finalDir, const std::st
     }
     // A full disk is a failed write, not a missing plot (seventh probe: the run exited 0 without
     // report.html): the run fails and the previous results stay.
-    struct statvfs disk {};
-    if (::statvfs(dir.c_str(), &disk) == 0 && uint64_t(disk.f_bavail) * uint64_t(disk.f_frsize) < (uint64_t(1) << 20))
+    if (diskNearlyFull(dir))
         throw RuntimeError("the disk holding " + shortText(finalDir, 300) + " is full: the plots and report.html could not be written");
     const std::string see = std::filesystem::exists(log) ? " (see " + finalDir + "/plots.log)" : " (its log could not be written)";
     if (failed) std::fprintf(stderr, "warning: plotting failed%s; tables and images are complete\n", see.c_str());

@@ -684,7 +684,7 @@ Scene loadGltf(const std::string& file, GltfStats* stats, size_t maxTriangles, c
 
     bool magic = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
     std::string ext = file.size() >= 4 ? file.substr(file.size() - 4) : "";
-    for (auto& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    ext = asciiLowerCase(ext);
     if (ext == ".glb" && !magic) throw InputError(file, "", "not a GLB file (it does not start with \"glTF\")");
     bool binary = magic;  // a .gltf that is really binary loads too
 

@@ -2,11 +2,11 @@
 
 #include "framework/experiment/Config.h"
 #include "framework/scene/SceneConfig.h"
+#include "framework/core/Text.h"
 #include "framework/sweep/SweepText.h"
 
 #include <algorithm>
 #include <cstdlib>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -124,11 +124,6 @@ void absolutiseAxisValue(Json& value, const std::string& path, const std::string
     }
 }
 
-std::string lowerCase(std::string text) {
-    for (char& ch : text) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    return text;
-}
-
 /// A label of a "value" axis is x of a plot: a positive number (JSON syntax, which every reader of
 /// sweep.csv parses the same way).
 bool isPositiveNumber(const std::string& label) {
@@ -145,7 +140,7 @@ SweepAxis parseAxis(JsonNode node, size_t a, const std::set<std::string>& names,
                               " letters, digits and _ (it becomes a column name)");
     // Compared in lower case: names become plot files (sweep_NAME.png), and on a case-insensitive
     // file system "RES" and "res", or "STAGES" and the stages figure, are one file (twenty-second probe).
-    const std::string lower = lowerCase(axis.name);
+    const std::string lower = asciiLowerCase(axis.name);
     if (kReservedNames.count(lower)) node.fail("name", "\"" + axis.name + "\" is a column of sweep.csv already; choose another name");
     // Its plot would be sweep_stages.png, the stages figure's file (eleventh probe: one replaced the other).
     if (lower == "stages") node.fail("name", "\"" + axis.name + "\" would name its plot sweep_stages.png, the stages figure's file; choose another name");
@@ -438,7 +433,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     std::vector<JsonNode> axisNodes = root.objectArray("axes");
     for (size_t a = 0; a < axisNodes.size(); ++a) {
         s.axes.push_back(parseAxis(axisNodes[a], a, names, paths, sweepDir));
-        names.insert(lowerCase(s.axes.back().name));
+        names.insert(asciiLowerCase(s.axes.back().name));
         // The snapshot carries the values as the runs use them (glTF paths absolute), so that
         // DIR/sweep.json, read from DIR, gives the same runs.
         Json& values = s.axesJson[a]["values"];

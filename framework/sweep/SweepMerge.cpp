@@ -12,7 +12,6 @@
 #include <filesystem>
 #include <set>
 #include <sstream>
-#include <sys/statvfs.h>
 
 namespace shadowlab {
 
@@ -221,8 +220,7 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
         if (rc == 2) throw InputError(shortText(dir, 300), "", "the report was refused: " + last + "; sweep.csv is complete");
         // A full disk is a failed write with a reason, not an empty one (the script may have had no
         // room to say anything).
-        struct statvfs disk {};
-        if (::statvfs(dir.c_str(), &disk) == 0 && uint64_t(disk.f_bavail) * uint64_t(disk.f_frsize) < (uint64_t(1) << 20))
+        if (diskNearlyFull(dir))
             throw RuntimeError("the disk holding " + shortText(dir, 300) + " is full: the report could not be written; sweep.csv is complete");
         std::fprintf(stderr, "sweep merge: the report script failed (%s): %s; sweep.csv is complete (log: %s)\n",
                      rc < 0 ? "it could not start, or died of a signal" : ("exit code " + std::to_string(rc)).c_str(),
