@@ -401,11 +401,10 @@ TEST(ReferenceTracer, TwoMillionTriangles) {
 }
 
 // The layouts that save memory at scale answer every ray as the default one does: the vertices
-// read in place from the Scene (no copy) and the compact BVH (indexed leaves, compact nodes), on
+// read in place from the Scene (no copy) and the compact BVH nodes, on
 // the engine, with rays grazing its thin parts and aimed at its vertices and edges.
 TEST(ReferenceTest, SharedVerticesAndCompactBvhAnswerEveryRayAlike) {
     Scene s = loadGltf(test::kEngineGlb);
-    ASSERT_GT(s.positions.capacity(), s.positions.size()) << "no spare vertex: the shared layout would be copied";
     EmbreeTracer copied(s, EmbreeTracer::MotionUpdate::Refit);
     EmbreeTracer shared(s, EmbreeTracer::MotionUpdate::Refit, EmbreeTracer::Vertices::Share);
     EmbreeTracer compact(s, EmbreeTracer::MotionUpdate::Refit, EmbreeTracer::Vertices::Share, true);

@@ -43,8 +43,8 @@ const ParamStruct<ReferenceParams>& referenceParams() {
                 ParamChange::Rebuild)
         .choice("bvh", &P::bvh, ReferenceBvh::Auto,
                 {{"auto", ReferenceBvh::Auto}, {"fast", ReferenceBvh::Fast}, {"compact", ReferenceBvh::Compact}},
-                "Embree's layout: fast (precomputed triangle leaves) or compact (indexed leaves reading the scene's "
-                "vertices, compact nodes: less memory, slower rays); auto: compact from 10 M triangles; either is exact",
+                "Embree's node layout: fast, or compact (compact nodes: less memory, slower rays); auto: compact from "
+                "10 M triangles; either is exact (the triangles are decided by the shaders' own test either way)",
                 ParamChange::Rebuild);
     return s;
 }

@@ -145,7 +145,8 @@ void checkLightClearance(const ExperimentConfig& c) {
                                  " (nearest point [" + number(closest.point.x) + ", " + number(closest.point.y) + ", " +
                                  number(closest.point.z) + "]) at " + frameText(c, f) + ": keep it 1.25 x the ray offset (" +
                                  number(clearance / kClearance) + ") from every surface or lower ray_offset (the "
-                                 "reference's shadow rays end that short of the light, the volume algorithms' do not)");
+                                 "shadow rays and the shadow volumes meet at the light, and the exact algorithms are compared "
+                                 "with the reference only where nothing lies that near it)");
         if (!changes || f == c.frames - 1) break;
     }
 }

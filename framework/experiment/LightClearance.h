@@ -1,13 +1,15 @@
 #pragma once
 // A point or spot light kept clear of every surface by 1.25 × the ray offset, on every frame checked.
 //
-// The reference (and bvh_raytrace) ends each shadow ray the ray offset short of the light; the
-// volume algorithms (psv, ptsv, shadow_volumes) and the cluster tests count every triangle up to the
-// light itself. A surface within that distance of the light is seen by one and not the other, and
-// their images disagree on whole regions (tenth probe: a light just behind a wall; the count is in
-// results/reference/exactness_campaign_llvmpipe.md). Which one is right is a matter of definition, not of precision, so such a scene is
-// refused instead of compared, with a quarter of the offset more so that rounding at the ray's end
-// cannot decide it either.
+// The rule came from a difference of definition: the reference (and bvh_raytrace) ended each shadow
+// ray the ray offset short of the light, while the volume algorithms (psv, ptsv, shadow_volumes)
+// and the cluster tests count every triangle up to the light itself, and a surface within that
+// distance of the light was seen by one and not the other (tenth probe: a light just behind a wall,
+// whole regions apart; results/reference/exactness_campaign_llvmpipe.md). Rays to point and spot
+// lights now run to the light itself (common/shadow_ray.glsl, reference/Watertight.h), with no
+// division that a GPU could round otherwise, and they rely on this rule: nothing lies at the
+// segment's end, where the rays and the volumes' apex meet, within a quarter of the offset more
+// than rounding could decide.
 #include "framework/experiment/Config.h"
 
 namespace shadowlab {

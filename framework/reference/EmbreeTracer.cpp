@@ -1,6 +1,7 @@
 #include "framework/reference/EmbreeTracer.h"
 
 #include "framework/core/Error.h"
+#include "framework/reference/Watertight.h"
 
 #include <algorithm>
 #include <atomic>
@@ -40,10 +41,13 @@ const char* errorName(RTCError code) {
     }
 }
 
-// The per-ray state of the transparent path travels with the intersect context: Embree hands the
-// same pointer to the filter, so the context is the first member and the filter casts back.
-struct FilterContext {
+// The per-ray state travels with the intersect context: Embree hands the same pointer to the
+// triangles' occlusion callback, so the context is the first member and the callback casts back.
+struct TraceContext {
     RTCIntersectContext rtc;
+    watertight::Ray ray; ///< the ray in the triangle test's frame, set up once
+    const glm::vec3* vertices;
+    // The transparent path only (materialIds null otherwise):
     const uint32_t* materialIds;
     const float* materialTransmit;
     std::vector<EmbreeTracer::CountedHit>* seen;
@@ -58,29 +62,45 @@ bool alreadyCounted(const std::vector<EmbreeTracer::CountedHit>& seen, unsigned 
     return false;
 }
 
-// Occlusion filter of the transparent path: multiplies in each distinct crossing's transmission and
-// rejects the hit so traversal goes on, unless the ray is (numerically) fully blocked. Hits arrive
-// in no particular order; the product and the duplicate test do not depend on it.
-void transparencyFilter(const RTCFilterFunctionNArguments* args) {
-    auto* ctx = reinterpret_cast<FilterContext*>(args->context);
-    // Only rtcOccluded1 is used, so every valid lane belongs to the one ray of this context.
+// The triangles are Embree user primitives: Embree's BVH finds the candidates, and the shaders'
+// watertight test (Watertight.h) decides each, so the reference's decision on every ray–triangle
+// pair is the GPU algorithms' own. A hit occludes the ray (tfar = -inf); on the transparent path
+// each distinct crossing multiplies in its transmission, and the ray goes on unless (numerically)
+// fully blocked. Hits arrive in no particular order; the product and the duplicate test do not
+// depend on it. Only rtcOccluded1 is used, so every valid lane is the context's one ray.
+void occludedTriangle(const RTCOccludedFunctionNArguments* args) {
+    auto* ctx = reinterpret_cast<TraceContext*>(args->context);
+    const glm::vec3* v = ctx->vertices + 3 * size_t(args->primID);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0) continue;
-        unsigned prim = RTCHitN_primID(args->hit, args->N, i);
-        float t = RTCRayN_tfar(args->ray, args->N, i); // Embree passes the hit distance in tfar
-        if (!alreadyCounted(*ctx->seen, prim, t)) {
-            ctx->seen->push_back({prim, t});
-            ctx->transmission *= ctx->materialTransmit[ctx->materialIds[prim]];
+        float t = 0.0f;
+        if (!watertight::hit(ctx->ray, v[0], v[1], v[2], &t)) continue;
+        if (ctx->materialIds) {
+            if (!alreadyCounted(*ctx->seen, args->primID, t)) {
+                ctx->seen->push_back({args->primID, t});
+                ctx->transmission *= ctx->materialTransmit[ctx->materialIds[args->primID]];
+            }
+            if (ctx->transmission > EmbreeTracer::kOpaqueTransmission) continue;
         }
-        if (ctx->transmission > EmbreeTracer::kOpaqueTransmission) args->valid[i] = 0;
+        RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();
     }
+}
+
+// A triangle's box, widened by a few float steps so that Embree's box test can drop no ray the
+// watertight test would let hit it (the test decides within rounding of the triangle's edges).
+void triangleBounds(const RTCBoundsFunctionArguments* args) {
+    const glm::vec3* v = static_cast<const glm::vec3*>(args->geometryUserPtr) + 3 * size_t(args->primID);
+    glm::vec3 lo = glm::min(v[0], glm::min(v[1], v[2])), hi = glm::max(v[0], glm::max(v[1], v[2]));
+    const glm::vec3 pad = glm::max(glm::abs(lo), glm::abs(hi)) * 0x1p-20f + glm::vec3(std::numeric_limits<float>::min());
+    lo -= pad, hi += pad;
+    *args->bounds_o = RTCBounds{lo.x, lo.y, lo.z, 0.0f, hi.x, hi.y, hi.z, 0.0f};
 }
 
 RTCRay makeRay(glm::vec3 o, glm::vec3 d, float tfar) {
     RTCRay r{};
     r.org_x = o.x, r.org_y = o.y, r.org_z = o.z;
     r.dir_x = d.x, r.dir_y = d.y, r.dir_z = d.z;
-    r.tnear = std::numeric_limits<float>::min(); // hits count on (0, tfar], as in common/watertight.glsl: Embree takes t >= tnear
+    r.tnear = 0.0f; // the watertight test takes hits on (0, tfar]
     r.tfar = tfar;
     r.time = 0.0f;
     r.mask = 0xFFFFFFFFu; // the geometry's default mask is all ones; a zero ray mask would hit nothing
@@ -126,17 +146,11 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update, Vertices ver
         materialTransmit_.push_back(std::clamp(1.0f - m.opacity, 0.0f, 1.0f));
         if (m.opacity < 1.0f) transparent_ = true;
     }
-    if (transparent_) {
-        materialIds_ = scene.materialIds;
-        if (!rtcGetDeviceProperty(device_, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED))
-            fail("tracing transparent casters", "this Embree build has no filter function support");
-    }
+    if (transparent_) materialIds_ = scene.materialIds;
 
-    // ROBUST: turns off Embree's accuracy-reducing shortcuts; the ground truth must not lose hits at
-    // shared edges or grazing angles to speed. CONTEXT_FILTER_FUNCTION: only the transparent path sets a
-    // context filter, so occluded() can still ask plain opaque questions of the same BVH.
+    // ROBUST: turns off Embree's accuracy-reducing shortcuts in its box tests; the ground truth must
+    // not lose a candidate triangle at a grazing angle to speed.
     RTCSceneFlags flags = RTC_SCENE_FLAG_ROBUST;
-    if (transparent_) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     const bool dynamic = scene.dynamic();
     if (dynamic) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_DYNAMIC);
     if (compact) flags = RTCSceneFlags(flags | RTC_SCENE_FLAG_COMPACT);
@@ -146,31 +160,19 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update, Vertices ver
     rtcSetSceneBuildQuality(scene_, dynamic ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
 
     if (triangleCount_ > 0) {
-        if (triangleCount_ * 3 > std::numeric_limits<uint32_t>::max())
-            fail("indexing the scene", "too many triangles for 32-bit indices");
-        RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+        if (triangleCount_ > std::numeric_limits<uint32_t>::max())
+            fail("indexing the scene", "too many triangles for 32-bit primitive ids");
+        RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
         if (!geom) fail("rtcNewGeometry");
-        size_t nv = scene.positions.size();
-        // Shared: the Scene's floats in place, when nothing will move them and the vector's spare
-        // capacity covers Embree's read past the last vertex. Otherwise copied into Embree-allocated
-        // buffers, which carry that padding, and the Scene need not outlive us.
-        sharesVertices_ = vertices == Vertices::Share && !dynamic && scene.positions.capacity() > nv;
-        float* verts = nullptr;
-        if (sharesVertices_)
-            rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, scene.positions.data(), 0,
-                                       3 * sizeof(float), nv);
-        else
-            verts = static_cast<float*>(
-                rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
-        auto* index = static_cast<uint32_t*>(
-            rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), triangleCount_));
-        if ((!verts && !sharesVertices_) || !index) {
-            rtcReleaseGeometry(geom);
-            fail("allocating geometry buffers");
-        }
-        static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
-        if (verts) std::memcpy(verts, scene.positions.data(), nv * sizeof(glm::vec3));
-        for (uint32_t i = 0; i < uint32_t(nv); ++i) index[i] = i; // triangle soup: triangle t = vertices 3t..3t+2
+        // Shared: the Scene's floats in place, when nothing will move them. Otherwise a copy, and
+        // the Scene need not outlive us.
+        sharesVertices_ = vertices == Vertices::Share && !dynamic;
+        if (!sharesVertices_) ownVertices_ = scene.positions;
+        vertices_ = sharesVertices_ ? scene.positions.data() : ownVertices_.data();
+        rtcSetGeometryUserPrimitiveCount(geom, unsigned(triangleCount_));
+        rtcSetGeometryUserData(geom, const_cast<glm::vec3*>(vertices_));
+        rtcSetGeometryBoundsFunction(geom, triangleBounds, const_cast<glm::vec3*>(vertices_));
+        rtcSetGeometryOccludedFunction(geom, occludedTriangle);
         if (dynamic && update == MotionUpdate::Refit) rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_REFIT);
         rtcCommitGeometry(geom);
         rtcAttachGeometry(scene_, geom);
@@ -183,14 +185,12 @@ EmbreeTracer::EmbreeTracer(const Scene& scene, MotionUpdate update, Vertices ver
 
 void EmbreeTracer::moveTriangles(size_t firstTriangle, const glm::vec3* positions, size_t count) {
     if (!geometry_ || firstTriangle + count > triangleCount_) throw RuntimeError("Embree: moved triangles out of range");
-    auto* verts = static_cast<glm::vec3*>(rtcGetGeometryBufferData(geometry_, RTC_BUFFER_TYPE_VERTEX, 0));
-    std::memcpy(verts + 3 * firstTriangle, positions, 3 * count * sizeof(glm::vec3));
+    std::memcpy(ownVertices_.data() + 3 * firstTriangle, positions, 3 * count * sizeof(glm::vec3));
 }
 
 void EmbreeTracer::commitMoves() {
     if (!geometry_) return;
-    rtcUpdateGeometryBuffer(geometry_, RTC_BUFFER_TYPE_VERTEX, 0);
-    rtcCommitGeometry(geometry_);
+    rtcCommitGeometry(geometry_); // the bounds callback reads the moved vertices
     rtcCommitScene(scene_);
     if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw RuntimeError("Embree: updating the BVH failed");
 }
@@ -202,15 +202,18 @@ EmbreeTracer::~EmbreeTracer() {
 
 size_t EmbreeTracer::memoryBytes() const {
     int64_t embree = std::max<int64_t>(0, state_->bytes.load(std::memory_order_relaxed));
-    return size_t(embree) + materialIds_.size() * sizeof(uint32_t) + materialTransmit_.size() * sizeof(float);
+    return size_t(embree) + ownVertices_.size() * sizeof(glm::vec3) + materialIds_.size() * sizeof(uint32_t) +
+           materialTransmit_.size() * sizeof(float);
 }
 
 bool EmbreeTracer::occluded(glm::vec3 origin, glm::vec3 dir, float tfar) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx); // no filter: any triangle blocks, whatever its opacity
+    TraceContext ctx{};
+    rtcInitIntersectContext(&ctx.rtc); // no materials: any triangle blocks, whatever its opacity
+    ctx.ray = watertight::makeRay(origin, dir, tfar);
+    ctx.vertices = vertices_;
     RTCRay ray = makeRay(origin, dir, tfar);
-    rtcOccluded1(scene_, &ctx, &ray);
-    return ray.tfar < 0.0f; // Embree sets tfar = -inf on an occlusion hit
+    if (triangleCount_ > 0) rtcOccluded1(scene_, &ctx.rtc, &ray);
+    return ray.tfar < 0.0f; // tfar = -inf on an occlusion hit
 }
 
 float EmbreeTracer::transmission(glm::vec3 origin, glm::vec3 dir, float tfar) const {
@@ -219,22 +222,18 @@ float EmbreeTracer::transmission(glm::vec3 origin, glm::vec3 dir, float tfar) co
 }
 
 float EmbreeTracer::traceSegment(glm::vec3 origin, glm::vec3 dir, float tfar, std::vector<CountedHit>& seen) const {
-    RTCRay ray = makeRay(origin, dir, tfar);
-    if (!transparent_) {
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        rtcOccluded1(scene_, &ctx, &ray);
-        return ray.tfar < 0.0f ? 0.0f : 1.0f;
-    }
+    if (!transparent_) return occluded(origin, dir, tfar) ? 0.0f : 1.0f;
     seen.clear();
-    FilterContext ctx{};
+    TraceContext ctx{};
     rtcInitIntersectContext(&ctx.rtc);
-    ctx.rtc.filter = transparencyFilter;
+    ctx.ray = watertight::makeRay(origin, dir, tfar);
+    ctx.vertices = vertices_;
     ctx.materialIds = materialIds_.data();
     ctx.materialTransmit = materialTransmit_.data();
     ctx.seen = &seen;
     ctx.transmission = 1.0f;
-    rtcOccluded1(scene_, &ctx.rtc, &ray);
+    RTCRay ray = makeRay(origin, dir, tfar);
+    if (triangleCount_ > 0) rtcOccluded1(scene_, &ctx.rtc, &ray);
     return ray.tfar < 0.0f ? 0.0f : ctx.transmission;
 }
 
@@ -252,7 +251,7 @@ void EmbreeTracer::traceVisibility(const CpuGBuffer& g, const Light& light, floa
         lastRays_ = 0;
         return;
     }
-    const bool directional = light.type == LightType::Directional;
+    const bool directional = light.type == LightType::Directional, area = light.type == LightType::Area;
     const std::vector<glm::vec3> samples = light.samplePoints();
     const glm::vec3 dirToLight = directional ? -light.direction() : glm::vec3(0.0f);
     const float inf = std::numeric_limits<float>::infinity();
@@ -274,7 +273,7 @@ void EmbreeTracer::traceVisibility(const CpuGBuffer& g, const Light& light, floa
                     visibility[i] = 0.0f;
                     continue;
                 }
-                const glm::vec3 o = p + n * rayOffset;
+                const glm::vec3 o = watertight::origin(p, n, rayOffset);
                 if (directional) {
                     visibility[i] = traceSegment(o, dirToLight, inf, seen);
                     ++localRays;
@@ -282,14 +281,9 @@ void EmbreeTracer::traceVisibility(const CpuGBuffer& g, const Light& light, floa
                 }
                 float sum = 0.0f;
                 for (const glm::vec3& s : samples) {
-                    glm::vec3 d = s - o;
-                    float dist = glm::length(d);
                     ++localRays;
-                    if (!(dist > 0.0f)) { // the origin is on the sample point: nothing in between
-                        sum += 1.0f;
-                        continue;
-                    }
-                    sum += traceSegment(o, d / dist, std::max(0.0f, dist - rayOffset), seen);
+                    const watertight::Segment seg = watertight::towardsSample(o, s, rayOffset, area);
+                    sum += seg.d == glm::vec3(0.0f) ? 1.0f : traceSegment(o, seg.d, seg.tfar, seen); // origin on the sample: nothing between
                 }
                 visibility[i] = sum / float(samples.size());
             }

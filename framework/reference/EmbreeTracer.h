@@ -12,12 +12,16 @@
 //                                                                the metrics ignore such pixels).
 //   * otherwise, for each sample point s of light.samplePoints() (a single point for point and spot
 //     lights; for a directional light one ray along -direction() with tfar = +inf), one occlusion
-//     ray: origin o = p + n * rayOffset, unit direction towards s, hits on (0, tfar] (tnear = FLT_MIN),
-//     tfar = max(0, |s - o| - rayOffset) (stops short of the light by the same offset, so a light
-//     sitting on geometry is not shadowed by it). Visibility = mean over the samples of the
+//     ray from o = p + n * rayOffset (rounded as the shaders round it: Watertight.h): to a point or
+//     spot light the segment o + t (s - o), t in (0, 1] (validate keeps every surface 1.25 ray
+//     offsets from such a light, so nothing lies at its end); to an area light's sample, unit
+//     direction, t in (0, |s - o| - rayOffset] (an area light may sit on a surface). Each triangle
+//     is decided by the shaders' own watertight test (Watertight.h, common/watertight.glsl), so
+//     that the GPU algorithms and the reference agree on every ray–triangle pair, ties included;
+//     Embree's BVH only finds the candidates. Visibility = mean over the samples of the
 //     sample's transmission: 1 unoccluded, 0 blocked by an opaque triangle, and for scenes with
 //     transparent materials the product of (1 - opacity) over the distinct surface crossings:
-//     a triangle reported twice (Embree may, e.g. after spatial splits) counts once, and so do
+//     a triangle reported twice counts once, and so do
 //     hits at the same distance (relative 1e-5, kSameHitDistance) on different triangles, which
 //     are one surface crossed exactly at a shared edge or vertex (otherwise the diagonal of every
 //     transparent quad would cast a darker line). A product below kOpaqueTransmission counts as 0
@@ -54,11 +58,10 @@ public:
     EmbreeTracer(const Scene& scene, MotionUpdate update);
     /// How the tracer holds the vertices. Copy: its own (the Scene may go away). Share: a static
     /// scene's Scene::positions are read in place, no second copy (36 bytes a triangle); the Scene
-    /// must then outlive the tracer and not change. Embree's 16-byte loads read 4 bytes past the
-    /// last vertex, so a vector without spare capacity is copied anyway (sharesVertices() says).
+    /// must then outlive the tracer and not change.
     enum class Vertices { Copy, Share };
-    /// `compact`: Embree's memory-conservative layouts (RTC_SCENE_FLAG_COMPACT: indexed leaves
-    /// that read the vertices in place, compact nodes), for scenes whose BVH would crowd memory.
+    /// `compact`: Embree's memory-conservative node layout (RTC_SCENE_FLAG_COMPACT), for scenes
+    /// whose BVH would crowd memory.
     EmbreeTracer(const Scene& scene, MotionUpdate update, Vertices vertices, bool compact = false);
     /// Whether the vertices are the Scene's own (Vertices::Share took effect).
     bool sharesVertices() const { return sharesVertices_; }
@@ -71,7 +74,8 @@ public:
     void traceVisibility(const CpuGBuffer& g, const Light& light, float rayOffset, int threads,
                          std::vector<float>& visibility) const;
 
-    /// Whether any triangle (whatever its opacity) lies on the segment origin + t * dir, t in [0, tfar].
+    /// Whether any triangle (whatever its opacity) lies on the segment origin + t * dir, t in (0, tfar],
+    /// by the shaders' watertight test.
     bool occluded(glm::vec3 origin, glm::vec3 dir, float tfar) const;
     /// Fraction of light passing along the segment: product of (1 - opacity) of the distinct triangles
     /// crossed (0 or 1 in opaque scenes). `dir` need not be unit length; t is in units of |dir|.
@@ -115,7 +119,9 @@ private:
 
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
-    RTCGeometry geometry_ = nullptr; ///< the one triangle geometry (owned by scene_)
+    RTCGeometry geometry_ = nullptr; ///< the one user geometry of triangles (owned by scene_)
+    std::vector<glm::vec3> ownVertices_; ///< the copy, unless the Scene's are shared
+    const glm::vec3* vertices_ = nullptr; ///< 3 per triangle: the Scene's or ownVertices_
     size_t triangleCount_ = 0;
     bool transparent_ = false;
     bool sharesVertices_ = false;

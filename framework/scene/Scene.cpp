@@ -60,10 +60,8 @@ void Scene::append(const Scene& other, const glm::mat4& m) {
     // A mirroring transform flips the winding; keep normals consistent with the winding.
     bool mirrored = glm::determinant(glm::mat3(m)) < 0.0f;
     // Grow geometrically (at least doubling): appending many objects one by one stays linear.
-    // One spare vertex: a static scene's positions are then Embree's own vertex buffer, whose
-    // 16-byte loads read 4 bytes past the last vertex (EmbreeTracer::Vertices::Share).
-    if (positions.capacity() < positions.size() + other.positions.size() + 1) {
-        const size_t want = std::max(positions.size() + other.positions.size() + 1, 2 * positions.capacity());
+    if (positions.capacity() < positions.size() + other.positions.size()) {
+        const size_t want = std::max(positions.size() + other.positions.size(), 2 * positions.capacity());
         positions.reserve(want);
         normals.reserve(want / 3);
         materialIds.reserve(want / 3);

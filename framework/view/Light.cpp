@@ -1,5 +1,7 @@
 #include "framework/view/Light.h"
 
+#include "framework/core/ExactFloat.h"
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -37,21 +39,6 @@ glm::vec3 Light::toLight(glm::vec3 p) const {
     return glm::normalize(position - p);
 }
 
-namespace {
-
-// Exact-decision arithmetic shared with shaders/common/light.glsl: every sum and product rounded
-// to float (this file is compiled without contraction) and a subnormal result flushed to zero, as
-// a GPU may do on its own (GLSL 4.50 section 4.7.1); flushing on both sides makes that choice moot.
-float flushed(float x) { return std::fabs(x) < std::numeric_limits<float>::min() ? 0.0f : x; }
-float exactSub(float a, float b) { return flushed(flushed(a) - flushed(b)); }
-float exactMul(float a, float b) { return flushed(flushed(a) * flushed(b)); }
-float exactDot(glm::vec3 a, glm::vec3 b) {
-    return flushed(flushed(exactMul(a.x, b.x) + exactMul(a.y, b.y)) + exactMul(a.z, b.z));
-}
-glm::vec3 exactSub(glm::vec3 a, glm::vec3 b) { return {exactSub(a.x, b.x), exactSub(a.y, b.y), exactSub(a.z, b.z)}; }
-
-} // namespace
-
 float Light::cosConeSquared() const {
     const double c = std::cos(double(coneDeg) * (3.14159265358979323846 / 180.0));
     return float(c * c);
@@ -59,16 +46,16 @@ float Light::cosConeSquared() const {
 
 bool Light::illuminates(glm::vec3 p) const {
     if (type != LightType::Spot && type != LightType::Area) return true;
-    const glm::vec3 d = direction(), fromLight = exactSub(p, position);
-    const float along = exactDot(fromLight, d);
+    const glm::vec3 d = direction(), fromLight = exact::sub(p, position);
+    const float along = exact::dot(fromLight, d);
     if (type == LightType::Area) return along > 0.0f;
     // Inside the cone: cos(angle to the axis) > cos(half-angle), squared (both sides positive).
-    return along > 0.0f && exactMul(along, along) > exactMul(cosConeSquared(), exactDot(fromLight, fromLight));
+    return along > 0.0f && exact::mul(along, along) > exact::mul(cosConeSquared(), exact::dot(fromLight, fromLight));
 }
 
 bool Light::reaches(glm::vec3 p, glm::vec3 n) const {
-    if (type == LightType::Directional) return exactDot(n, -direction()) > 0.0f;
-    return illuminates(p) && exactDot(n, exactSub(position, p)) > 0.0f;
+    if (type == LightType::Directional) return exact::dot(n, -direction()) > 0.0f;
+    return illuminates(p) && exact::dot(n, exact::sub(position, p)) > 0.0f;
 }
 
 std::vector<glm::vec2> areaSamplePattern(const std::string& pattern, int count, uint32_t seed) {

@@ -14,7 +14,7 @@
 #include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/counters.glsl"
-#include "common/watertight.glsl"
+#include "common/shadow_ray.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #define BVH_TICK_NODE() SIMD_TICK(BVH_SIMD_NODE)
@@ -68,7 +68,7 @@ void main() {
             vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
             visibility = 0.0; // unlit before occlusion (the reference writes 0; metrics skip it)
             if (lightReaches(p, n)) {
-                vec3 o = p + n * uRayOffset; // the same (unnormalised) normal as the reference
+                vec3 o = watertightOrigin(p, n, uRayOffset); // the reference's, bit for bit
                 bool directional = uLightType == LIGHT_DIRECTIONAL;
                 int count = directional ? 1 : uSampleCount, first = uSampleFirst, end = directional ? 1 : uSampleEnd;
                 // The state the earlier dispatches left: unblocked samples and failure flags.
@@ -86,10 +86,11 @@ void main() {
                     if (directional) {
                         r = bvhMakeRay(o, -uLightDirection, kInf);
                     } else {
-                        vec3 d = lightSamples[s].xyz - o;
-                        float dist = length(d);
-                        if (!(dist > 0.0)) { ++unblocked; ++done; continue; } // origin on the sample
-                        r = bvhMakeRay(o, d / dist, max(0.0, dist - uRayOffset));
+                        vec3 d;
+                        float tfar;
+                        shadowRayTo(o, lightSamples[s].xyz, uRayOffset, d, tfar);
+                        if (d == vec3(0.0)) { ++unblocked; ++done; continue; } // origin on the sample
+                        r = bvhMakeRay(o, d, tfar);
                     }
                     BvhTrace t = bvhTrace(r);
                     visited += t.visited;

@@ -1,35 +1,52 @@
 // Watertight ray–triangle test (Woop, Benthin & Wald 2013), shared by the shaders that test shadow
-// rays against triangles (bvh_raytrace; line_space's exact start region). Like Embree's robust mode
-// the reference uses, a ray through a shared edge hits one of the two triangles and never slips
-// between them, so both agree with the reference ray for ray.
+// rays against triangles (bvh_raytrace; the close calls of psv, ptsv, shadow_volumes; metric_tree,
+// izb; line_space's exact start region). A ray through an edge two triangles share hits one of the
+// two and never slips between them.
+//
+// The reference runs this very test (framework/reference/Watertight.cpp, its C++ twin), so the two
+// decide every ray–triangle pair alike, ties included, on any GPU GLSL 4.50 allows: no division and
+// no square root (GLSL allows 2.5 ULP for a division, more for a square root): the ray is sheared by
+// multiplying through by its direction's dominant component, scaled by a power of two; `precise`
+// everywhere (no fused multiply-add); every subnormal flushed to zero on both sides (a GPU may flush
+// them on its own). The values are the same as Woop's times positive factors, so the signs decide
+// the same way.
 //
 // The ray is set up once (watertightRay); vertices are permuted into its frame with swizzles and
 // selects instead of indexing a vector by a variable, which some compilers (llvmpipe's among them)
 // turn into memory accesses.
 struct WatertightRay {
     vec3 o;
-    float tfar;  // hits count on (0, tfar]
-    int kz;      // dominant axis of the direction
-    bool swapXY; // the direction points down kz: swap the other two axes to keep the winding
-    vec3 shear;  // (dx / dz, dy / dz, 1 / dz) in the permuted frame
+    vec3 d;     // permuted (dominant axis last) and scaled by a power of two: |d.z| in [0.5, 1)
+    float tfar; // hits count on (0, tfar] along the direction as given; scaled like d
+    int kz;     // dominant axis of the direction
 };
 
-// v in the ray's frame: (v[kx], v[ky], v[kz]) with kx = (kz + 1) % 3, ky = (kx + 1) % 3, then swapped.
-vec3 watertightPermute(vec3 v, int kz, bool swapXY) {
-    vec3 p = kz == 0 ? v.yzx : (kz == 1 ? v.zxy : v.xyz);
-    return swapXY ? p.yxz : p;
+// Exact-decision arithmetic, the twin of framework/core/ExactFloat.h: operands and result flushed.
+float wtFlush(float x) { return abs(x) < 1.17549435e-38 ? 0.0 : x; }
+vec3 wtFlush(vec3 v) { return vec3(wtFlush(v.x), wtFlush(v.y), wtFlush(v.z)); }
+float wtSub(float a, float b) { precise float r = wtFlush(a) - wtFlush(b); return wtFlush(r); }
+float wtAdd(float a, float b) { precise float r = wtFlush(a) + wtFlush(b); return wtFlush(r); }
+float wtMul(float a, float b) { precise float r = wtFlush(a) * wtFlush(b); return wtFlush(r); }
+vec3 wtSub(vec3 a, vec3 b) { return vec3(wtSub(a.x, b.x), wtSub(a.y, b.y), wtSub(a.z, b.z)); }
+
+// v in the ray's frame: (v[kx], v[ky], v[kz]) with kx = (kz + 1) % 3, ky = (kx + 1) % 3.
+vec3 watertightPermute(vec3 v, int kz) { return kz == 0 ? v.yzx : (kz == 1 ? v.zxy : v.xyz); }
+
+// The reference's ray origin p + n * offset, rounded as framework/reference/Watertight.cpp rounds it.
+vec3 watertightOrigin(vec3 p, vec3 n, float offset) {
+    return vec3(wtAdd(p.x, wtMul(n.x, offset)), wtAdd(p.y, wtMul(n.y, offset)), wtAdd(p.z, wtMul(n.z, offset)));
 }
 
 WatertightRay watertightRay(vec3 o, vec3 d, float tfar) {
     WatertightRay r;
-    r.o = o;
-    r.tfar = tfar;
+    r.o = wtFlush(o);
     vec3 a = abs(d);
     r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
-    float dz = r.kz == 0 ? d.x : (r.kz == 1 ? d.y : d.z);
-    r.swapXY = dz < 0.0;
-    vec3 pd = watertightPermute(d, r.kz, r.swapXY);
-    r.shear = vec3(pd.x / pd.z, pd.y / pd.z, 1.0 / pd.z);
+    vec3 pd = watertightPermute(wtFlush(d), r.kz);
+    int e;
+    frexp(pd.z, e); // pd.z = m * 2^e, |m| in [0.5, 1) (e = 0 for a zero direction)
+    r.d = vec3(wtFlush(ldexp(pd.x, -e)), wtFlush(ldexp(pd.y, -e)), ldexp(pd.z, -e));
+    r.tfar = ldexp(tfar, e);
     return r;
 }
 
@@ -42,41 +59,46 @@ WatertightRay watertightRay(vec3 o, vec3 d, float tfar) {
 // negation, which the watertight argument needs. `precise` alone would give that (no contraction,
 // GLSL 4.50 section 4.8.1), and keeps the value equal to the reference's (uncontracted) one; the
 // canonical order keeps the two triangles consistent even where a compiler contracts anyway.
-// Swapping the endpoints does not change the uncontracted value: rn(rn(ab) - rn(cd)) is odd.
 float watertightEdge(vec2 a, vec2 b) {
     bool swapped = a.x > b.x || (a.x == b.x && a.y > b.y);
     vec2 p = swapped ? b : a, q = swapped ? a : b;
 #if SHADOWLAB_FAULT_FMA_EDGES
     // What a contracting compiler may make of it: fma(p.x, q.y, -(p.y * q.x)), the first product
     // exact. Emulated in double (exact product) because a driver's fma() may itself be unfused.
-    precise float e = float(double(p.x) * double(q.y) - double(p.y * q.x));
+    float e = wtFlush(float(double(p.x) * double(q.y) - double(wtMul(p.y, q.x))));
 #else
-    precise float e = p.x * q.y - p.y * q.x;
+    float e = wtSub(wtMul(p.x, q.y), wtMul(p.y, q.x));
 #endif
     return swapped ? -e : e;
 }
 
+// The edge value decided in double: products of floats are exact in double, so its sign is exact.
+float watertightEdgeInDouble(vec2 a, vec2 b) {
+    return wtFlush(float(double(a.x) * double(b.y) - double(a.y) * double(b.x)));
+}
+
+// A vertex relative to the origin, permuted, projected along the ray onto z = 0 and scaled by d.z.
+vec3 watertightProject(WatertightRay r, vec3 v) {
+    vec3 a = watertightPermute(wtSub(v, r.o), r.kz);
+    return vec3(wtSub(wtMul(a.x, r.d.z), wtMul(r.d.x, a.z)), wtSub(wtMul(a.y, r.d.z), wtMul(r.d.y, a.z)), a.z);
+}
+
 bool watertightHit(WatertightRay r, vec3 v0, vec3 v1, vec3 v2) {
-    vec3 A = watertightPermute(v0 - r.o, r.kz, r.swapXY);
-    vec3 B = watertightPermute(v1 - r.o, r.kz, r.swapXY);
-    vec3 C = watertightPermute(v2 - r.o, r.kz, r.swapXY);
-    // precise: a vertex two triangles share must land on the same 2D point in both
-    precise float Ax = A.x - r.shear.x * A.z, Ay = A.y - r.shear.y * A.z;
-    precise float Bx = B.x - r.shear.x * B.z, By = B.y - r.shear.y * B.z;
-    precise float Cx = C.x - r.shear.x * C.z, Cy = C.y - r.shear.y * C.z;
-    float U = watertightEdge(vec2(Cx, Cy), vec2(Bx, By));
-    float V = watertightEdge(vec2(Ax, Ay), vec2(Cx, Cy));
-    float W = watertightEdge(vec2(Bx, By), vec2(Ax, Ay));
+    vec3 A = watertightProject(r, v0), B = watertightProject(r, v1), C = watertightProject(r, v2);
+    float U = watertightEdge(C.xy, B.xy);
+    float V = watertightEdge(A.xy, C.xy);
+    float W = watertightEdge(B.xy, A.xy);
     if (U == 0.0 || V == 0.0 || W == 0.0) { // on an edge in float: decide it in double
-        // (products of floats are exact in double, so the sign is exact, contracted or not)
-        U = float(double(Cx) * double(By) - double(Cy) * double(Bx));
-        V = float(double(Ax) * double(Cy) - double(Ay) * double(Cx));
-        W = float(double(Bx) * double(Ay) - double(By) * double(Ax));
+        U = watertightEdgeInDouble(C.xy, B.xy);
+        V = watertightEdgeInDouble(A.xy, C.xy);
+        W = watertightEdgeInDouble(B.xy, A.xy);
     }
     if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
-    precise float det = U + V + W; // precise: the reference's rounding, uncontracted
-    if (det == 0.0) return false;
-    precise float T = U * (r.shear.z * A.z) + V * (r.shear.z * B.z) + W * (r.shear.z * C.z);
-    // t = T / det must lie in (0, tfar]
-    return det > 0.0 ? (T > 0.0 && T <= r.tfar * det) : (T < 0.0 && T >= r.tfar * det);
+    float det = wtAdd(wtAdd(U, V), W);
+    float D = wtMul(det, r.d.z); // t = T / D
+    if (D == 0.0) return false;
+    float T = wtAdd(wtAdd(wtMul(U, A.z), wtMul(V, B.z)), wtMul(W, C.z));
+    float end = wtMul(r.tfar, D);
+    // t must lie in (0, tfar]
+    return D > 0.0 ? (T > 0.0 && T <= end) : (T < 0.0 && T >= end);
 }

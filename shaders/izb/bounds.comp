@@ -2,6 +2,7 @@
 // izb, grid_fit samples: each face's box of its lit samples this frame, as ordered words (the uint
 // order of the words is the float order of the values, so atomicMin and atomicMax make the box).
 #include "common/light.glsl"
+#include "common/watertight.glsl"
 #include "izb/layout.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D uPosition;
@@ -20,7 +21,7 @@ void main() {
     vec4 pos = texelFetch(uPosition, px, 0);
     vec3 n = texelFetch(uNormal, px, 0).xyz;
     if (!(pos.w >= 0.5 && lightReaches(pos.xyz, n))) return;
-    vec3 x = pos.xyz + n * uRayOffset;
+    vec3 x = watertightOrigin(pos.xyz, n, uRayOffset);
     int face = 0;
     vec2 uv;
     if (lightIsDirectional()) uv = izbOrtho(x);

@@ -4,6 +4,7 @@
 // the cell it went to (as an integer: a cell index as float bits could be a denormal or a NaN). A sample the light does not reach (outside a spot's cone, facing away) is
 // not inserted: its visibility is 0, as the reference's.
 #include "common/light.glsl"
+#include "common/watertight.glsl"
 #include "izb/layout.glsl"
 #include "izb/grid.glsl"
 #include "common/stored_float.glsl"
@@ -29,7 +30,7 @@ void main() {
     ivec2 at = ivec2(0);
     vec4 pos = texelFetch(uPosition, px, 0);
     vec3 n = texelFetch(uNormal, px, 0).xyz;
-    vec3 x = pos.xyz + n * uRayOffset;
+    vec3 x = watertightOrigin(pos.xyz, n, uRayOffset);
     if (pos.w >= 0.5 && lightReaches(pos.xyz, n)) {
         if (lightIsDirectional()) {
             at = izbCellOf(0, izbOrtho(x));

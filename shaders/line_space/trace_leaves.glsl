@@ -3,7 +3,7 @@
 uint leafCells = 0u, trianglesTested = 0u, nearNodes = 0u; // read by leafWalk, the near field (counters)
 
 #if LS_START_MODE == LS_START_EXACT
-WatertightRay exactRay = WatertightRay(vec3(0.0), 0.0, 2, false, vec3(0.0)); // the current ray, in the triangle test's frame
+WatertightRay exactRay = WatertightRay(vec3(0.0), vec3(0.0), 0.0, 2); // the current ray, in the triangle test's frame
 #endif
 
 #if LS_LEAF_SPLIT > 1

@@ -372,7 +372,7 @@ void main() {
             visibility = 0.0; // facing away from the light
             // The reference's ray origin: the same offset along the same (unnormalised) normal.
             // Facing the light and inside a spot's cone, decided as the reference decides it (Light::reaches).
-            if (lightReaches(x, nrm)) { needs = true; q = x + nrm * uRayOffset; }
+            if (lightReaches(x, nrm)) { needs = true; q = watertightOrigin(x, nrm, uRayOffset); }
         }
     }
     Result r = Result(1.0, 0u, 0u, 0u, 0u, 0u, 0u, false, false);

@@ -299,9 +299,9 @@ void queryPixel(ivec2 px) {
         vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
         visibility = 0.0; // facing away from the light, or outside a spot's cone
         if (lightReaches(p, n)) {
-            // The reference's ray origin: the same offset along the same (unnormalised) normal;
-            // precise, so that both passes' programs round it alike.
-            precise vec3 q = p + n * uRayOffset;
+            // The reference's ray origin: the same offset along the same (unnormalised) normal,
+            // rounded alike in both passes' programs and the reference.
+            vec3 q = watertightOrigin(p, n, uRayOffset);
             Query Q;
             Q.q = q;
 #if PSV_DEPTH_SKIP

@@ -5,6 +5,7 @@
 // tile's distinct clusters and reduce.comp builds the levels above. No shared memory and no
 // barrier: a barrier makes llvmpipe run the workgroups as coroutines.
 #include "common/light.glsl"
+#include "common/watertight.glsl"
 #include "common/scene.glsl"
 #include "ptsv/ptsv.glsl"
 layout(local_size_x = PTSV_TILE, local_size_y = PTSV_TILE) in;
@@ -27,7 +28,7 @@ void main() {
             // Facing the light and inside a spot's cone, decided as the reference decides it (Light::reaches).
             if (lightReaches(p, n)) {
                 // The reference's ray origin: the same offset along the same (unnormalised) normal.
-                q = p + n * uRayOffset;
+                q = watertightOrigin(p, n, uRayOffset);
                 // The key follows the G-buffer point p (in this pixel's frustum); q is at most
                 // uRayOffset away, which the implicit-bounds test allows for.
                 float depth = -(uView * vec4(p, 1.0)).z;

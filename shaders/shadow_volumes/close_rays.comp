@@ -31,7 +31,7 @@ void main() {
     ivec2 px;
     if (!pixelListEntry(px)) return;
     vec3 p = texelFetch(uPosition, px, 0).xyz, n = texelFetch(uNormal, px, 0).xyz;
-    vec3 o = p + n * uRayOffset, d;
+    vec3 o = watertightOrigin(p, n, uRayOffset), d;
     float tfar;
     shadowRaySegment(o, uRayOffset, d, tfar);
     BvhTrace t = bvhTrace(bvhMakeRay(o, d, tfar));

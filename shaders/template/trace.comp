@@ -10,7 +10,7 @@
 #include "common/statistics.glsl"
 #include "common/light.glsl"
 #include "common/scene.glsl"
-#include "common/watertight.glsl"
+#include "common/shadow_ray.glsl"
 #include "common/counters.glsl"
 #include "template/layout.glsl"
 layout(local_size_x = TEMPLATE_GROUP_SIDE, local_size_y = TEMPLATE_GROUP_SIDE) in;
@@ -66,7 +66,7 @@ void main() {
         vec3 p = pos.xyz, n = texelFetch(uNormal, px, 0).xyz;
         visibility = 0.0; // not reached by the light (the metrics skip these pixels)
         if (lightReaches(p, n)) {
-            vec3 o = p + n * uRayOffset;
+            vec3 o = watertightOrigin(p, n, uRayOffset); // the reference's, bit for bit
             bool directional = lightIsDirectional();
             int count = directional ? 1 : uSampleCount, end = directional ? 1 : uSampleEnd;
             uint unblocked = 0u; // samples the earlier dispatches found unblocked, then this one's
@@ -80,10 +80,11 @@ void main() {
                 if (directional) {
                     r = watertightRay(o, -uLightDirection, kInf);
                 } else {
-                    vec3 d = lightSamples[s].xyz - o;
-                    float dist = length(d);
-                    if (!(dist > 0.0)) { ++unblocked; continue; } // origin on the sample
-                    r = watertightRay(o, d / dist, max(0.0, dist - uRayOffset));
+                    vec3 d;
+                    float tfar;
+                    shadowRayTo(o, lightSamples[s].xyz, uRayOffset, d, tfar);
+                    if (d == vec3(0.0)) { ++unblocked; continue; } // origin on the sample
+                    r = watertightRay(o, d, tfar);
                 }
                 if (!occluded(r, tests)) ++unblocked;
             }
