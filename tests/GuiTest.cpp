@@ -240,8 +240,9 @@ TEST(GuiTest, PlaysMovingGeometryOnTheRunnersClock) {
 TEST(GuiTest, BadInputIsOneLineAndExitCode2) {
     if (kGui.empty()) FAIL() << "shadowlab-gui was not built (needs libglfw3-dev and libimgui-dev)";
     // Checked before any window opens, so no X server is needed.
+    // Twenty-third probe: a repeated --set was taken (the last one), where shadowlab run refuses it.
     for (const std::string args : {" --set no_such_key=1", " --algorithm no_such_algorithm", " --set resolution=1",
-                                   " --frames x", " /nonexistent/config.json"}) {
+                                   " --frames x", " /nonexistent/config.json", " --algorithm shadow_map --set pcf=0 --set pcf=3"}) {
         std::string out;
         EXPECT_EQ(test::runCommand(kGui + " " + (args[1] == '/' ? "" : kSmoke) + args, out), 2) << args << "\n" << out;
         std::string trimmed = out.substr(0, out.find_last_not_of('\n') + 1);
@@ -290,6 +291,10 @@ TEST(GuiTest, WhatValidateRefusesAndOutputsOverInputsAreRefusedBeforeAFrame) {
         EXPECT_NE(out.find("an input of this session"), std::string::npos) << out;
     }
     EXPECT_EQ(text(dir + "/c.json"), original);
+    // Twenty-third probe: a line_space pool validate refuses, asked for with --set, failed in the
+    // build with exit 1; it is refused before the first frame, as validate refuses it.
+    EXPECT_EQ(runGui(cmd + " " + dir + "/c.json --frames 1 --size 64x64 --algorithm line_space --set n=8 --set d=4 2>&1", out), 2) << out;
+    EXPECT_NE(out.find("line_space"), std::string::npos) << out;
 #if !defined(__SANITIZE_ADDRESS__)
     std::ofstream(dir + "/big.json") << test::configWith(
         {{"scene", R"({"objects": [{"procedural": "soup", "triangles": 8000000}]})"}});

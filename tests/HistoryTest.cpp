@@ -465,6 +465,35 @@ TEST(HistoryTest, ATimeOrResolutionNoRunWritesIsBadInput) {
     }
 }
 
+// Twenty-third probe: a summary with no results ("algorithms": {}) beside a config that runs sm
+// compared as "No regression", exit 0, and history showed empty cells. Results must be those of
+// exactly the ids the run's config.resolved.json gives, each of its algorithm (as sweep merge holds them).
+TEST(HistoryTest, ResultsOtherThanTheConfigsIdsAreBadInput) {
+    const std::vector<std::pair<std::function<void(Json&)>, std::string>> edits = {
+        {[](Json& s) { s["algorithms"] = Json::object(); }, "holds no results for \"bvh_raytrace\""},
+        {[](Json& s) { s["algorithms"].erase("bvh_raytrace"); }, "holds no results for \"bvh_raytrace\""},
+        {[](Json& s) { s["algorithms"]["extra"] = s["algorithms"]["psv"]; }, "an id its config.resolved.json does not give"},
+        {[](Json& s) { s["algorithms"]["psv"]["algorithm"] = "izb"; }, "another algorithm than its config.resolved.json"},
+    };
+    for (const auto& [change, why] : edits) {
+        const std::string dir = test::makeTempDir("history-ids");
+        writeRuns(dir, {20, 20}, {0, 0}, kSpread);
+        for (const char* run : {"/run-99", "/run-100"}) {
+            Json s = Json::parse(std::ifstream(dir + run + "/summary.json"));
+            s["algorithms"]["psv"]["algorithm"] = "psv";
+            s["algorithms"]["bvh_raytrace"]["algorithm"] = "bvh_raytrace";
+            if (std::string(run) == "/run-99") change(s);
+            std::ofstream(dir + run + "/summary.json") << s.dump();
+            std::ofstream(dir + run + "/config.resolved.json")
+                << R"({"reference": false, "algorithms": [{"id": "psv", "algorithm": "psv"}, {"id": "bvh_raytrace", "algorithm": "bvh_raytrace"}]})";
+        }
+        const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "compare", dir + "/run-100", dir + "/run-99"});
+        EXPECT_EQ(ran.rc, 2) << why << ": " << ran.err;
+        EXPECT_NE(ran.err.find(why), std::string::npos) << ran.err;
+        EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
+    }
+}
+
 // Twenty-second probe: compare followed a summary.json linked to another run's (merge refused it),
 // and took a summary's resolution that its own config.resolved.json contradicts.
 TEST(HistoryTest, ASummaryThatIsNotTheRunsOwnIsBadInput) {

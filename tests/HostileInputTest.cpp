@@ -300,6 +300,17 @@ std::vector<BadCase> badCases() {
         {"GltfIndicesAccessorMissing", "m.gltf",
          test::triangleGltf({{"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "indices": 9}]}])"}}),
          {"m.gltf", "/meshes/0/primitives/0/indices", "accessor index 9 is out of range"}},
+        // Twenty-third probe: an index accessor without a bufferView got tinygltf's message without a
+        // path; a buffer's uri climbing out of the model's folder read any file, and the index
+        // checks printed its bytes.
+        {"GltfIndicesWithoutABufferView", "m.gltf",
+         test::triangleGltf({{"meshes", R"([{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}])"},
+                             {"accessors", R"([{"bufferView": 0, "componentType": 5126, "type": "VEC3", "count": 3, "min": [0, 0, 0],
+                                 "max": [1, 1, 0]}, {"componentType": 5121, "count": 3, "type": "SCALAR"}])"}}),
+         {"m.gltf", "/meshes/0/primitives/0/indices", "has no bufferView"}},
+        {"GltfBufferUriClimbsOutOfItsFolder", "m.gltf",
+         test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "../../../../../../../../../../etc/passwd"}])"}}),
+         {"m.gltf", "/buffers/0/uri", "outside the glTF file's folder"}},
         {"GltfRootListedTwice", "m.gltf", test::triangleGltf({{"scenes", R"([{"nodes": [0, 0]}])"}}),
          {"m.gltf", "/scenes/0/nodes/1", "listed twice"}},
         {"GltfAlphaModeNotInTheEnumeration", "m.gltf",

@@ -229,5 +229,37 @@ TEST(MemoryPlanTest, LineSpaceEstimateCoversItsPools) {
     }
 }
 
+// Twenty-third probe: before its window exists the GUI plans without the device's limits, and
+// line_space's pools planned uncapped (32 GiB for N 6, d 4, where run planned 2.45) refused a
+// config validate accepts. Unknown limits now plan the pools at the least storage block GL
+// allows, never more than any device's limits would.
+TEST(MemoryPlanTest, LineSpaceWithUnknownLimitsPlansNoMoreThanWithTheDevices) {
+    const AlgorithmInfo* a = findAlgorithm("line_space");
+    ASSERT_NE(a, nullptr);
+    for (auto [n, d] : {std::pair{6, 4}, std::pair{8, 5}, std::pair{6, 3}}) {
+        ParamValues params(a->schema());
+        params.set("n", n);
+        params.set("d", d);
+        FootprintQuery unknown;
+        unknown.resolution = {64, 64};
+        unknown.params = &params;
+        unknown.triangles = 1'000'000;
+        for (size_t reported : {size_t(128) << 20, size_t(2) << 30}) {
+            FootprintQuery device = unknown;
+            device.reportedStorageBlockBytes = reported;
+            device.storageBlockBytes = reported;
+            EXPECT_LE(a->footprint(unknown).bytes, a->footprint(device).bytes) << "N " << n << " d " << d << ", block " << reported;
+        }
+    }
+}
+
+// Twenty-third probe: under a small ulimit the refusal read "0.00 GiB ... of 0.00 GiB".
+TEST(MemoryPlanTest, SmallSizesAreWrittenInMiB) {
+    EXPECT_EQ(formatMemorySize(size_t(60) << 20), "60.0 MiB");
+    EXPECT_EQ(formatMemorySize(size_t(600) << 20), "0.59 GiB");
+    EXPECT_EQ(formatMemorySize(size_t(3) << 20), "3.0 MiB");
+    EXPECT_EQ(formatMemorySize(size_t(6) << 30), "6.00 GiB");
+}
+
 } // namespace
 } // namespace shadowlab

@@ -1,6 +1,7 @@
 // The output place: checked before any work, locked against a second run, swapped in one step,
 // cleaned of what killed runs left, never replacing what is not a shadowlab output.
 #include "framework/core/Error.h"
+#include "framework/experiment/Compare.h"
 #include "framework/experiment/OutputPlace.h"
 #include "tests/TestSupport.h"
 
@@ -370,6 +371,42 @@ TEST(OutputPlaceTest, AnAbsurdlyLongPathIsEchoedShort) {
     EXPECT_NE(err.find("already exists"), std::string::npos) << err;
     EXPECT_NE(err.find("..."), std::string::npos) << err;
     EXPECT_LT(err.size(), 600u) << err;
+}
+
+// Twenty-third probe: a run killed while it deleted the results it had just replaced left them,
+// unmarked, at DIR.partial-PID; no later run removed them and history counted them as a run. They
+// carry the leftover mark before the exchange now, the next run into DIR removes them, and no
+// reader of results takes a run's temporary folder for a run.
+TEST(OutputPlaceTest, PreviousResultsCaughtMidDeletionAreALeftoverTheNextRunRemoves) {
+    std::string base = test::makeTempDir("place-mid-delete"), out = base + "/out";
+    makeOutput(out, "old");
+    static std::string leftover;
+    static bool marked = false;
+    OutputPlace::afterExchangeForTests = [](const std::string& previous) {
+        leftover = previous;
+        marked = fs::exists(previous + "/.shadowlab-partial");
+        throw std::runtime_error("killed");  // the deletion never happens
+    };
+    {
+        OutputPlace p = OutputPlace::open(out, true);
+        std::ofstream(p.partialDir() + "/summary.json") << "new";
+        EXPECT_THROW(p.commit(), std::runtime_error);
+    }
+    OutputPlace::afterExchangeForTests = nullptr;
+    EXPECT_EQ(slurp(out + "/summary.json"), "new");
+    ASSERT_TRUE(fs::exists(leftover + "/summary.json")) << "the previous results, where the kill left them";
+    EXPECT_TRUE(marked) << "the previous results carried no leftover mark at the exchange";
+    try {
+        readRunSummary(leftover);
+        ADD_FAILURE() << "a run's temporary folder was read as a run";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("temporary folder"), std::string::npos) << e.what();
+    }
+    std::vector<std::string> notes;
+    { OutputPlace next = OutputPlace::open(out, true, &notes); }
+    EXPECT_FALSE(fs::exists(leftover)) << "the next run into the output left the leftover";
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_NE(notes[0].find("left by an interrupted run"), std::string::npos) << notes[0];
 }
 
 } // namespace

@@ -380,6 +380,27 @@ TEST(SweepMergeEdgeTest, ALinkAtAReportFileIsRefusedLikeOneAtTheTable) {
     }
 }
 
+// Twenty-third probe: a sweep folder whose runs/ was a link wrote its runs through it, replacing a
+// user's files in the folder it named (exit 0). The runs go into the sweep's own folder only.
+TEST(SweepMergeEdgeTest, ALinkedRunsFolderIsRefusedAndWhatItNamesIsLeftAlone) {
+    const std::string dir = test::makeTempDir("sweep-linked-runs");
+    const std::string out = dir + "/sw", victim = dir + "/elsewhere", file = smallFile(dir);
+    ASSERT_FALSE(test::fakeSweepRuns(kBin, file, out).is_null());  // a sweep's folder, its runs kept elsewhere
+    fs::remove_all(out + "/runs");
+    fs::create_directories(victim);
+    std::ofstream(victim + "/notes.log") << "keep";
+    fs::create_directory_symlink(victim, out + "/runs");
+    const Ran r = runArgs(sweep({"run", file, "--out", out}));
+    EXPECT_EQ(r.rc, 2) << r.err;
+    expectOneShortLine(r);
+    EXPECT_NE(r.err.find("symbolic link"), std::string::npos) << r.err;
+    size_t entries = 0;
+    for (const auto& e : fs::directory_iterator(victim)) entries += e.path().filename() != "notes.log";
+    EXPECT_EQ(entries, 0u) << "the sweep wrote into the folder the link names";
+    std::ifstream kept(victim + "/notes.log");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(kept), {}), "keep");
+}
+
 /// Sweeps that plan accepts at the edges of what it accepts; the report must take each of them.
 struct EdgeSweep {
     const char* name;
@@ -433,6 +454,8 @@ TEST(SweepStateTest, BrokenSummariesAreFailedRunsAndTheGoodOnesAreMerged) {
     fs::create_directory(summary(2)); // a directory in its place
     Json missing = test::fakeSummary(10);
     missing["algorithms"]["psv"]["time_ms"]["total"].erase("mean"); // a key the table needs
+    missing["algorithms"]["reference"] = missing["algorithms"]["shadow_map"];  // the config's ids all there
+    missing["algorithms"]["reference"]["algorithm"] = "reference";
     std::ofstream(summary(3), std::ios::trunc) << missing.dump();
 
     Ran r = runArgs(sweep({"merge", out, "--no-plots"}));

@@ -604,7 +604,13 @@ Footprint lineSpaceFootprint(const FootprintQuery& q) {
     const bool culled = exact && p.startTriangles == LineSpaceStartTriangles::Culled;
     const bool split = p.leafSplit > 1;
     const size_t n = q.triangles;
-    const size_t pools = lineSpacePoolBound(p.n, p.d, n, q.reportedStorageBlockBytes);
+    // Limits not known yet (the GUI's check before its window; the device's follows before the
+    // first frame): the pools capped at the least storage block GL 4.5 allows, so that this early
+    // check never refuses what the device's own limits admit (twenty-third probe: planned
+    // uncapped, (6, 4) came to 32 GiB where run planned 2.45).
+    constexpr size_t kGlMinStorageBlockBytes = size_t(1) << 27;
+    const size_t block = q.reportedStorageBlockBytes > 0 ? q.reportedStorageBlockBytes : kGlMinStorageBlockBytes;
+    const size_t pools = lineSpacePoolBound(p.n, p.d, n, block);
     // The pools are built on the host and uploaded: both copies are held while setScene() runs.
     f.bytes = saturatingSum({saturatingMul(8 + (culled ? 16 : 0) + (split ? 8 : 0), n), pools});
     f.peakBytes = saturatingSum({pools, saturatingMul(8, n)});

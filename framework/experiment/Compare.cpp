@@ -5,6 +5,7 @@
 #include "framework/core/Text.h"
 #include "framework/experiment/Config.h"
 #include "framework/experiment/JUnit.h"
+#include "framework/experiment/OutputPlace.h"
 #include "framework/metrics/Noise.h"
 
 #include <algorithm>
@@ -233,24 +234,59 @@ namespace {
 void checkAgainstConfig(const Json& s, const std::string& dir, const std::string& file) {
     const std::string config = dir + "/config.resolved.json";
     std::error_code ec;
-    if (!s.contains("resolution") || !fs::is_regular_file(fs::symlink_status(config, ec))) return;
+    if (!fs::is_regular_file(fs::symlink_status(config, ec))) return;
     Json c;
     try {
         c = Json::parse(readInputFile(config, size_t(16) << 20));
     } catch (const std::exception&) {
         return; // not a run's config: what is checked of the summary stands alone
     }
-    if (c.is_object() && c.contains("resolution") && c["resolution"] != s["resolution"])
+    if (c.is_object() && c.contains("resolution") && s.contains("resolution") && c["resolution"] != s["resolution"])
         throw InputError(file, "/resolution", "holds " + shortText(s["resolution"].dump(), 40) + " where the run's config.resolved.json says " +
                                                   shortText(c["resolution"].dump(), 40));
+    // Results for exactly the ids the config gives, each of its algorithm (twenty-third probe: a
+    // summary with no results compared as "No regression"; sweep merge held its runs to this).
+    if (!c.is_object() || !c.contains("algorithms")) return; // not a run's resolved config, which lists them
+    std::set<std::string> ids;
+    collectIds(c, ids);
+    for (const auto& [id, entry] : s["algorithms"].items()) {
+        if (!ids.count(id))
+            throw InputError(file, "/algorithms/" + id, "holds results under an id its config.resolved.json does not give");
+        if (const std::string algorithm = algorithmOf(c, id); entry.value("algorithm", Json()) != Json(algorithm))
+            throw InputError(file, "/algorithms/" + id + "/algorithm",
+                             "names another algorithm than its config.resolved.json (" + shortText(algorithm, 60) + ")");
+    }
+    for (const std::string& id : ids)
+        if (!s["algorithms"].contains(id))
+            throw InputError(file, "/algorithms", "holds no results for \"" + shortText(id, 60) + "\", which its config.resolved.json runs");
 }
 } // namespace
+
+void collectIds(const Json& resolved, std::set<std::string>& ids) {
+    if (resolved.value("reference", Json(true)) != Json(false)) ids.insert("reference");
+    if (resolved.contains("algorithms") && resolved["algorithms"].is_array())
+        for (const Json& a : resolved["algorithms"])
+            if (a.is_object() && a.contains("id") && a["id"].is_string()) ids.insert(a["id"].get<std::string>());
+}
+
+std::string algorithmOf(const Json& resolved, const std::string& id) {
+    if (id == "reference") return resolved.value("reference", Json(true)) != Json(false) ? "reference" : "";
+    if (resolved.contains("algorithms") && resolved["algorithms"].is_array())
+        for (const Json& a : resolved["algorithms"])
+            if (a.is_object() && a.value("id", Json()) == Json(id) && a.contains("algorithm") && a["algorithm"].is_string())
+                return a["algorithm"].get<std::string>();
+    return "";
+}
 
 Json readRunSummary(const std::string& dir) {
     const std::string file = dir + "/summary.json";
     std::error_code ec;
     if (!fs::is_directory(dir, ec) || !fs::exists(file, ec))
         throw InputError(shortText(dir, 300), "", "is not a run's output folder (it holds no summary.json)");
+    // A killed run's leftover is not a run (twenty-third probe: the previous results, half
+    // deleted, were counted by history as a complete run).
+    if (OutputPlace::isRunTemporary(fs::path(dir).lexically_normal().filename().string()))
+        throw InputError(shortText(dir, 300), "", "is a run's temporary folder (DIR.partial-PID, DIR.old-PID or DIR.kept-PID), not a run's output");
     // The run's own file, as sweep merge holds it (twenty-second probe: compare followed a link to
     // another run's summary).
     if (fs::is_symlink(fs::symlink_status(file, ec)))

@@ -8,6 +8,7 @@
 #include "framework/core/JsonNode.h"
 #include "framework/metrics/Noise.h"
 
+#include <set>
 #include <string>
 
 namespace shadowlab {
@@ -30,8 +31,17 @@ struct Comparison {
     size_t regressions = 0;
 };
 
-/// DIR/summary.json, which must be a complete run's (InputError naming the file otherwise).
+/// DIR/summary.json, which must be a complete run's (InputError naming the file otherwise): not a
+/// run's temporary folder (DIR.partial-PID, DIR.old-PID, DIR.kept-PID), and, where the folder holds
+/// its config.resolved.json, results for exactly the ids that config gives, each of the algorithm
+/// it names, at its resolution.
 Json readRunSummary(const std::string& dir);
+
+/// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
+void collectIds(const Json& resolvedConfig, std::set<std::string>& ids);
+/// The algorithm a resolved run config runs under `id` ("reference" for the reference), "" when
+/// it gives no such id.
+std::string algorithmOf(const Json& resolvedConfig, const std::string& id);
 /// The top-level keys in which two runs' config.resolved.json differ (output.dir aside), or one
 /// entry saying a file cannot be read.
 std::vector<std::string> configDifferences(const std::string& baseDir, const std::string& newDir);

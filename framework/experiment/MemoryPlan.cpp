@@ -49,9 +49,12 @@ DeviceLimits currentDeviceLimits(size_t triangles) {
     return {storage, maxTextureBufferTexels(), reported};
 }
 
-std::string formatGiB(size_t bytes) {
+std::string formatMemorySize(size_t bytes) {
+    // Below a tenth of a GiB in MiB: "0.00 GiB of 0.00 GiB" hid both sides of a refusal under a
+    // small ulimit (twenty-third probe).
     char s[32];
-    std::snprintf(s, sizeof s, "%.2f GiB", double(bytes) / double(size_t(1) << 30));
+    if (bytes < (size_t(1) << 30) / 10) std::snprintf(s, sizeof s, "%.1f MiB", double(bytes) / double(size_t(1) << 20));
+    else std::snprintf(s, sizeof s, "%.2f GiB", double(bytes) / double(size_t(1) << 30));
     return s;
 }
 
@@ -64,7 +67,7 @@ Json MemoryPlan::toJson() const {
 }
 
 std::string MemoryPlan::summary() const {
-    std::string s = formatGiB(peak) + " estimated at the peak, of " + formatGiB(available) + " available (";
+    std::string s = formatMemorySize(peak) + " estimated at the peak, of " + formatMemorySize(available) + " available (";
     bool first = true;
     // The largest parts, at most five: a plan of 2000 algorithm entries stays one short line.
     std::vector<std::pair<std::string, size_t>> parts = held;
@@ -130,7 +133,7 @@ std::vector<std::string> describeFootprints(const ExperimentConfig& cfg, size_t 
     for (const AlgorithmEntry* e : planEntries(cfg)) {
         const Footprint f = footprintOf(*e, cfg, triangles, moving, limits);
         lines.push_back(e->id + " (" + e->info->name + "): " +
-                        (f.refusal.empty() ? formatGiB(f.bytes) + " held, " + formatGiB(f.peakBytes) + " more while it sets up" +
+                        (f.refusal.empty() ? formatMemorySize(f.bytes) + " held, " + formatMemorySize(f.peakBytes) + " more while it sets up" +
                                                  (e->info->sceneCheck ? " (at most; whether its structures fit this device "
                                                                         "is decided on the scene, by validate and run)"
                                                                       : "")
@@ -259,8 +262,8 @@ MemoryPlan checkMemoryPlan(const ExperimentConfig& cfg, const ScenePrediction& s
         throw InputError(cfg.file, "/scene",
                          "the run would need about " + plan.summary() + " for up to " + std::to_string(triangles) +
                              " triangles; " +
-                             (*machine.limitedBy ? "this process may take " + formatGiB(plan.available) + " more (" + machine.limitedBy + ")"
-                                                 : "this machine has " + formatGiB(plan.machine) + " in all") +
+                             (*machine.limitedBy ? "this process may take " + formatMemorySize(plan.available) + " more (" + machine.limitedBy + ")"
+                                                 : "this machine has " + formatMemorySize(plan.machine) + " in all") +
                              ": use fewer triangles or algorithms");
     return plan;
 }

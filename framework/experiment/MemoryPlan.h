@@ -65,7 +65,7 @@ InputError sceneRefusalError(const ExperimentConfig& cfg, const AlgorithmEntry& 
 /// what `shadowlab plan` prints, to find the size where each algorithm stops.
 std::vector<std::string> describeFootprints(const ExperimentConfig& cfg, size_t triangles, bool moving, const DeviceLimits& limits);
 
-/// "1.23 GiB".
-std::string formatGiB(size_t bytes);
+/// "1.23 GiB", or "45.6 MiB" below a tenth of a GiB.
+std::string formatMemorySize(size_t bytes);
 
 } // namespace shadowlab

@@ -651,8 +651,15 @@ void OutputPlace::commit() {
             refuseCommit("it now holds \"" + shortText(foreign, 80) + "\", which the output there did not write");
     writeManifest(fs::path(partial_));
     if (exists) {
+        // The previous results get the leftover mark first: after the exchange they sit at
+        // DIR.partial-PID while they are deleted, and a run killed meanwhile must leave them
+        // marked for the next run to remove (twenty-third probe: half-deleted previous results
+        // stayed, unmarked, and history counted them as a run). Killed before the exchange, the
+        // output keeps a stray mark, which no check reads there.
+        (void)writeMark(fs::path(final_) / kPartialMark);
         if (::renameat2(AT_FDCWD, partial_.c_str(), AT_FDCWD, final_.c_str(), RENAME_EXCHANGE) == 0) {
             committed_ = true;
+            if (afterExchangeForTests) afterExchangeForTests(partial_);
             fs::remove_all(partial_, ec);  // now the previous results
         } else if (errno == EINVAL || errno == ENOSYS) {
             // A file system without exchange: two renames; open() recovers DIR.old-PID if killed between.
@@ -693,6 +700,8 @@ bool OutputPlace::isRunOutput(const std::string& dir) {
     const std::string m = markerOf(fs::path(dir));
     return m == "summary.json" || m == "config.resolved.json";
 }
+
+bool OutputPlace::isRunTemporary(const std::string& name) { return shadowlab::isRunTemporary(name); }
 
 bool OutputPlace::isCompleteOutput(const std::string& dir) {
     std::error_code ec;

@@ -67,6 +67,13 @@ public:
     static bool isCompleteOutput(const std::string& dir);
     /// Whether `dir` is a run's output, finished or not (summary.json or config.resolved.json).
     static bool isRunOutput(const std::string& dir);
+    /// Whether a folder's name is that of a run's temporary folder (X.partial-PID, X.old-PID,
+    /// X.kept-PID), which no run's output may take.
+    static bool isRunTemporary(const std::string& name);
+
+    /// Tests only: called between the exchange of a commit that replaces an output and the removal
+    /// of the previous results (at `previous`), where a run killed at that moment leaves them.
+    static inline void (*afterExchangeForTests)(const std::string& previous) = nullptr;
 
 private:
     OutputPlace() = default;

@@ -32,6 +32,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+std::vector<int> sortedCopy(std::vector<int> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
@@ -169,7 +174,8 @@ public:
     ExperimentRun(const ExperimentConfig& cfg, const RunOptions& opt, const std::string& backend)
         : cfg_(cfg), opt_(opt), backend_(backend), place_(openPlace(cfg, opt, ownPlace_)),
           dir_(place_ ? place_->partialDir() : std::string()), finalDir_(place_ ? place_->finalDir() : std::string()),
-          sceneGpu_(*cfg.scene), gbuffer_(cfg.resolution), shading_(cfg.resolution), statFrames_(cfg.statisticsFrames()) {}
+          sceneGpu_(*cfg.scene), gbuffer_(cfg.resolution), shading_(cfg.resolution), statFrames_(cfg.statisticsFrames()),
+          imageFrames_(sortedCopy(cfg.imagesAtFrames)) {}
 
     ExperimentResults run() {
         setUp();
@@ -228,9 +234,7 @@ private:
                                              instances_.size());
     }
 
-    bool isImageFrame(int f) const {
-        return opt_.writeOutputs && std::find(cfg_.imagesAtFrames.begin(), cfg_.imagesAtFrames.end(), f) != cfg_.imagesAtFrames.end();
-    }
+    bool isImageFrame(int f) const { return opt_.writeOutputs && std::binary_search(imageFrames_.begin(), imageFrames_.end(), f); }
     bool isStatFrame(int f) const { return std::binary_search(statFrames_.begin(), statFrames_.end(), f); }
 
     // The G-buffer and its CPU copy are every algorithm's shared input, made before any timer
@@ -451,6 +455,7 @@ private:
     StageTimer timer_;
     const bool softwareGl_ = isSoftwareRenderer(glRendererString());
     const std::vector<int> statFrames_;
+    const std::vector<int> imageFrames_; ///< output.images_at_frames, sorted
     std::vector<Instance> instances_;
     size_t rssAfterSetup_ = 0;
     ExperimentResults results_;

@@ -50,10 +50,26 @@ AutomationPlan planAutomation(const GuiOptions& opts, const ExperimentConfig& co
     // Rules between parameters, once every --set is in (their order does not matter).
     std::string why;
     if (const ParamRule* r = trial.brokenRule(&why)) throw InputError("--set", r->key, why);
+    plan.params = trial;
     if (opts.startFrame >= config.frames)
         throw InputError("--frame", "", "frame " + std::to_string(opts.startFrame) + " is outside [0, " +
                                             std::to_string(config.frames - 1) + "]");
     return plan;
+}
+
+ExperimentConfig configAsStarted(const ExperimentConfig& config, const AutomationPlan& plan) {
+    ExperimentConfig started = config;
+    const std::vector<AlgorithmChoice> choices = algorithmChoices(config);
+    const AlgorithmChoice& choice = choices[size_t(plan.choice)];
+    const ParamValues& params = plan.params ? *plan.params : choice.params;
+    if (!choice.fromConfig) {
+        started.algorithms.push_back({choice.label, choice.info, params, "--algorithm"});
+        return started;
+    }
+    for (AlgorithmEntry& e : started.algorithms)
+        if (e.id == choice.label) e.params = params;
+    if (started.reference && started.referenceEntry.id == choice.label) started.referenceEntry.params = params;
+    return started;
 }
 
 void applyAutomation(GuiState& s, const GuiOptions& opts, const AutomationPlan& plan) {

@@ -6,6 +6,7 @@
 #include "framework/experiment/Config.h"
 #include "framework/gui/GuiOptions.h"
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,7 +20,14 @@ class Viewer;
 struct AutomationPlan {
     int choice = 0;                                         ///< index into algorithmChoices(config)
     std::vector<std::pair<std::string, ParamValue>> sets;   ///< parsed and validated --set values
+    std::optional<ParamValues> params;                      ///< the chosen algorithm's parameters with the --set values
 };
+
+/// The config as the session starts it: the chosen algorithm (a config entry, or one added as
+/// --algorithm names it) with its --set values, for the checks run and validate make (the memory
+/// plan, each algorithm's fit on the scene), so that what validate refuses the GUI refuses too,
+/// as bad input, before the first frame.
+ExperimentConfig configAsStarted(const ExperimentConfig& config, const AutomationPlan& plan);
 
 /// Validates --algorithm, --set and --frame; throws InputError (one line) on the first problem.
 AutomationPlan planAutomation(const GuiOptions& opts, const ExperimentConfig& config);

@@ -145,8 +145,13 @@ int runGui(const GuiOptions& opts) {
         checkWindowSize("--size", opts.windowSize, std::min(viewport[0], viewport[1]), texture);
         if (opts.resizeTo.x > 0) checkWindowSize("--resize", opts.resizeTo, std::min(viewport[0], viewport[1]), texture);
     }
-    checkMemoryPlan(config, predicted, currentDeviceLimits(predicted.triangles));
-    checkAlgorithmsTakeScene(config);
+    {
+        // As run and validate check it, with the chosen algorithm and its --set values (twenty-third
+        // probe: a refused line_space pool failed in the build, exit 1).
+        const ExperimentConfig started = configAsStarted(config, plan);
+        checkMemoryPlan(started, predicted, currentDeviceLimits(predicted.triangles));
+        checkAlgorithmsTakeScene(started);
+    }
     installGlDebugCallback(true);
     ImGuiSession imgui(context);
 

@@ -141,6 +141,9 @@ GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
             const std::string& kv = value();
             size_t eq = kv.find('=');
             if (eq == std::string::npos || eq == 0) throw usage("--set expects KEY=VALUE, got " + echoed(kv));
+            // As shadowlab run refuses it (twenty-third probe: the GUI took the last of two).
+            for (const auto& [key, text] : o.sets)
+                if (key == kv.substr(0, eq)) throw usage("--set " + echoed(key) + " is given twice");
             o.sets.push_back({kv.substr(0, eq), kv.substr(eq + 1)});
         } else if (a == "--view") {
             o.view = value();

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <set>
 #include <sstream>
 #include <string>
@@ -270,6 +271,17 @@ constexpr const char* kDataUriPrefixes[] = {"data:application/octet-stream;base6
 
 /// The decoded length of a buffer's data URI, or why the reader cannot decode it (another media
 /// type or encoding, or a payload that is not base64).
+/// Whether `path` (resolved, links followed) lies in `folder` (resolved likewise) or below it.
+bool insideFolder(const std::string& path, const std::string& folder) {
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::canonical(path, ec);
+    if (ec) return false;
+    const std::filesystem::path f = std::filesystem::canonical(folder.empty() ? "." : folder, ec);
+    if (ec) return false;
+    const auto rel = p.lexically_relative(f);
+    return !rel.empty() && *rel.begin() != "..";
+}
+
 size_t dataUriLength(const std::string& uri, std::string& problem) {
     for (const char* prefix : kDataUriPrefixes) {
         const size_t start = std::strlen(prefix);
@@ -361,10 +373,17 @@ void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool bi
             if (doc["meshes"][m].contains("primitives"))
                 for (size_t p = 0; p < doc["meshes"][m]["primitives"].size(); ++p) {
                     const Json& prim = doc["meshes"][m]["primitives"][p];
-                    if (prim.contains("indices") && prim["indices"].get<uint64_t>() >= accessors)
-                        throw InputError(file, "/meshes/" + std::to_string(m) + "/primitives/" + std::to_string(p) + "/indices",
-                                         "accessor index " + std::to_string(prim["indices"].get<uint64_t>()) +
-                                             " is out of range (the file has " + std::to_string(accessors) + ")");
+                    if (!prim.contains("indices")) continue;
+                    const std::string at = "/meshes/" + std::to_string(m) + "/primitives/" + std::to_string(p) + "/indices";
+                    const uint64_t index = prim["indices"].get<uint64_t>();
+                    if (index >= accessors)
+                        throw InputError(file, at, "accessor index " + std::to_string(index) + " is out of range (the file has " +
+                                                       std::to_string(accessors) + ")");
+                    // The reader needs the indices in a buffer (twenty-third probe: "accessor[1] invalid
+                    // bufferView", no path).
+                    if (!doc["accessors"][index].contains("bufferView"))
+                        throw InputError(file, at, "index accessor " + std::to_string(index) +
+                                                       " has no bufferView: a primitive's indices are read from a buffer");
                 }
     if (doc.contains("bufferViews"))
         for (size_t i = 0; i < doc["bufferViews"].size(); ++i) {
@@ -419,6 +438,12 @@ void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool bi
                 struct stat st {};
                 if (::stat(path.c_str(), &st) != 0)
                     throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " does not exist");
+                // The model's own files only: a uri climbing out of its folder ("../../etc/...") or a
+                // link out of it would read any file the process can, and the index checks' messages
+                // would print its bytes (twenty-third probe).
+                if (!insideFolder(path, parentDir(file)))
+                    throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) +
+                                                               " lies outside the glTF file's folder; a buffer's uri names a file in that folder or below it");
                 if (!S_ISREG(st.st_mode))
                     throw InputError(file, where + "/uri", "the buffer file " + shortPath(path) + " is " +
                                                                nonRegularKind(path, true) + ", not a regular file");

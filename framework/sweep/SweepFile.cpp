@@ -1,5 +1,6 @@
 #include "framework/sweep/SweepFile.h"
 
+#include "framework/experiment/Compare.h"
 #include "framework/experiment/Config.h"
 #include "framework/scene/SceneConfig.h"
 #include "framework/core/Text.h"
@@ -17,22 +18,6 @@
 namespace shadowlab {
 
 /// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
-void collectIds(const Json& resolved, std::set<std::string>& ids) {
-    if (resolved.value("reference", Json(true)) != Json(false)) ids.insert("reference");
-    if (resolved.contains("algorithms") && resolved["algorithms"].is_array())
-        for (const Json& a : resolved["algorithms"])
-            if (a.is_object() && a.contains("id") && a["id"].is_string()) ids.insert(a["id"].get<std::string>());
-}
-
-std::string algorithmOf(const Json& resolved, const std::string& id) {
-    if (id == "reference") return resolved.value("reference", Json(true)) != Json(false) ? "reference" : "";
-    if (resolved.contains("algorithms") && resolved["algorithms"].is_array())
-        for (const Json& a : resolved["algorithms"])
-            if (a.is_object() && a.value("id", Json()) == Json(id) && a.contains("algorithm") && a["algorithm"].is_string())
-                return a["algorithm"].get<std::string>();
-    return "";
-}
-
 namespace {
 
 /// Text a spreadsheet would read as a formula in a CSV cell: it starts with =, +, - or @ and is not

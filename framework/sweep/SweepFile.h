@@ -68,11 +68,6 @@ Sweep parseSweep(const Json& json, const std::string& file);
 /// A stable id of a run: a hash of its resolved config with output.dir left out, so the same run
 /// keeps its id when axes are added or the sweep is written to another folder.
 std::string runId(const Json& resolvedConfig);
-/// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
-void collectIds(const Json& resolvedConfig, std::set<std::string>& ids);
-/// The algorithm a resolved run config runs under `id` ("reference" for the reference), "" when
-/// it gives no such id.
-std::string algorithmOf(const Json& resolvedConfig, const std::string& id);
 
 /// The runs as JSON: {name, axes: [{name, scale, labels, paths}], merge, runs: [{index, id, axes: {name: label}}]}
 /// (`sweep plan --json`, and DIR/plan.json for the merge's report).

@@ -3,6 +3,7 @@
 #include "framework/core/Error.h"
 #include "framework/core/FileIO.h"
 #include "framework/core/Interrupt.h"
+#include "framework/experiment/Compare.h"
 #include "framework/experiment/Expectations.h"
 #include "framework/experiment/OutputPlace.h"
 #include "framework/sweep/SweepFile.h"
@@ -93,6 +94,11 @@ void checkSweepFolder(const std::string& outputDir) {
         const fs::file_status st = fs::status(d, ec);
         if (fs::exists(st) && !fs::is_directory(st)) throw InputError(shortText(d, 300), "", "is not a folder (the sweep's output folder goes there)");
     }
+    // The runs go into the sweep's own folder, never through a link into someone else's
+    // (twenty-third probe: a linked runs/ had a user's files there replaced by the runs' logs).
+    std::error_code ec;
+    if (fs::is_symlink(fs::symlink_status(outputDir + "/runs", ec)))
+        throw InputError(shortText(outputDir + "/runs", 300), "", "is a symbolic link; a sweep writes its runs into a folder of its own");
 }
 
 RunPaths::RunPaths(const std::string& outputDir, const std::string& id)
