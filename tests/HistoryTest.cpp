@@ -451,6 +451,9 @@ TEST(HistoryTest, ATimeOrResolutionNoRunWritesIsBadInput) {
         {[](Json& s) { s["algorithms"]["psv"]["repetitions"]["time_ms"]["total"] = Json::array(); }, "/algorithms/psv/repetitions/time_ms/total"},
         {[](Json& s) { s["renderer"] = std::string(1000000, 'R'); }, "/renderer"},
         {[](Json& s) { s["renderer"] = "a\u202eb\u200bc"; }, "/renderer"},
+        // Twenty-second probe (left then): a statistic whose min lies above its max was compared.
+        {[](Json& s) { s["algorithms"]["psv"]["time_ms"]["total"] = {{"mean", 5.0}, {"min", 9.0}, {"max", 1.0}}; }, "/algorithms/psv/time_ms/total/min"},
+        {[](Json& s) { s["algorithms"]["psv"]["counters"] = {{"nodes", {{"mean", 50.0}, {"min", 1.0}, {"max", 2.0}}}}; }, "/algorithms/psv/counters/nodes/mean"},
     };
     for (const auto& [change, path] : edits) {
         const std::string dir = test::makeTempDir("history-bad-number");

@@ -9,6 +9,7 @@
 #include "framework/render/LightUniforms.h"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cstdio>
 #include <functional>
@@ -171,7 +172,7 @@ public:
         // The last frame's ballot workgroups found subgroups of another width than compiled (it
         // was reported as overflow): shared-memory votes from now on.
         if (vote_ == kVoteBallot && counters_ && counters_.read()[PTSV_C_SUBGROUP_MISMATCH] != 0) {
-            std::fprintf(stderr, "ptsv: subgroups of another width than %d at run time: switching to shared-memory votes\n",
+            std::fprintf(stderr, "shadowlab: warning: ptsv: subgroups of another width than %d at run time: switching to shared-memory votes\n",
                          lanes_);
             fellBack_ = true;
             compile();
@@ -445,7 +446,6 @@ private:
         sampleTexels_ = makeBufferTexture(samples_, GL_RGBA32UI, 16, "ptsv samples");
         maskTexels_ = makeBufferTexture(masks_, GL_R32UI, 4, "ptsv masks");
         shadowTexels_ = makeBufferTexture(shadow_, GL_R32UI, 4, "ptsv shadow marks");
-        warnedSplit_ = false;
     }
 
     void setUniforms(const Camera& camera, const Light& light) {
@@ -463,11 +463,12 @@ private:
         const float tanHalf = std::tan(glm::radians(camera.fovYDeg) * 0.5f);
         const glm::mat4 view = camera.view();
         const int split = splitDepth();
-        if (p_.twoPass && p_.splitLevel > layout_.levels && !warnedSplit_) {
-            std::fprintf(stderr, "ptsv: split_level %d is below the %d-level tree: using %d\n",
+        // Once a process, not once an instance (the timed and the statistics pass each have one),
+        // prefixed as the runner's warnings; summary.json's resolved_params says what was used.
+        static std::atomic<bool> warnedSplit{false};
+        if (p_.twoPass && p_.splitLevel > layout_.levels && !warnedSplit.exchange(true))
+            std::fprintf(stderr, "shadowlab: warning: ptsv: split_level %d is below the %d-level tree: using %d\n",
                          p_.splitLevel, layout_.levels, split);
-            warnedSplit_ = true;
-        }
         for (const ShaderProgram* p : {&hierarchy_, &clusters_, &reduce_, &setup_, &pass1_, &pass2_, &jobArgs_, &resolve_}) {
             setLightUniforms(*p, light);
             p->set("uResolution", resolution_);
@@ -538,7 +539,6 @@ private:
     bool fellBack_ = false; ///< ballots met subgroups of another width: shared votes from then on
     ptsv::KeyLayout layout_;
     std::array<float, 6> layoutKey_{};
-    bool warnedSplit_ = false;
     ShaderProgram hierarchy_, clusters_, reduce_, setup_, pass1_, pass2_, jobArgs_, resolve_;
     GlBuffer masks_, bounds_, samples_, shadow_, heatCounts_, planes_, jobs_, jobIterations_;
     GlTexture boundsTexels_, sampleTexels_, planeTexels_, maskTexels_, shadowTexels_; ///< read-only views of those buffers

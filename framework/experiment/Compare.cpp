@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <cstring>
 #include <filesystem>
 #include <set>
@@ -72,6 +73,19 @@ void checkMeasured(const Json& j, const std::string& file, const std::string& pa
     if (j.is_null()) throw InputError(file, path, "holds null where a run writes a number");
 }
 
+/// A statistic's min, mean, median and max, where given, in the order a run's are: min <= mean,
+/// median <= max, within the rounding of a mean (twenty-second probe: min > max was compared).
+void checkStatisticOrder(const Json& stats, const std::string& file, const std::string& path) {
+    auto at = [&](const char* k) { return stats.contains(k) && stats[k].is_number() ? std::optional<double>(stats[k].get<double>()) : std::nullopt; };
+    const auto lo = at("min"), hi = at("max");
+    if (!lo || !hi) return;
+    const double slack = 1e-9 * std::max(std::abs(*lo), std::abs(*hi));
+    if (*lo > *hi + slack) throw InputError(file, path + "/min", "is above its max, which no run writes");
+    for (const char* k : {"mean", "median"})
+        if (const auto v = at(k); v && (*v < *lo - slack || *v > *hi + slack))
+            throw InputError(file, path + "/" + k, "lies outside [min, max], which no run writes");
+}
+
 /// Every time of one algorithm entry: the stage statistics, the frames' totals, the repetitions'
 /// (as many as the repetitions' count, which a config holds to 1000).
 void checkTimes(const Json& entry, const std::string& file, const std::string& at, const Json& frames) {
@@ -80,14 +94,18 @@ void checkTimes(const Json& entry, const std::string& file, const std::string& a
     for (const char* key : {"time_ms", "cpu_time_ms"})
         if (entry.contains(key) && entry[key].is_object())
             for (const auto& [stage, stats] : entry[key].items())
-                if (stats.is_object())
+                if (stats.is_object()) {
                     for (const auto& [stat, v] : stats.items())
                         checkTime(v, file, at + "/" + key + "/" + shortText(stage, 60) + "/" + shortText(stat, 60));
+                    checkStatisticOrder(stats, file, at + "/" + key + "/" + shortText(stage, 60));
+                }
     if (entry.contains("counters") && entry["counters"].is_object())
         for (const auto& [name, stats] : entry["counters"].items())
-            if (stats.is_object())
+            if (stats.is_object()) {
                 for (const auto& [stat, v] : stats.items())
                     checkMeasured(v, file, at + "/counters/" + shortText(name, 60) + "/" + shortText(stat, 60));
+                checkStatisticOrder(stats, file, at + "/counters/" + shortText(name, 60));
+            }
     if (entry.contains("total_ms_per_frame") && entry["total_ms_per_frame"].is_array() && frames.is_number_unsigned() &&
         entry["total_ms_per_frame"].size() != frames.get<uint64_t>())
         throw InputError(file, at + "/total_ms_per_frame", "holds " + std::to_string(entry["total_ms_per_frame"].size()) +
