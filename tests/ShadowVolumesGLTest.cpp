@@ -64,12 +64,14 @@ TEST_P(ShadowVolumesAccuracyGLTest, MatchesReference) {
                 count("silhouette_edges"), count("silhouette_quads"), count("fill_per_pixel"), count("close_call_pixels"),
                 count("stencil_wrapped_pixels"));
     expectAccurateRow(o, c.maxMismatch);
-    // Close calls are the exception, not the method: the stencil decides at least nine pixels in
-    // ten (the most measured: 5.3 % on the engine, 3.7 % amid the clutter) where the rasteriser has
-    // 8 subpixel bits. With GL's minimum of 4 (zink over lavapipe reports it) the border margin is
-    // 16 times wider, and on the engine, whose triangles are a pixel or less at 96², 22 % of the
-    // lit pixels are close calls (measured): there the bound is that with room, a third.
-    const double share = count("subpixel_bits") > 4.0 ? 0.1 : 0.34;
+    // Close calls are the exception, not the method: the stencil decides most pixels. The border
+    // pass hands the ray every pixel a face's plane passes within the ray offset of, near that
+    // face's border: on the engine, whose triangles are a pixel or less at 96², 17.3 % of the lit
+    // pixels (5.3 % before the border pass; 1 % on fins_and_soup), the most measured with 8
+    // subpixel bits: the bound is that with room, a quarter. With GL's minimum of 4 (zink over
+    // lavapipe reports it) the border margin is 16 times wider (22 % there before the border
+    // pass): half.
+    const double share = count("subpixel_bits") > 4.0 ? 0.25 : 0.5;
     EXPECT_LT(count("close_call_pixels"), share * double(o.accuracy.litPixels));
     EXPECT_EQ(count("loop_capped_pixels"), 0.0);
 }

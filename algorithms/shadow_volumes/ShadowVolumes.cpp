@@ -130,7 +130,7 @@ public:
         first_ = GlBuffer::fromVector(adj.first.empty() ? std::vector<uint32_t>{0u} : adj.first, 0);
         facing_ = GlBuffer(std::max<size_t>(scene.triangleCount(), 1) * sizeof(int32_t), nullptr, 0);
         records_ = GlBuffer(capacity_ * sizeof(uint32_t), nullptr, 0);
-        draw_ = GlBuffer(4 * sizeof(uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        draw_ = GlBuffer(SV_DRAW_WORDS * sizeof(uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
         facingTexels_ = makeBufferTexture(facing_, GL_R32I, 4, "shadow_volumes' facing signs");
         recordTexels_ = makeBufferTexture(records_, GL_R32UI, 4, "shadow_volumes' silhouette records");
         sideTexels_ = makeBufferTexture(sides_, GL_R32UI, 4, "shadow_volumes' edge sides");
@@ -228,7 +228,7 @@ private:
     void findSilhouettes(const FrameInputs& f) {
         const unsigned triangles = unsigned(scene_->triangleCount());
         f.timer.begin("silhouettes");
-        const uint32_t command[4] = {6u, 0u, 0u, 0u};
+        const uint32_t command[SV_DRAW_WORDS] = {6u, 0u, 0u, 0u, 8u, 0u, 0u, 0u, 2u, 0u, 0u, 0u}; // faces, border lines, corners
         glNamedBufferSubData(draw_.id(), 0, sizeof(command), command);
         facing_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_FACING_BINDING);
         sides_.bindBase(GL_SHADER_STORAGE_BUFFER, SV_SIDES_BINDING);
@@ -314,6 +314,7 @@ private:
             volumePass_.set("uCountSign", zfail ? -1.0f : 1.0f);
             volumePass_.set("uCountBehind", zfail ? 1 : 0);
             volumePass_.set("uPass", 0);
+            volumePass_.set("uBorder", 0);
             volumePass_.use();
             glBindBuffer(GL_DRAW_INDIRECT_BUFFER, draw_.id());
             glDrawArraysIndirect(GL_TRIANGLES, nullptr);
@@ -322,10 +323,43 @@ private:
                 volumePass_.set("uPass", 1);
                 glDrawArrays(GL_TRIANGLES, 0, GLsizei(6u * triangles));
             }
+            if (p_.closeCalls) drawBorders(f, offset, triangles);
             glBindVertexArray(0);
         }
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
         f.timer.end();
+    }
+
+    /// The border pass (volume.frag, SV_BORDER_PASS): every face's borders as lines and its finite
+    /// corners as points, counting nothing, each fragment marking the pixels around it that the
+    /// face separates from their test points. Inside the volume pass's state, with the stencil, the
+    /// count and the depth test off.
+    void drawBorders(const FrameInputs& f, float offset, unsigned triangles) {
+        glDisable(GL_STENCIL_TEST);
+        glDisable(GL_DEPTH_TEST);
+        glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        setLightUniforms(borderPass_, f.light);
+        borderPass_.set("uViewProj", f.gbuffer.viewProjection());
+        borderPass_.set("uCapacity", unsigned(capacity_));
+        borderPass_.set("uEye", f.camera.position);
+        borderPass_.set("uRayOffset", offset);
+        borderPass_.set("uCloseCall", closeCallLength());
+        borderPass_.use();
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, draw_.id());
+        borderPass_.set("uPass", 0);
+        borderPass_.set("uBorder", 1);
+        glDrawArraysIndirect(GL_LINES, reinterpret_cast<const void*>(4 * sizeof(uint32_t)));
+        borderPass_.set("uBorder", 2);
+        glDrawArraysIndirect(GL_POINTS, reinterpret_cast<const void*>(8 * sizeof(uint32_t)));
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+        if (triangles > 0) {
+            borderPass_.set("uPass", 1);
+            borderPass_.set("uBorder", 1);
+            glDrawArrays(GL_LINES, 0, GLsizei(6u * triangles));
+            borderPass_.set("uBorder", 2);
+            glDrawArrays(GL_POINTS, 0, GLsizei(3u * triangles));
+        }
+        glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     }
 
     /// Each pixel's count read: shadowed, lit, or listed as a close call.
@@ -339,6 +373,7 @@ private:
         setLightUniforms(resolvePass_, f.light);
         resolvePass_.set("uRayOffset", offset);
         resolvePass_.set("uCloseCall", closeCallLength());
+        if (p_.closeCalls) resolvePass_.set("uViewProj", f.gbuffer.viewProjection());
         scene_->bindStorage();  // the own triangle's plane (resolve.comp)
         glBindTextureUnit(SV_TRIANGLE_ID_UNIT, f.gbuffer.triangleId());
         if (options_.statistics) runPixelPass(f, resolvePass_, {&closeView_, &countView_});
@@ -406,6 +441,9 @@ private:
         volumePass_ = ShaderProgram::graphics("shadow_volumes/volume.vert", "shadow_volumes/volume.frag",
                                               {instr, check, {"SV_CLOSE_CALLS", p_.closeCalls ? "1" : "0"},
                                                {"SV_ANALYTIC", p_.depthTest == SvDepthTest::Analytic ? "1" : "0"}});
+        if (p_.closeCalls)
+            borderPass_ = ShaderProgram::graphics("shadow_volumes/volume.vert", "shadow_volumes/volume.frag",
+                                                  {{"SV_CLOSE_CALLS", "1"}, {"SV_BORDER_PASS", "1"}, {"SV_ANALYTIC", "1"}});
         resolvePass_ = ShaderProgram::compute("shadow_volumes/resolve.comp",
                                               {instr, check, {"SV_CLOSE_CALLS", p_.closeCalls ? "1" : "0"}});
         eyePass_ = ShaderProgram::compute("shadow_volumes/eye_count.comp", {{"SCENE_POSITION_TEXELS", "1"}});
@@ -420,7 +458,7 @@ private:
     glm::ivec2 resolution_{0};
     int subpixelBits_ = 8;
     bool zfailLast_ = true;
-    ShaderProgram eyePass_, facingPass_, silhouettePass_, depthPass_, volumePass_, resolvePass_, closeRayPass_;
+    ShaderProgram eyePass_, facingPass_, silhouettePass_, depthPass_, volumePass_, borderPass_, resolvePass_, closeRayPass_;
     GlBuffer sides_, first_, facing_, records_, draw_;
     PixelList closeList_;
     bvh::SceneBvh bvh_; ///< the close calls' rays trace through it

@@ -3,7 +3,9 @@
 #define SV_FIRST_BINDING 4    // uint[edges + 1]: edge e's sides are [first[e], first[e + 1])
 #define SV_FACING_BINDING 5   // int[n]: +1 the triangle's volume as wound, -1 flipped, 0 no volume
 #define SV_RECORDS_BINDING 6  // uint[capacity]: one per silhouette quad drawn: first side << 1 | reversed
-#define SV_DRAW_BINDING 7     // the quads' DrawArraysIndirectCommand: {6, quads, 0, 0}
+#define SV_DRAW_BINDING 7     // the quads' DrawArraysIndirectCommands: faces {6, quads, 0, 0}, then the border
+                              // pass's lines {8, quads, 0, 0} and corners {2, quads, 0, 0}
+#define SV_DRAW_WORDS 12
 #define SV_COUNTER_BINDING 8
 #define SV_CLOSE_LIST_BINDING 9    // {count, uint[pixels]}: close-call pixels, x | y << 16
 #define SV_CLOSE_ARGS_BINDING 11    // the close-ray dispatch's {x, y, z} groups
@@ -54,3 +56,6 @@
 #define SV_SIDE_PLANE 0   // where the view ray meets the face's plane
 #define SV_SIDE_BORDER 1  // near the face's border: a close call if the test point is near it too
 #define SV_SIDE_CLOSE 2   // not to be decided here: a close call
+// The border pass finds the faces that separate a pixel's q and x within this many pixels of its
+// centre (the screen length of [q, x]); the resolve pass makes a pixel where it is longer a close call.
+#define SV_BORDER_REACH 0.25

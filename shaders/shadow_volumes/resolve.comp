@@ -47,6 +47,17 @@ bool ownTriangleMayHide(ivec2 px, vec3 p, vec3 n) {
     precise float sl = lightIsDirectional() ? -dot(n, uLightDirection) : dot(n, uLightPosition - a);
     return abs(sx) <= uCloseCall || (sx > 0.0) != (sl > 0.0);
 }
+
+// Whether the segment [q, x] is longer on screen than the border pass reaches (volume.frag,
+// SV_BORDER_PASS): a point nearer the eye than a few hundred ray offsets. Its faces could separate
+// q and x a pixel or more away from its centre, so the ray decides it.
+uniform mat4 uViewProj;
+bool beyondBorderReach(vec3 p, vec3 n) {
+    vec4 cp = uViewProj * vec4(p, 1.0), cx = uViewProj * vec4(p + n * uRayOffset, 1.0);
+    if (!(cp.w > 0.0) || !(cx.w > 0.0)) return true;
+    vec2 pixels = 0.5 * vec2(imageSize(uVisibility)) * (cx.xy / cx.w - cp.xy / cp.w);
+    return !(length(pixels) <= SV_BORDER_REACH);
+}
 #endif
 
 void main() {
@@ -69,7 +80,7 @@ void main() {
             }
             bool close = imageLoad(uClose, px).x != 0u;
 #if SV_CLOSE_CALLS
-            close = close || ownTriangleMayHide(px, p, n);
+            close = close || ownTriangleMayHide(px, p, n) || beyondBorderReach(p, n);
 #endif
 #if SV_CHECK
             // Every closed volume adds 1 to (beyond - before) if it holds the eye, else 0.

@@ -15,7 +15,11 @@ layout(std430, binding = SV_SIDES_BINDING) readonly buffer Sides { uint sides[];
 layout(std430, binding = SV_FIRST_BINDING) readonly buffer First { uint first[]; };
 layout(std430, binding = SV_FACING_BINDING) readonly buffer Facing { int facing[]; };
 layout(std430, binding = SV_RECORDS_BINDING) writeonly buffer Records { uint records[]; };
-layout(std430, binding = SV_DRAW_BINDING) buffer Draw { uint drawCount, drawQuads, drawFirst, drawBaseInstance; };
+layout(std430, binding = SV_DRAW_BINDING) buffer Draw {
+    uint drawCount, drawQuads, drawFirst, drawBaseInstance; // the faces
+    uint lineCount, lineQuads, lineFirst, lineBaseInstance; // the border pass's lines and corners
+    uint pointCount, pointQuads, pointFirst, pointBaseInstance;
+};
 layout(std430, binding = SV_COUNTER_BINDING) buffer Counters { uint counters[]; };
 uniform uint uEdgeCount;
 uniform uint uCapacity;
@@ -32,6 +36,8 @@ void main() {
     if (m == 0) return;
     uint k = uint(abs(m));
     uint base = atomicAdd(drawQuads, k);
+    atomicAdd(lineQuads, k);
+    atomicAdd(pointQuads, k);
     atomicAdd(counters[SV_C_SILHOUETTES], 1u);
     atomicAdd(counters[SV_C_QUADS], k);
     if (base + k > uCapacity || base + k < base) {

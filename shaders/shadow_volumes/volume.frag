@@ -138,16 +138,21 @@ float borderPixels(vec3 v, float se) {
 // no fragment: neither its count nor its own tests see the face, though the face may put x in a
 // volume that q is not in. So a fragment within 1.5 pixels of its face's border (deeper inside, the
 // face covers the neighbours' centres too, and each tests it itself) tests the face's plane against
-// its 8 neighbours' q and x, and makes each it passes between (or near) a close call. What is left:
-// a face that reaches no pixel centre within a pixel of the point (docs/algorithms/shadow_volumes.md).
-void markNeighbours(ivec2 px) {
+// its 8 neighbours' q and x, and makes each it passes between (or near) a close call. A face that
+// reaches no pixel centre within a pixel of the point is the border pass's (below): its borders'
+// fragments test the pixel itself too (`self`).
+void markNeighbours(ivec2 px, bool self) {
     ivec2 size = textureSize(uPosition, 0);
     for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 m = px + ivec2(dx, dy);
-            if ((dx == 0 && dy == 0) || any(lessThan(m, ivec2(0))) || any(greaterThanEqual(m, size))) continue;
+            if ((dx == 0 && dy == 0 && !self) || any(lessThan(m, ivec2(0))) || any(greaterThanEqual(m, size))) continue;
             vec4 pm = texelFetch(uPosition, m, 0);
             if (pm.w < 0.5) continue;
+            // q and x lie within the ray offset of p (x along the triangle's unit normal, q along the
+            // view ray at x's depth): a plane farther from p than that, and the tests' rounding,
+            // separates neither from anything (1.01: a unit normal's own rounding, with room).
+            if (abs(dot(vPlane.xyz, pm.xyz) + vPlane.w) > 1.01 * uRayOffset + uCloseCall) continue;
             // The neighbour's own triangle: resolve.comp tests it (ownTriangleMayHide).
             if (vTriangle != ~0u && vTriangle + 1u == texelFetch(uTriangleId, m, 0).x) continue;
             vec3 nm = texelFetch(uNormal, m, 0).xyz;
@@ -158,6 +163,23 @@ void markNeighbours(ivec2 px) {
 }
 #endif
 
+#if SV_BORDER_PASS
+// The border pass (exact variant only): every volume face's borders drawn as lines and its finite
+// corners as points, counting nothing. A face thinner on screen than a pixel may reach no pixel
+// centre, and so make no fragment of the volume pass anywhere near a point x it separates from q.
+// But then the face's border passes within the screen length of the segment [q, x] of the pixel's
+// centre (its projection starts at the centre; the resolve pass makes every pixel where that
+// length exceeds SV_BORDER_REACH pixels a close call instead), inside the pixel's diamond: a line
+// through the diamond makes a fragment there by the diamond-exit rule, one ending inside it (a
+// corner) a point does, and GL lets either land at most one pixel off (GL 4.5 section 14.5.1). So
+// testing the face's plane against the q and x of the fragment's pixel and its 8 neighbours finds
+// every pixel the face separates from its test point.
+void main() {
+    if (vPlane == kNever) discard;
+    markNeighbours(ivec2(gl_FragCoord.xy), true);
+    discard;
+}
+#else
 void main() {
 #if SHADOWLAB_STATISTICS
     addWide(SV_C_FRAGMENTS_LO, 1u);
@@ -173,7 +195,7 @@ void main() {
             vec2 ndc = 2.0 * gl_FragCoord.xy / vec2(textureSize(uPosition, 0)) - 1.0;
             vec4 far = uInverseViewProj * vec4(ndc, 1.0, 1.0);
             vec3 v = normalize(far.xyz / far.w - uEye);
-            if (borderPixels(v, dot(vPlane.xyz, uEye) + vPlane.w) <= 1.5) markNeighbours(px);
+            if (borderPixels(v, dot(vPlane.xyz, uEye) + vPlane.w) <= 1.5) markNeighbours(px, false);
         }
 #endif
         return;
@@ -213,7 +235,7 @@ void main() {
     }
 #if SV_CLOSE_CALLS
     if (close) imageStore(uClose, px, uvec4(1u));
-    if (!farCap && borderPixels(normalize(p - uEye), se) <= 1.5) markNeighbours(px);
+    if (!farCap && borderPixels(normalize(p - uEye), se) <= 1.5) markNeighbours(px, false);
 #endif
 #if SV_ANALYTIC
     if (behind != (uCountBehind != 0)) {
@@ -229,3 +251,4 @@ void main() {
 #endif
 #endif
 }
+#endif

@@ -16,6 +16,8 @@ layout(binding = SV_RECORDS_UNIT) uniform usamplerBuffer uRecords;
 layout(binding = SV_SIDES_UNIT) uniform usamplerBuffer uSides;
 uniform mat4 uViewProj;
 uniform int uPass;       // 0 silhouette quads, 1 caps
+uniform int uBorder;     // 0 the faces (triangles); the faces' borders for the border pass
+                         // (volume.frag, SV_BORDER_PASS): 1 their edges (lines), 2 their finite corners (points)
 uniform uint uCapacity;  // records the list holds
 
 invariant gl_Position;
@@ -34,8 +36,16 @@ vec4 planeThrough(vec3 p, vec3 n) {
 }
 const vec4 kNever = vec4(0.0, 0.0, 0.0, 1.0); // a plane no point is close to
 
+// The vertices of one primitive list: the faces as triangles, or their borders as lines or points.
+// A side quad's corners are 0 v, 1 u, 2 u at infinity, 3 v at infinity; a near cap's are 0, 1, 2.
+const int kQuadTriangles[6] = int[6](0, 1, 2, 0, 2, 3); // (v, u, u inf) and (v, u inf, v inf)
+const int kQuadLines[8] = int[8](0, 1, 1, 2, 0, 3, 2, 3); // its four borders, the one at infinity too
+const int kCapLines[6] = int[6](0, 1, 1, 2, 2, 0);
+int verticesPerQuad() { return uBorder == 0 ? 6 : uBorder == 1 ? 8 : 2; }
+int verticesPerCap() { return uBorder == 2 ? 3 : 6; }
+
 void main() {
-    int j = gl_VertexID % 6;
+    int j = gl_VertexID % (uPass == 0 ? verticesPerQuad() : verticesPerCap());
     vTriangle = ~0u;
     vA = vB = vC = vec3(0.0);
     vKind = SV_FACE_FAR_CAP;
@@ -46,11 +56,11 @@ void main() {
         uint t = side >> 3, k = (side >> 1) & 3u;
         vec3 u = corner(t, k), v = corner(t, (k + 1u) % 3u);
         if ((record & 1u) != 0u) { vec3 w = u; u = v; v = w; }
-        // The quad (v, u, u at infinity, v at infinity), outward for a volume whose cap walks u -> v,
-        // as two triangles: (v, u, u inf) and (v, u inf, v inf).
-        if (j == 0 || j == 3) gl_Position = finite(v);
-        else if (j == 1) gl_Position = finite(u);
-        else if (j == 2 || j == 4) gl_Position = infinite(u);
+        // The quad (v, u, u at infinity, v at infinity), outward for a volume whose cap walks u -> v.
+        int c = uBorder == 0 ? kQuadTriangles[j] : uBorder == 1 ? kQuadLines[j] : j;
+        if (c == 0) gl_Position = finite(v);
+        else if (c == 1) gl_Position = finite(u);
+        else if (c == 2) gl_Position = infinite(u);
         else gl_Position = infinite(v);
         vec3 toL = lightIsDirectional() ? -uLightDirection : uLightPosition - u;
         vPlane = planeThrough(u, cross(v - u, toL));
@@ -59,14 +69,15 @@ void main() {
         vKind = SV_FACE_SIDE;
         return;
     }
-    uint t = uint(gl_VertexID) / 6u;
+    uint t = uint(gl_VertexID) / uint(verticesPerCap());
     int f = texelFetch(uFacing, int(t)).x;
     if (f == 0) { gl_Position = vec4(0.0, 0.0, 0.0, 1.0); vPlane = kNever; return; }
-    // Near cap corners 0, 1, 2 (flipped: 0, 2, 1); far cap the other way round.
+    // Near cap corners 0, 1, 2 (flipped: 0, 2, 1); far cap the other way round. The border pass
+    // takes the near cap's borders only: a far cap lies at infinity, beyond every test point.
     const uint kOrder[6] = uint[6](0u, 1u, 2u, 0u, 2u, 1u);
-    uint k = kOrder[f > 0 ? j : (j + 3) % 6];
+    uint k = uBorder == 0 ? kOrder[f > 0 ? j : (j + 3) % 6] : uint(uBorder == 1 ? kCapLines[j] : j);
     vec3 p = corner(t, k);
-    if (j < 3) {
+    if (j < 3 || uBorder != 0) {
         gl_Position = finite(p);
         vec3 a = corner(t, 0u), b = corner(t, 1u), c = corner(t, 2u);
         vPlane = planeThrough(a, cross(b - a, c - a));
