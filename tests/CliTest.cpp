@@ -90,6 +90,20 @@ TEST(CliTest, RunRefusesAHugeNameInOneShortLine) {
     EXPECT_LT(bad.err.size(), 1000u);
 }
 
+// Twenty-fourth probe: a name that cannot be results/NAME was refused although --out named the
+// folder; validate, which has no --out, still refuses it.
+TEST(CliTest, OutLiftsTheNameRuleOfTheDefaultFolder) {
+    const std::string dir = test::makeTempDir("cli-name-out");
+    std::ofstream(dir + "/c.json") << test::configWith({{"name", "\"a/b\""}, {"resolution", "[16, 16]"}, {"frames", "1"},
+                                                        {"output", R"({"plots": false})"}});
+    const test::Ran ran = test::runArgs({bin(), "run", dir + "/c.json", "--out", dir + "/out", "--no-progress"});
+    EXPECT_EQ(ran.rc, 0) << ran.err;
+    EXPECT_TRUE(std::filesystem::exists(dir + "/out/summary.json"));
+    const test::Ran checked = test::runArgs({bin(), "validate", dir + "/c.json"});
+    EXPECT_EQ(checked.rc, 2) << checked.err;
+    EXPECT_NE(checked.err.find("/name"), std::string::npos) << checked.err;
+}
+
 // A scene an algorithm cannot take on this device is refused before it is made: exit 2, one line
 // naming the entry and the structure, nothing written, and no time spent making 1.2 M triangles.
 // `plan` says the same without running, and gives every algorithm's verdict.

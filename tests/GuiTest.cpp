@@ -242,7 +242,9 @@ TEST(GuiTest, BadInputIsOneLineAndExitCode2) {
     // Checked before any window opens, so no X server is needed.
     // Twenty-third probe: a repeated --set was taken (the last one), where shadowlab run refuses it.
     for (const std::string args : {" --set no_such_key=1", " --algorithm no_such_algorithm", " --set resolution=1",
-                                   " --frames x", " /nonexistent/config.json", " --algorithm shadow_map --set pcf=0 --set pcf=3"}) {
+                                   " --frames x", " /nonexistent/config.json", " --algorithm shadow_map --set pcf=0 --set pcf=3",
+                                   // Twenty-fourth probe: a positive step too small for a float was "not positive".
+                                   " --record-keyframes '0,3,5,0,0,0' --record-step 1e-300"}) {
         std::string out;
         EXPECT_EQ(test::runCommand(kGui + " " + (args[1] == '/' ? "" : kSmoke) + args, out), 2) << args << "\n" << out;
         std::string trimmed = out.substr(0, out.find_last_not_of('\n') + 1);
@@ -291,6 +293,16 @@ TEST(GuiTest, WhatValidateRefusesAndOutputsOverInputsAreRefusedBeforeAFrame) {
         EXPECT_NE(out.find("an input of this session"), std::string::npos) << out;
     }
     EXPECT_EQ(text(dir + "/c.json"), original);
+    // Twenty-fourth probe: --report R/summary.json turned a run's summary into a frame log, and
+    // --screenshot and --report naming one file kept the last one written. Both before a window.
+    fs::create_directories(dir + "/run");
+    std::ofstream(dir + "/run/summary.json") << "{}";
+    std::ofstream(dir + "/run/.shadowlab-output");
+    EXPECT_EQ(guiError(dir + "/c.json --frames 1 --report " + dir + "/run/summary.json", out), 2) << out;
+    EXPECT_NE(out.find("--report"), std::string::npos) << out;
+    EXPECT_EQ(text(dir + "/run/summary.json"), "{}");
+    EXPECT_EQ(guiError(dir + "/c.json --frames 1 --screenshot " + dir + "/same.png --report " + dir + "/same.png", out), 2) << out;
+    EXPECT_NE(out.find("name the same file"), std::string::npos) << out;
     // Twenty-third probe: a line_space pool validate refuses, asked for with --set, failed in the
     // build with exit 1; it is refused before the first frame, as validate refuses it.
     EXPECT_EQ(runGui(cmd + " " + dir + "/c.json --frames 1 --size 64x64 --algorithm line_space --set n=8 --set d=4 2>&1", out), 2) << out;

@@ -454,6 +454,12 @@ TEST(HistoryTest, ATimeOrResolutionNoRunWritesIsBadInput) {
         // Twenty-second probe (left then): a statistic whose min lies above its max was compared.
         {[](Json& s) { s["algorithms"]["psv"]["time_ms"]["total"] = {{"mean", 5.0}, {"min", 9.0}, {"max", 1.0}}; }, "/algorithms/psv/time_ms/total/min"},
         {[](Json& s) { s["algorithms"]["psv"]["counters"] = {{"nodes", {{"mean", 50.0}, {"min", 1.0}, {"max", 2.0}}}}; }, "/algorithms/psv/counters/nodes/mean"},
+        // Twenty-fourth probe: an object as a counter's mean stopped compare with the JSON library's
+        // message (exit 1); -5e9 rays and frames of 50 % under a worst frame of 0 were compared.
+        {[](Json& s) { s["algorithms"]["psv"]["counters"] = {{"nodes", {{"mean", Json::object()}}}}; }, "/algorithms/psv/counters/nodes/mean"},
+        {[](Json& s) { s["algorithms"]["psv"]["counters"] = {{"nodes", {{"mean", -5e9}}}}; }, "/algorithms/psv/counters/nodes/mean"},
+        {[](Json& s) { s["algorithms"]["psv"]["accuracy"]["per_frame_mismatch"] = {0.5, 0.5}; }, "/algorithms/psv/accuracy/per_frame_mismatch/0"},
+        {[](Json& s) { s["algorithms"]["psv"]["accuracy"]["mismatch_ratio"] = 0.5; }, "/algorithms/psv/accuracy/mismatch_ratio"},
     };
     for (const auto& [change, path] : edits) {
         const std::string dir = test::makeTempDir("history-bad-number");
@@ -471,6 +477,20 @@ TEST(HistoryTest, ATimeOrResolutionNoRunWritesIsBadInput) {
 // Twenty-third probe: a summary with no results ("algorithms": {}) beside a config that runs sm
 // compared as "No regression", exit 0, and history showed empty cells. Results must be those of
 // exactly the ids the run's config.resolved.json gives, each of its algorithm (as sweep merge holds them).
+// Twenty-fourth probe: "complete": "yes" stopped compare with the JSON library's message, exit 1.
+TEST(HistoryTest, ACompleteThatIsNotTrueIsBadInput) {
+    for (const Json& complete : {Json("yes"), Json(nullptr), Json(1), Json::object(), Json::array()}) {
+        const std::string dir = test::makeTempDir("history-complete");
+        writeRuns(dir, {20, 20}, {0, 0}, kSpread);
+        Json s = Json::parse(std::ifstream(dir + "/run-99/summary.json"));
+        s["complete"] = complete;
+        std::ofstream(dir + "/run-99/summary.json") << s.dump();
+        const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "compare", dir + "/run-100", dir + "/run-99"});
+        EXPECT_EQ(ran.rc, 2) << complete.dump() << ": " << ran.err;
+        EXPECT_NE(ran.err.find("not a complete run's summary"), std::string::npos) << ran.err;
+    }
+}
+
 TEST(HistoryTest, ResultsOtherThanTheConfigsIdsAreBadInput) {
     const std::vector<std::pair<std::function<void(Json&)>, std::string>> edits = {
         {[](Json& s) { s["algorithms"] = Json::object(); }, "holds no results for \"bvh_raytrace\""},

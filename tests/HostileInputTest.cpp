@@ -311,6 +311,10 @@ std::vector<BadCase> badCases() {
         {"GltfBufferUriClimbsOutOfItsFolder", "m.gltf",
          test::triangleGltf({{"buffers", R"([{"byteLength": 36, "uri": "../../../../../../../../../../etc/passwd"}])"}}),
          {"m.gltf", "/buffers/0/uri", "outside the glTF file's folder"}},
+        // Twenty-fourth probe: a node translation of 1e300 (inf in float) was reported as vertices at
+        // -nan, with no word of the node.
+        {"GltfNodeTranslationBeyondAFloat", "m.gltf", test::triangleGltf({{"nodes", R"([{"mesh": 0, "translation": [1e300, 0, 0]}])"}}),
+         {"m.gltf", "/nodes/0/translation", "does not fit a float"}},
         {"GltfRootListedTwice", "m.gltf", test::triangleGltf({{"scenes", R"([{"nodes": [0, 0]}])"}}),
          {"m.gltf", "/scenes/0/nodes/1", "listed twice"}},
         {"GltfAlphaModeNotInTheEnumeration", "m.gltf",

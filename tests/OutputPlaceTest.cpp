@@ -409,5 +409,23 @@ TEST(OutputPlaceTest, PreviousResultsCaughtMidDeletionAreALeftoverTheNextRunRemo
     EXPECT_NE(notes[0].find("left by an interrupted run"), std::string::npos) << notes[0];
 }
 
+// Twenty-fourth probe: validate accepted an output beside a folder (or a user's file) named
+// DIR.lock, which run then could not lock; --out fo.lock made an output that blocked every later
+// run into fo. Both are refused before anything is made.
+TEST(OutputPlaceTest, ALockNameThatCannotBeTakenOrAnOutputNamedLikeALockIsRefused) {
+    const std::string base = test::makeTempDir("place-lock-name");
+    fs::create_directories(base + "/fresh.lock");
+    std::string err = errorOf(base + "/fresh", false);
+    EXPECT_NE(err.find("not a shadowlab lock file"), std::string::npos) << err;
+    std::ofstream(base + "/mine.lock") << "my notes";
+    err = errorOf(base + "/mine", false);
+    EXPECT_NE(err.find("not a shadowlab lock file"), std::string::npos) << err;
+    EXPECT_EQ(slurp(base + "/mine.lock"), "my notes");
+    err = errorOf(base + "/fo.lock", false);
+    EXPECT_NE(err.find("ends in .lock"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(base + "/fo.lock"));
+    EXPECT_EQ(errorOf(base + "/fine", false), "");
+}
+
 } // namespace
 } // namespace shadowlab

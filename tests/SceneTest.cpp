@@ -3,6 +3,7 @@
 #include "framework/scene/GltfLoader.h"
 #include "framework/scene/Procedural.h"
 #include "framework/scene/SceneConfig.h"
+#include "tests/HostileInputs.h"
 #include "tests/TestSupport.h"
 
 #include <gtest/gtest.h>
@@ -78,6 +79,18 @@ const MalformedCase kMalformed[] = {
     {"IncorrectVertexArrays/Cube.gltf", "/bufferViews/2"},                           // views past the 514-byte buffer
     {"RecursiveNodes/RecursiveNodes.gltf", "cycle"},                                 // node 0 ↔ node 1
 };
+
+// Twenty-fourth probe: a node rotation of [1e-300, 0, 0, 0] (a half turn about x once normalised)
+// was refused with vertices "at -nan": its squared length underflowed to 0 in double.
+TEST(GltfTest, ATinyButValidRotationIsAHalfTurn) {
+    const std::string dir = test::makeTempDir("gltf-tiny-rotation");
+    std::ofstream(dir + "/m.gltf") << test::triangleGltf({{"nodes", R"([{"mesh": 0, "rotation": [1e-300, 0, 0, 0]}])"}});
+    const Scene s = loadGltf(dir + "/m.gltf");
+    ASSERT_EQ(s.triangleCount(), 1u);
+    bool turned = false;
+    for (const glm::vec3& v : s.positions) turned = turned || v.y < -0.5f; // (0, 1, 0) goes to (0, -1, 0)
+    EXPECT_TRUE(turned);
+}
 
 class GltfMalformedTest : public ::testing::TestWithParam<MalformedCase> {};
 

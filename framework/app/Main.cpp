@@ -223,6 +223,7 @@ int run(const std::vector<std::string>& args) {
     // The output place is checked and locked before the scene is loaded and anything rendered, so a
     // run that could not save its results fails at once instead of after the work.
     ExperimentConfig cfg = loadConfig(config, false, overrides);
+    if (opt.outputDir.empty() && !cfg.defaultOutputProblem.empty()) throw InputError(config, "/name", cfg.defaultOutputProblem);
     std::vector<std::string> notes;
     // A place from the config is named as validate names it: the config and /output/dir.
     OutputPlace place = [&] {
@@ -317,6 +318,7 @@ int validate(const std::string& config, const std::vector<std::string>& override
     // The output place too (run --out may name another).
     // An existing one must be one `run --force` can replace (seventh probe: a user's folder, a sweep
     // and the config's own folder were "valid", and every run refused them).
+    if (!cfg.defaultOutputProblem.empty()) throw InputError(config, "/name", cfg.defaultOutputProblem);
     try {
         OutputPlace::check(cfg.outputDir, overrides.empty() ? config : std::string());
         OutputPlace::checkReplaceable(cfg.outputDir);

@@ -67,10 +67,12 @@ void checkTime(const Json& j, const std::string& file, const std::string& path) 
         throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a time in ms (0 to 1e12)");
 }
 
-/// A statistic of a counter: a run always computes it, so null is no run's (twenty-second probe: a
-/// null mean stopped compare with the JSON library's message and exit 1).
+/// A statistic of a counter: a run always computes it, a number of at least 0, as every counter is
+/// a count, a size, a share or a time (twenty-second probe: a null mean stopped compare with the
+/// JSON library's message and exit 1; twenty-fourth: an object did too, and -5e9 rays were tabulated).
 void checkMeasured(const Json& j, const std::string& file, const std::string& path) {
-    if (j.is_null()) throw InputError(file, path, "holds null where a run writes a number");
+    if (!(j.is_number() && j.get<double>() >= 0))
+        throw InputError(file, path, "holds " + shortText(j.dump(), 40) + " where a run writes a count (a number, at least 0)");
 }
 
 /// A statistic's min, mean, median and max, where given, in the order a run's are: min <= mean,
@@ -153,6 +155,17 @@ void checkAccuracy(const Json& a, const std::string& file, const std::string& pa
                 throw InputError(file, where, "holds " + shortText(v.dump(), 40) + " where a run writes a share in [0, 1]");
             }
         }
+    }
+    // The worst frame is the worst of the frames and of their mean (twenty-fourth probe: frames of
+    // 50 % beside a worst frame of 0 compared as "same").
+    if (a.contains("mismatch_ratio_max")) {
+        const double worst = a["mismatch_ratio_max"].get<double>() * (1 + 1e-9) + 1e-12;
+        if (a.contains("mismatch_ratio") && a["mismatch_ratio"].get<double>() > worst)
+            throw InputError(file, path + "/mismatch_ratio", "lies above mismatch_ratio_max, which no run writes");
+        if (a.contains("per_frame_mismatch"))
+            for (size_t i = 0; i < a["per_frame_mismatch"].size(); ++i)
+                if (a["per_frame_mismatch"][i].get<double>() > worst)
+                    throw InputError(file, path + "/per_frame_mismatch/" + std::to_string(i), "lies above mismatch_ratio_max, which no run writes");
     }
 }
 
@@ -310,7 +323,10 @@ Json readRunSummary(const std::string& dir) {
     if (fs::is_symlink(fs::symlink_status(file, ec)))
         throw InputError(shortText(file, 300), "", "is a symbolic link, not the run's own file");
     const Json s = JsonNode::parseFile(file);
-    if (!s.is_object() || s.value("complete", false) != true || !s.contains("algorithms") || !s["algorithms"].is_object())
+    // Compared as JSON, not read as a bool (twenty-fourth probe: "complete": "yes" stopped compare
+    // with the JSON library's message, exit 1).
+    if (!s.is_object() || !s.contains("complete") || s["complete"] != Json(true) || !s.contains("algorithms") ||
+        !s["algorithms"].is_object())
         throw InputError(shortText(file, 300), "", "is not a complete run's summary (no \"complete\": true and \"algorithms\")");
     // What compare and history order and divide by is what a run writes (seventh probe: a
     // started_utc of "not-a-date" sorted as the newest run and decided history's exit code;

@@ -368,8 +368,8 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     if (out.has("dir") && out.raw()["dir"].is_string() && out.raw()["dir"].get<std::string>().empty())
         out.fail("dir", "must not be empty (it names the output directory)");
     if (!out.has("dir") && !isFileName(c.name))
-        root.fail("name", "\"" + shortText(c.name, 60) + "\" cannot name the default output folder results/NAME (it holds '/' or "
-                          "'\\', or is '.' or '..'): give output.dir");
+        c.defaultOutputProblem = "\"" + shortText(c.name, 60) + "\" cannot name the default output folder results/NAME (it holds '/' or "
+                                 "'\\', or is '.' or '..'): give output.dir or --out";
     c.outputDir = out.getPath("dir", "results/" + c.name);
     if (const std::string why = pathTextProblem(c.outputDir); !why.empty()) out.fail("dir", "the folder's name " + why);
     c.imagesAtFrames = out.getIntList("images_at_frames", {0});

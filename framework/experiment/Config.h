@@ -51,6 +51,9 @@ struct ExperimentConfig {
     std::vector<Expectation> expectations; ///< `expect`: bounds checked once the results are written
 
     std::string outputDir;       ///< resolved against the config's folder
+    /// Why results/NAME cannot be the output folder when output.dir is not given ("" when it can):
+    /// refused where that default is used, not where `--out` names another (twenty-fourth probe).
+    std::string defaultOutputProblem;
     std::vector<int> imagesAtFrames;
     bool plots = true;
 

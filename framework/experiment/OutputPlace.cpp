@@ -477,6 +477,24 @@ void OutputPlace::check(const std::string& given, const std::string& runConfig) 
     if (absolute.string().size() + kSuffix + kDeepestFile > PATH_MAX)
         throw InputError(shortPath(dir), "", "the path is " + std::to_string(absolute.string().size()) + " bytes; with the files a run "
                                               "writes inside it, it would pass the system's " + std::to_string(PATH_MAX) + "-byte limit");
+    // The lock a run takes beside its output must be takeable, and no output may take a lock's
+    // name (twenty-fourth probe: validate accepted output.dir=fresh beside a folder fresh.lock that
+    // run then could not lock; --out fo.lock made an output that blocked every later run into fo).
+    if (last.size() > 5 && last.compare(last.size() - 5, 5, ".lock") == 0)
+        throw InputError(shortPath(dir), "", "the folder name ends in .lock, the name of a run's lock file beside its output");
+    {
+        const std::string lock = absolute.string() + ".lock";
+        struct stat st {};
+        bool takeable = ::lstat(lock.c_str(), &st) != 0;
+        if (!takeable && S_ISREG(st.st_mode)) {
+            const int fd = ::open(lock.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+            takeable = fd >= 0 && isLockFile(fd);
+            if (fd >= 0) ::close(fd);
+        }
+        if (!takeable)
+            throw InputError(shortPath(dir), "", shortPath(lock) + " is not a shadowlab lock file (a folder, a link or a file of "
+                                                  "yours), and a run locks its output under that name: move it or choose another output");
+    }
     // What run will do first, tried: make a folder beside DIR, in the nearest folder that exists
     // (sixth probe: validate accepted output.dir=/proc/x, which run then could not make).
     std::error_code ec;
@@ -702,6 +720,8 @@ bool OutputPlace::isRunOutput(const std::string& dir) {
 }
 
 bool OutputPlace::isRunTemporary(const std::string& name) { return shadowlab::isRunTemporary(name); }
+
+void OutputPlace::checkFileOutsideOutputs(const std::string& file) { checkAncestors(file, ""); }
 
 bool OutputPlace::isCompleteOutput(const std::string& dir) {
     std::error_code ec;

@@ -39,6 +39,10 @@ public:
     /// InputError when `dir` cannot be a sweep's folder: as check() (but no place inside a sweep at
     /// all, not even its runs/ID), and an existing folder must be empty or hold a sweep (sweep.json).
     static void checkSweepPlace(const std::string& dir);
+    /// InputError when a file some command writes (shadowlab-gui's --screenshot, --report,
+    /// --save-config) lies inside a run's output, a run in progress, a run's temporary folder, a
+    /// sweep or a compare's or history's output: it would corrupt what is there, or be deleted with it.
+    static void checkFileOutsideOutputs(const std::string& file);
     /// InputError when `dir` exists and `run --force` could not replace it: not a directory, a link,
     /// a sweep, not a shadowlab output, or holding another output or a run in progress. `validate`
     /// checks a config's output.dir with it, so that what it accepts a run can write.

@@ -5,6 +5,7 @@
 #include "framework/core/JsonNode.h"
 #include "framework/core/Text.h"
 #include "framework/experiment/MemoryPlan.h"
+#include "framework/experiment/OutputPlace.h"
 #include "framework/scene/SceneConfig.h"
 #include "framework/gl/Gl.h"
 #include "framework/gui/Automation.h"
@@ -112,13 +113,27 @@ static void refuseOutputsOverInputs(const GuiOptions& opts, const Json& source) 
     // The built-in scene has no config file: its scene's files only, relative to this folder.
     std::vector<std::string> inputs = configInputFiles(source, opts.config.empty() ? std::string("built-in") : opts.config);
     if (opts.config.empty()) inputs.erase(inputs.begin());
-    for (const auto& [option, file] : {std::pair<const char*, const std::string*>{"--screenshot", &opts.screenshot},
-                                       {"--report", &opts.report}, {"--save-config", &opts.saveConfig}}) {
+    const std::pair<const char*, const std::string*> outputs[] = {
+        {"--screenshot", &opts.screenshot}, {"--report", &opts.report}, {"--save-config", &opts.saveConfig}};
+    for (size_t k = 0; k < std::size(outputs); ++k) {
+        const auto& [option, file] = outputs[k];
+        if (file->empty()) continue;
         std::error_code ec;
         for (const std::string& input : inputs)
-            if (!file->empty() && std::filesystem::equivalent(*file, input, ec))
+            if (std::filesystem::equivalent(*file, input, ec))
                 throw InputError(shortPath(*file), "", std::string(option) + ": the file is an input of this session (" +
                                                            shortPath(input) + "); write it elsewhere");
+        // Twenty-fourth probe: --report R/summary.json turned a run's summary into a frame log, and
+        // two options naming one file kept only the last one written.
+        try {
+            OutputPlace::checkFileOutsideOutputs(*file);
+        } catch (const InputError& e) {
+            throw InputError(shortPath(*file), "", std::string(option) + ": " + e.cause());
+        }
+        for (size_t j = 0; j < k; ++j)
+            if (!outputs[j].second->empty() && std::filesystem::absolute(*outputs[j].second, ec).lexically_normal() ==
+                                                   std::filesystem::absolute(*file, ec).lexically_normal())
+                throw InputError(shortPath(*file), "", std::string(option) + " and " + outputs[j].first + " name the same file");
     }
 }
 

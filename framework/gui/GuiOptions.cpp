@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 
 namespace shadowlab {
 
@@ -156,8 +157,12 @@ GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
         else if (a == "--screenshot") o.screenshot = fileName(a, value());
         else if (a == "--record-keyframes") o.recordKeyframes = parseKeyframes(value());
         else if (a == "--record-step") {
-            o.recordStep = float(number(a, value()));
-            if (!(o.recordStep > 0)) throw usage("--record-step must be positive");
+            const double step = number(a, value());
+            if (!(step > 0)) throw usage("--record-step must be positive");
+            // Read as a float (twenty-fourth probe: 1e-300 became 0 and was called not positive).
+            if (!(step >= double(std::numeric_limits<float>::min()) && step <= double(std::numeric_limits<float>::max())))
+                throw usage("--record-step is " + echoed(std::to_string(step)) + ", beyond what a float holds");
+            o.recordStep = float(step);
         } else if (a == "--save-config") o.saveConfig = fileName(a, value());
         else if (a == "--report") o.report = fileName(a, value());
         else if (a == "--size") o.windowSize = size(a, value());

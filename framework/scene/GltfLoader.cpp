@@ -44,6 +44,16 @@ namespace {
 using gltf::escapeKey;
 using gltf::NodeAnimation;
 using gltf::rotationMatrix;
+
+namespace {
+/// A node's rotation as a unit quaternion: scaled by its largest component first, so that neither
+/// tiny components (1e-300, whose squares underflow: twenty-fourth probe, a 180-degree turn reported
+/// as vertices at -nan) nor huge ones overflow the length. Zero is refused by validateNodes().
+glm::vec4 unitQuaternion(const std::vector<double>& q) {
+    const double m = std::max(std::max(std::abs(q[0]), std::abs(q[1])), std::max(std::abs(q[2]), std::abs(q[3])));
+    return glm::vec4(glm::normalize(glm::dvec4(q[0] / m, q[1] / m, q[2] / m, q[3] / m)));
+}
+} // namespace
 using gltf::slerp;
 using gltf::Track;
 
@@ -234,9 +244,7 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         anim->fixed[i] = localMatrix(node);
         anim->t[i] = node.translation.size() == 3 ? glm::vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])) : glm::vec3(0.0f);
         // Normalised in double, as localMatrix() does: a float length of large components overflows.
-        anim->r[i] = node.rotation.size() == 4
-                         ? glm::vec4(glm::normalize(glm::dvec4(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3])))
-                         : glm::vec4(0, 0, 0, 1);
+        anim->r[i] = node.rotation.size() == 4 ? unitQuaternion(node.rotation) : glm::vec4(0, 0, 0, 1);
         anim->s[i] = node.scale.size() == 3 ? glm::vec3(float(node.scale[0]), float(node.scale[1]), float(node.scale[2])) : glm::vec3(1.0f);
     }
     if (chosen == m_.animations.size()) return anim;  // node paths only
@@ -386,6 +394,11 @@ void Loader::validateNodes() {
             bool ok = v.empty() || v.size() == n;
             for (double d : v) ok = ok && std::isfinite(d);
             if (!ok) fail(path + "/" + key, "expected " + std::to_string(n) + " finite numbers");
+            // Placed in float (twenty-fourth probe: a translation of 1e300 became inf, and its
+            // vertices were reported at -nan, with no word of the node).
+            for (double d : v)
+                if (!(std::abs(d) <= double(std::numeric_limits<float>::max())))
+                    fail(path + "/" + key, "holds " + shortText(std::to_string(d), 30) + ", which does not fit a float");
         };
         checkVec(n.matrix, 16, "matrix");
         checkVec(n.translation, 3, "translation");
@@ -501,10 +514,7 @@ glm::mat4 Loader::localMatrix(const tinygltf::Node& n) const {
     if (n.translation.size() == 3)
         t[3] = glm::vec4(float(n.translation[0]), float(n.translation[1]), float(n.translation[2]), 1.0f);
     if (n.rotation.size() == 4) {
-        double len = std::sqrt(n.rotation[0] * n.rotation[0] + n.rotation[1] * n.rotation[1] + n.rotation[2] * n.rotation[2] +
-                               n.rotation[3] * n.rotation[3]);
-        r = rotationMatrix(glm::vec4(float(n.rotation[0] / len), float(n.rotation[1] / len), float(n.rotation[2] / len),
-                                     float(n.rotation[3] / len)));
+        r = rotationMatrix(unitQuaternion(n.rotation));
     }
     if (n.scale.size() == 3)
         s = glm::mat4(glm::vec4(float(n.scale[0]), 0, 0, 0), glm::vec4(0, float(n.scale[1]), 0, 0),
