@@ -3,8 +3,8 @@
 // rounded to IEEE single once (no fused multiply-add: include this only in files compiled with
 // -ffp-contract=off, see CMakeLists.txt) and every subnormal flushed to zero, operands and result,
 // as a GPU may do on its own (GLSL 4.50 section 4.7.1); flushing on both sides makes that choice
-// moot. The shaders' twins: lightFlushed/lightSub/lightMul (shaders/common/light.glsl) and
-// wtFlush/wtSub/wtMul/wtAdd (shaders/common/watertight.glsl).
+// moot. The shaders' twin: shaders/common/exact_float.glsl (exactFlush, exactSub, exactAdd,
+// exactMul, exactDot), used by common/light.glsl and common/watertight.glsl.
 #include <cmath>
 #include <limits>
 
@@ -13,6 +13,7 @@
 namespace shadowlab::exact {
 
 inline float flushed(float x) { return std::fabs(x) < std::numeric_limits<float>::min() ? 0.0f : x; }
+inline glm::vec3 flushed(glm::vec3 v) { return {flushed(v.x), flushed(v.y), flushed(v.z)}; }
 inline float sub(float a, float b) { return flushed(flushed(a) - flushed(b)); }
 inline float add(float a, float b) { return flushed(flushed(a) + flushed(b)); }
 inline float mul(float a, float b) { return flushed(flushed(a) * flushed(b)); }

@@ -11,9 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -159,6 +159,7 @@ void checkAccuracy(const Json& a, const std::string& file, const std::string& pa
     // The worst frame is the worst of the frames and of their mean (twenty-fourth probe: frames of
     // 50 % beside a worst frame of 0 compared as "same").
     if (a.contains("mismatch_ratio_max")) {
+        // With the rounding of a mean of frames beside it, relative and near 0.
         const double worst = a["mismatch_ratio_max"].get<double>() * (1 + 1e-9) + 1e-12;
         if (a.contains("mismatch_ratio") && a["mismatch_ratio"].get<double>() > worst)
             throw InputError(file, path + "/mismatch_ratio", "lies above mismatch_ratio_max, which no run writes");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace shadowlab::watertight {
 
@@ -42,14 +43,14 @@ glm::vec3 project(const Ray& r, glm::vec3 v) {
 
 Ray makeRay(glm::vec3 o, glm::vec3 d, float tfar) {
     Ray r;
-    r.o = glm::vec3(exact::flushed(o.x), exact::flushed(o.y), exact::flushed(o.z));
+    r.o = exact::flushed(o);
     const glm::vec3 a = glm::abs(d);
     r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
-    glm::vec3 pd = permute(glm::vec3(exact::flushed(d.x), exact::flushed(d.y), exact::flushed(d.z)), r.kz);
+    glm::vec3 pd = permute(exact::flushed(d), r.kz);
     int e = 0;
     std::frexp(pd.z, &e); // pd.z = m * 2^e, |m| in [0.5, 1) (0 for a zero direction)
     r.d = glm::vec3(exact::flushed(std::ldexp(pd.x, -e)), exact::flushed(std::ldexp(pd.y, -e)), std::ldexp(pd.z, -e));
-    r.tfar = std::ldexp(tfar, e);
+    r.tfar = tfar <= std::numeric_limits<float>::max() ? std::ldexp(tfar, e) : tfar; // as the shader: +inf kept
     return r;
 }
 

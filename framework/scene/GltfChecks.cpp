@@ -269,8 +269,6 @@ namespace {
 /// The data URIs the reader decodes (others it would take for file names).
 constexpr const char* kDataUriPrefixes[] = {"data:application/octet-stream;base64,", "data:application/gltf-buffer;base64,"};
 
-/// The decoded length of a buffer's data URI, or why the reader cannot decode it (another media
-/// type or encoding, or a payload that is not base64).
 /// Whether `path` (resolved, links followed) lies in `folder` (resolved likewise) or below it.
 bool insideFolder(const std::string& path, const std::string& folder) {
     std::error_code ec;
@@ -282,6 +280,8 @@ bool insideFolder(const std::string& path, const std::string& folder) {
     return !rel.empty() && *rel.begin() != "..";
 }
 
+/// The decoded length of a buffer's data URI, or why the reader cannot decode it (another media
+/// type or encoding, or a payload that is not base64).
 size_t dataUriLength(const std::string& uri, std::string& problem) {
     for (const char* prefix : kDataUriPrefixes) {
         const size_t start = std::strlen(prefix);

@@ -44,8 +44,9 @@ namespace {
 using gltf::escapeKey;
 using gltf::NodeAnimation;
 using gltf::rotationMatrix;
+using gltf::slerp;
+using gltf::Track;
 
-namespace {
 /// A node's rotation as a unit quaternion: scaled by its largest component first, so that neither
 /// tiny components (1e-300, whose squares underflow: twenty-fourth probe, a 180-degree turn reported
 /// as vertices at -nan) nor huge ones overflow the length. Zero is refused by validateNodes().
@@ -53,9 +54,6 @@ glm::vec4 unitQuaternion(const std::vector<double>& q) {
     const double m = std::max(std::max(std::abs(q[0]), std::abs(q[1])), std::max(std::abs(q[2]), std::abs(q[3])));
     return glm::vec4(glm::normalize(glm::dvec4(q[0] / m, q[1] / m, q[2] / m, q[3] / m)));
 }
-} // namespace
-using gltf::slerp;
-using gltf::Track;
 
 // Images are never used (only geometry and base colour factors), so skip decoding them.
 bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
@@ -243,7 +241,6 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
         const auto& node = m_.nodes[i];
         anim->fixed[i] = localMatrix(node);
         anim->t[i] = node.translation.size() == 3 ? glm::vec3(float(node.translation[0]), float(node.translation[1]), float(node.translation[2])) : glm::vec3(0.0f);
-        // Normalised in double, as localMatrix() does: a float length of large components overflows.
         anim->r[i] = node.rotation.size() == 4 ? unitQuaternion(node.rotation) : glm::vec4(0, 0, 0, 1);
         anim->s[i] = node.scale.size() == 3 ? glm::vec3(float(node.scale[0]), float(node.scale[1]), float(node.scale[2])) : glm::vec3(1.0f);
     }

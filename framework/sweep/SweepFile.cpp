@@ -1,9 +1,9 @@
 #include "framework/sweep/SweepFile.h"
 
+#include "framework/core/Text.h"
 #include "framework/experiment/Compare.h"
 #include "framework/experiment/Config.h"
 #include "framework/scene/SceneConfig.h"
-#include "framework/core/Text.h"
 #include "framework/sweep/SweepText.h"
 
 #include <algorithm>
@@ -17,7 +17,6 @@
 
 namespace shadowlab {
 
-/// Adds the algorithm ids a resolved run config gives results under (its algorithms' and the reference's).
 namespace {
 
 /// Text a spreadsheet would read as a formula in a CSV cell: it starts with =, +, - or @ and is not

@@ -12,36 +12,26 @@ bool lightIsDirectional() { return uLightType == LIGHT_DIRECTIONAL; }
 
 uniform float uLightCosConeSq; // spot: cos² of the half-angle (Light::cosConeSquared)
 
-// Exact-decision arithmetic, the twin of framework/view/Light.cpp's: GLSL rounds +, - and *
-// correctly (4.50 section 4.7.1) but may flush subnormals and may fuse a*b+c; `precise` forbids the
-// fusing and every result below the smallest normal float is flushed here, on both sides alike.
-float lightFlushed(float x) { return abs(x) < 1.17549435e-38 ? 0.0 : x; }
-float lightSub(float a, float b) { precise float r = lightFlushed(a) - lightFlushed(b); return lightFlushed(r); }
-float lightMul(float a, float b) { precise float r = lightFlushed(a) * lightFlushed(b); return lightFlushed(r); }
-vec3 lightSub(vec3 a, vec3 b) { return vec3(lightSub(a.x, b.x), lightSub(a.y, b.y), lightSub(a.z, b.z)); }
-float lightDot(vec3 a, vec3 b) {
-    precise float xy = lightMul(a.x, b.x) + lightMul(a.y, b.y);
-    precise float xyz = lightFlushed(xy) + lightMul(a.z, b.z);
-    return lightFlushed(xyz);
-}
+// The decisions below repeat framework/view/Light.cpp's with the same exact-decision arithmetic.
+#include "common/exact_float.glsl"
 
 // The light reaches p at all (the twin of Light::illuminates): inside a spot's cone, in front of
 // an area light; point and directional lights reach everywhere.
 bool lightIlluminates(vec3 p) {
     if (uLightType != LIGHT_SPOT && uLightType != LIGHT_AREA) return true;
-    vec3 fromLight = lightSub(p, uLightPosition);
-    float along = lightDot(fromLight, uLightDirection);
+    vec3 fromLight = exactSub(p, uLightPosition);
+    float along = exactDot(fromLight, uLightDirection);
     if (uLightType == LIGHT_AREA) return along > 0.0;
     // Inside the cone: cos(angle to the axis) > cos(half-angle), squared (both sides positive).
-    return along > 0.0 && lightMul(along, along) > lightMul(uLightCosConeSq, lightDot(fromLight, fromLight));
+    return along > 0.0 && exactMul(along, along) > exactMul(uLightCosConeSq, exactDot(fromLight, fromLight));
 }
 
 // A surface point p of normal n (not normalised) receives direct light before occlusion: the
 // decision every exact algorithm shares with the reference (the twin of Light::reaches, operation
 // for operation, so that a tie such as grazing light or the cone's surface goes the same way).
 bool lightReaches(vec3 p, vec3 n) {
-    if (uLightType == LIGHT_DIRECTIONAL) return lightDot(n, -uLightDirection) > 0.0;
-    return lightIlluminates(p) && lightDot(n, lightSub(uLightPosition, p)) > 0.0;
+    if (uLightType == LIGHT_DIRECTIONAL) return exactDot(n, -uLightDirection) > 0.0;
+    return lightIlluminates(p) && exactDot(n, exactSub(uLightPosition, p)) > 0.0;
 }
 
 // Unit vector from p towards the light.

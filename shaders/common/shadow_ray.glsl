@@ -12,7 +12,7 @@
 // soft algorithms'; it may sit on a surface), unit direction and `offset` short of the sample.
 // A zero direction (o on the light) hits nothing.
 void shadowRayTo(vec3 o, vec3 s, float offset, out vec3 d, out float tfar) {
-    d = wtSub(s, o);
+    d = exactSub(s, o);
     tfar = 1.0;
     if (uLightType == LIGHT_AREA) {
         float dist = length(d);

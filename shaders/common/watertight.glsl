@@ -21,32 +21,26 @@ struct WatertightRay {
     int kz;     // dominant axis of the direction
 };
 
-// Exact-decision arithmetic, the twin of framework/core/ExactFloat.h: operands and result flushed.
-float wtFlush(float x) { return abs(x) < 1.17549435e-38 ? 0.0 : x; }
-vec3 wtFlush(vec3 v) { return vec3(wtFlush(v.x), wtFlush(v.y), wtFlush(v.z)); }
-float wtSub(float a, float b) { precise float r = wtFlush(a) - wtFlush(b); return wtFlush(r); }
-float wtAdd(float a, float b) { precise float r = wtFlush(a) + wtFlush(b); return wtFlush(r); }
-float wtMul(float a, float b) { precise float r = wtFlush(a) * wtFlush(b); return wtFlush(r); }
-vec3 wtSub(vec3 a, vec3 b) { return vec3(wtSub(a.x, b.x), wtSub(a.y, b.y), wtSub(a.z, b.z)); }
+#include "common/exact_float.glsl"
 
 // v in the ray's frame: (v[kx], v[ky], v[kz]) with kx = (kz + 1) % 3, ky = (kx + 1) % 3.
 vec3 watertightPermute(vec3 v, int kz) { return kz == 0 ? v.yzx : (kz == 1 ? v.zxy : v.xyz); }
 
 // The reference's ray origin p + n * offset, rounded as framework/reference/Watertight.cpp rounds it.
 vec3 watertightOrigin(vec3 p, vec3 n, float offset) {
-    return vec3(wtAdd(p.x, wtMul(n.x, offset)), wtAdd(p.y, wtMul(n.y, offset)), wtAdd(p.z, wtMul(n.z, offset)));
+    return vec3(exactAdd(p.x, exactMul(n.x, offset)), exactAdd(p.y, exactMul(n.y, offset)), exactAdd(p.z, exactMul(n.z, offset)));
 }
 
 WatertightRay watertightRay(vec3 o, vec3 d, float tfar) {
     WatertightRay r;
-    r.o = wtFlush(o);
+    r.o = exactFlush(o);
     vec3 a = abs(d);
     r.kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
-    vec3 pd = watertightPermute(wtFlush(d), r.kz);
+    vec3 pd = watertightPermute(exactFlush(d), r.kz);
     int e;
     frexp(pd.z, e); // pd.z = m * 2^e, |m| in [0.5, 1) (e = 0 for a zero direction)
-    r.d = vec3(wtFlush(ldexp(pd.x, -e)), wtFlush(ldexp(pd.y, -e)), ldexp(pd.z, -e));
-    r.tfar = ldexp(tfar, e);
+    r.d = vec3(exactFlush(ldexp(pd.x, -e)), exactFlush(ldexp(pd.y, -e)), ldexp(pd.z, -e));
+    r.tfar = tfar <= 3.40282347e38 ? ldexp(tfar, e) : tfar; // +inf (a directional light) kept: ldexp's is undefined
     return r;
 }
 
@@ -65,22 +59,22 @@ float watertightEdge(vec2 a, vec2 b) {
 #if SHADOWLAB_FAULT_FMA_EDGES
     // What a contracting compiler may make of it: fma(p.x, q.y, -(p.y * q.x)), the first product
     // exact. Emulated in double (exact product) because a driver's fma() may itself be unfused.
-    float e = wtFlush(float(double(p.x) * double(q.y) - double(wtMul(p.y, q.x))));
+    float e = exactFlush(float(double(p.x) * double(q.y) - double(exactMul(p.y, q.x))));
 #else
-    float e = wtSub(wtMul(p.x, q.y), wtMul(p.y, q.x));
+    float e = exactSub(exactMul(p.x, q.y), exactMul(p.y, q.x));
 #endif
     return swapped ? -e : e;
 }
 
 // The edge value decided in double: products of floats are exact in double, so its sign is exact.
 float watertightEdgeInDouble(vec2 a, vec2 b) {
-    return wtFlush(float(double(a.x) * double(b.y) - double(a.y) * double(b.x)));
+    return exactFlush(float(double(a.x) * double(b.y) - double(a.y) * double(b.x)));
 }
 
 // A vertex relative to the origin, permuted, projected along the ray onto z = 0 and scaled by d.z.
 vec3 watertightProject(WatertightRay r, vec3 v) {
-    vec3 a = watertightPermute(wtSub(v, r.o), r.kz);
-    return vec3(wtSub(wtMul(a.x, r.d.z), wtMul(r.d.x, a.z)), wtSub(wtMul(a.y, r.d.z), wtMul(r.d.y, a.z)), a.z);
+    vec3 a = watertightPermute(exactSub(v, r.o), r.kz);
+    return vec3(exactSub(exactMul(a.x, r.d.z), exactMul(r.d.x, a.z)), exactSub(exactMul(a.y, r.d.z), exactMul(r.d.y, a.z)), a.z);
 }
 
 bool watertightHit(WatertightRay r, vec3 v0, vec3 v1, vec3 v2) {
@@ -94,11 +88,11 @@ bool watertightHit(WatertightRay r, vec3 v0, vec3 v1, vec3 v2) {
         W = watertightEdgeInDouble(B.xy, A.xy);
     }
     if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
-    float det = wtAdd(wtAdd(U, V), W);
-    float D = wtMul(det, r.d.z); // t = T / D
+    float det = exactAdd(exactAdd(U, V), W);
+    float D = exactMul(det, r.d.z); // t = T / D
     if (D == 0.0) return false;
-    float T = wtAdd(wtAdd(wtMul(U, A.z), wtMul(V, B.z)), wtMul(W, C.z));
-    float end = wtMul(r.tfar, D);
+    float T = exactAdd(exactAdd(exactMul(U, A.z), exactMul(V, B.z)), exactMul(W, C.z));
+    float end = exactMul(r.tfar, D);
     // t must lie in (0, tfar]
     return D > 0.0 ? (T > 0.0 && T <= end) : (T < 0.0 && T >= end);
 }
