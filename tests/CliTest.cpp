@@ -245,6 +245,13 @@ TEST(CliTest, AnOptionTwiceOrWithoutItsValueIsBadInput) {
         {"sweep run " + sweep + " --out " + dir + "/a --out " + dir + "/b", "is given twice"},
         {"sweep run " + sweep + " --out --jobs 2", "not the option --jobs"},
         {"sweep slurm " + sweep + " --out " + dir + "/sw --partition ''", "must not be empty"},
+        // Probe 25: flags twice were refused by some commands and taken by others; one rule now.
+        {"run " + config + " --out " + dir + "/a --force --force", "--force is given twice"},
+        {"run " + config + " --out " + dir + "/a --no-progress --no-progress", "--no-progress is given twice"},
+        {"info --json --json", "--json is given twice"},
+        {"sweep plan " + sweep + " --check --check", "--check: is given twice"},
+        {"compare " + dir + " " + dir + " --force --force", "--force: is given twice"},
+        {"history " + dir + " --by-name --by-name", "--by-name: is given twice"},
     };
     for (const auto& [args, cause] : cases) {
         std::string out;

@@ -36,6 +36,14 @@ const Json& record(const Comparison& c, const std::string& id) {
     return none;
 }
 
+/// The one record of `kind` ("visibility", "shaded", "diff") in an id's compared images.
+const Json& image(const Json& images, const std::string& kind) {
+    for (const Json& im : images)
+        if (im["image"] == kind) return im;
+    static const Json none;
+    return none;
+}
+
 class CompareGLTest : public GLTest {};
 
 TEST_F(CompareGLTest, PlantedRegressionsAreNamedAndARunAgainstItselfChangesNothing) {
@@ -57,9 +65,12 @@ TEST_F(CompareGLTest, PlantedRegressionsAreNamedAndARunAgainstItselfChangesNothi
     EXPECT_EQ(psv["time"].back()["stage"], "total");
     EXPECT_EQ(psv["time"].back()["verdict"], "slower") << psv["time"].dump(2);
     EXPECT_EQ(psv["accuracy"]["verdict"], "worse") << psv["accuracy"].dump();
-    ASSERT_EQ(psv["images"].size(), 1u);
-    EXPECT_GT(psv["images"][0]["changed_pixels"].get<size_t>(), 0u);
-    EXPECT_TRUE(psv["images"][0].contains("picture"));
+    // Frame 2's visibility, shaded and difference images: each changed where psv wrote lit.
+    ASSERT_EQ(psv["images"].size(), 3u) << psv["images"].dump();
+    for (const char* kind : {"visibility", "shaded", "diff"}) {
+        EXPECT_GT(image(psv["images"], kind)["changed_pixels"].get<size_t>(), 0u) << kind;
+        EXPECT_TRUE(image(psv["images"], kind).contains("picture")) << kind;
+    }
     EXPECT_EQ(psv["regressions"].size(), 2u) << psv["regressions"].dump();
     // bvh_raytrace is untouched: its image and accuracy are the same. Its absolute time (and the
     // reference's) is left to the relative comparison below: two runs under a loaded ctest -j2
@@ -67,7 +78,8 @@ TEST_F(CompareGLTest, PlantedRegressionsAreNamedAndARunAgainstItselfChangesNothi
     // results/reference/compare_noise_llvmpipe.md). So every other regression is a time's.
     const Json& bvh = record(c, "bvh_raytrace");
     EXPECT_NE(bvh["accuracy"]["verdict"], "worse") << bvh.dump(2);
-    EXPECT_EQ(bvh["images"][0]["changed_pixels"], 0u);
+    ASSERT_EQ(bvh["images"].size(), 3u) << bvh["images"].dump();
+    for (const Json& im : bvh["images"]) EXPECT_EQ(im["changed_pixels"], 0u) << im.dump();
     size_t others = 0;
     for (const Json& r : c.records) {
         if (r["id"] == "psv") continue;
@@ -87,23 +99,36 @@ TEST_F(CompareGLTest, PlantedRegressionsAreNamedAndARunAgainstItselfChangesNothi
 
 // Seventh probe: an image compare could not read (truncated, missing, a FIFO, another size) was
 // skipped without a word, and the report read as if nothing had changed. Each is now named.
+// Probe 25: only the visibility images were read, so a lost, broken or changed shaded or
+// difference image went unreported; every saved image is compared now.
 TEST_F(CompareGLTest, ImagesThatCannotBeComparedAreNamed) {
     const std::string dir = test::makeTempDir("compare-images");
     runInto(dir + "/base");
     std::filesystem::copy(dir + "/base", dir + "/broken", std::filesystem::copy_options::recursive);
     std::filesystem::resize_file(dir + "/broken/images/psv_f0002_visibility.png", 200);
     std::filesystem::remove(dir + "/broken/images/bvh_raytrace_f0002_visibility.png");
+    std::filesystem::resize_file(dir + "/broken/images/psv_f0002_shaded.png", 100);
+    std::filesystem::remove(dir + "/broken/images/bvh_raytrace_f0002_diff.png");
+    // Another run's image in place of one: the same size, other pixels.
+    std::filesystem::copy_file(dir + "/base/images/psv_f0002_visibility.png", dir + "/broken/images/bvh_raytrace_f0002_shaded.png",
+                               std::filesystem::copy_options::overwrite_existing);
     const Comparison c = compareRuns(dir + "/base", dir + "/broken", {});
-    for (const char* id : {"psv", "bvh_raytrace"}) {
-        const Json& images = record(c, id)["images"];
-        ASSERT_EQ(images.size(), 1u) << id;
-        EXPECT_TRUE(images[0]["changed_pixels"].is_null()) << id;
-        EXPECT_NE(images[0]["note"].get<std::string>().find("NEW's image " + std::string(id) + "_f0002_visibility.png"), std::string::npos)
-            << images.dump();
-    }
+    auto noted = [&](const std::string& id, const std::string& kind) {
+        const Json& im = image(record(c, id)["images"], kind);
+        EXPECT_TRUE(im["changed_pixels"].is_null()) << id << " " << kind;
+        EXPECT_NE(im.value("note", "").find("NEW's image " + id + "_f0002_" + kind + ".png"), std::string::npos) << im.dump();
+    };
+    noted("psv", "visibility");
+    noted("psv", "shaded");
+    noted("bvh_raytrace", "visibility");
+    noted("bvh_raytrace", "diff");
+    EXPECT_GT(image(record(c, "bvh_raytrace")["images"], "shaded")["changed_pixels"].get<size_t>(), 0u);
+    EXPECT_EQ(image(record(c, "psv")["images"], "diff")["changed_pixels"], 0u);
     const std::string md = comparisonMarkdown(c, dir + "/base", dir + "/broken", {});
-    EXPECT_NE(md.find("psv frame 2: images not compared"), std::string::npos) << md;
-    EXPECT_NE(md.find("bvh_raytrace frame 2: images not compared"), std::string::npos) << md;
+    EXPECT_NE(md.find("psv frame 2 visibility: image not compared"), std::string::npos) << md;
+    EXPECT_NE(md.find("psv frame 2 shaded: image not compared"), std::string::npos) << md;
+    EXPECT_NE(md.find("bvh_raytrace frame 2 diff: image not compared"), std::string::npos) << md;
+    EXPECT_NE(md.find("bvh_raytrace frame 2 shaded: "), std::string::npos) << md;
 }
 
 } // namespace

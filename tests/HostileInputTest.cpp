@@ -7,6 +7,7 @@
 #include "tests/TestSupport.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sys/stat.h>
@@ -162,6 +163,14 @@ std::vector<BadCase> badCases() {
                      {"algorithms", R"([{"algorithm": "line_space"}])"}}),
          {"/algorithms/0/algorithm", "rebuild_every_frame"}},
         {"GltfAnimationUnknown", "m.gltf", test::triangleGltf({}), {"m.gltf", "/animations", "no animation"}, R"(, "animation": "walk")"},
+        // Probe 25: an index past the end was named as if it were a name.
+        {"GltfAnimationIndexBeyond", "m.gltf", test::triangleGltf({}), {"m.gltf", "/animations", "no animation of index or name 5"},
+         R"(, "animation": 5)"},
+        // Probe 25: glTF forbids normalized FLOAT (and UNSIGNED_INT) accessors; one was read as plain floats.
+        {"GltfNormalizedFloatAccessor", "m.gltf",
+         test::triangleGltf({{"accessors", R"([{"bufferView": 0, "componentType": 5126, "normalized": true, "type": "VEC3", "count": 3,
+                              "min": [0, 0, 0], "max": [1, 1, 0]}])"}}),
+         {"m.gltf", "/accessors/0/normalized", "FLOAT"}},
         {"GltfNodePathBeyondNodes", "m.gltf", test::triangleGltf({}), {"m.gltf", "node 7"},
          R"(, "node_paths": [{"node": 7, "path": {"keyframes": [{"time": 0}]}}])"},
         {"GlbWithDeepExtras", "m.glb", test::glbOf(test::triangleGltf({{"extras", deep}})), {"m.glb", "nesting deeper"}},
@@ -493,6 +502,26 @@ TEST(HostileInputTest, ParserNamesThePathOfEveryFault) {
     EXPECT_EQ(parseJson(text, "f"), Json::parse(text));
 }
 
+// Probe 25: a syntax error where the next key should be was reported at the last value read
+// (`"frames": 1, /*c*/` at /frames), and an end of input inside the root object at its last key.
+TEST(HostileInputTest, ASyntaxErrorNamesWhereTheParserStood) {
+    auto pathOf = [](const std::string& text) {
+        try {
+            parseJson(text, "f.json");
+        } catch (const InputError& e) {
+            EXPECT_NE(e.cause().find("invalid JSON"), std::string::npos) << e.what();
+            return e.jsonPath();
+        }
+        ADD_FAILURE() << "parsed: " << text;
+        return std::string("(parsed)");
+    };
+    EXPECT_EQ(pathOf(R"({"scene": {}, "frames": 1, /*c*/ "x": 1})"), "");
+    EXPECT_EQ(pathOf(R"({"scene": {"objects": [1, 2]})"), "");
+    EXPECT_EQ(pathOf(R"({"scene": {"objects": [1, 2], }})"), "/scene");
+    EXPECT_EQ(pathOf(R"({"frames": tru})"), "/frames");
+    EXPECT_EQ(pathOf(R"({"scene": {"objects": [1, tru]}})"), "/scene/objects/1");
+}
+
 TEST(HostileInputTest, ShortDumpStaysShort) {
     Json big = Json::array();
     for (int i = 0; i < 100000; ++i) big.push_back(Json::array({i, i, i}));
@@ -512,6 +541,23 @@ TEST(HostileInputTest, FifoAtACachePathIsBypassedNotOpened) {
     EXPECT_FALSE(hit);
     EXPECT_FALSE(loaded);
     EXPECT_TRUE(fs::is_fifo(path));  // left alone, not replaced
+}
+
+// Probe 25: a relative XDG_CACHE_HOME put cache files in the working folder; the XDG base
+// directory spec says to ignore it (as a relative HOME).
+TEST(HostileInputTest, ARelativeCacheHomeIsIgnored) {
+    const char* oldXdg = std::getenv("XDG_CACHE_HOME");
+    const char* oldHome = std::getenv("HOME");
+    const std::string keepXdg = oldXdg ? oldXdg : "", keepHome = oldHome ? oldHome : "";
+    ::setenv("XDG_CACHE_HOME", "relative_cache", 1);
+    ::setenv("HOME", "/home/someone", 1);
+    EXPECT_EQ(diskcache::directory("x"), "/home/someone/.cache/shadowlab/x");
+    ::setenv("HOME", "home", 1);
+    EXPECT_EQ(diskcache::directory("x"), "");
+    ::setenv("XDG_CACHE_HOME", "/var/cache", 1);
+    EXPECT_EQ(diskcache::directory("x"), "/var/cache/shadowlab/x");
+    oldXdg ? ::setenv("XDG_CACHE_HOME", keepXdg.c_str(), 1) : ::unsetenv("XDG_CACHE_HOME");
+    oldHome ? ::setenv("HOME", keepHome.c_str(), 1) : ::unsetenv("HOME");
 }
 
 } // namespace

@@ -296,6 +296,16 @@ TEST(SweepSlurmScriptTest, ValuesThatCouldAddOptionsOrCommandsAreRefused) {
         EXPECT_EQ(r.rc, 2) << o << ": " << r.err;
         EXPECT_FALSE(fs::exists(o + "/sweep.sbatch"));
     }
+    // The same folder given by the sweep file's output.dir is blamed there, not on an --out never
+    // given (probe 25).
+    {
+        const std::string inFile = smallFile(dir, {{"output", {{"dir", dir + "/out_%j"}}}});
+        const Ran r = runArgs(sweep({"slurm", inFile}));
+        EXPECT_EQ(r.rc, 2) << r.err;
+        EXPECT_NE(r.err.find("small.sweep.json: at /output/dir"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("error: --out"), std::string::npos) << r.err;
+        expectOneShortLine(r);
+    }
     // Each Slurm time format is accepted.
     for (const char* time : {"30", "30:00", "02:00:00", "1-0", "1-12:30", "2-00:00:00", "UNLIMITED"})
         EXPECT_EQ(runArgs(sweep({"slurm", file, "--out", out, "--time", time})).rc, 0) << time;

@@ -2,6 +2,7 @@
 // Markdown it is written as, and each way a hostile or careless config reached a report, a plan or
 // standard output before, kept as a test.
 #include "framework/core/Text.h"
+#include "HostileInputs.h"
 #include "SweepTestData.h"
 #include "TestSupport.h"
 
@@ -260,6 +261,33 @@ TEST(UserTextTest, AGltfThatIsNotARegularFileIsNamedSo) {
         expectOneLineNaming(r, "/scene/objects/0/gltf");
         EXPECT_NE(r.out.find("not a regular file"), std::string::npos) << r.out;
     }
+}
+
+// Probe 25: a path's text was checked after "x/\0/../y" folded to "y", and a glTF path not at
+// all, so a NUL cut the name short where the file was opened (a config read another file than the
+// one it names) and a line break or bidi mark reached config.resolved.json.
+TEST(UserTextTest, APathIsCheckedAsWrittenBeforeItIsFolded) {
+    const std::string gltf = test::makeTempDir("user-text-gltf") + "/m.gltf";
+    std::ofstream(gltf) << test::triangleGltf();
+    for (const char* tail : {"\\u0000", "\\n", "\\u202e"}) {
+        const Result out = shell(kBin + " validate " + kSmoke + " --set 'output.dir=\"o" + tail + "/../target\"'");
+        expectOneLineNaming(out, "/output/dir");
+        const Result scene = shell(kBin + " validate " + kSmoke + " --set 'scene.objects.0={\"gltf\": \"" + gltf + tail + ".x\"}'");
+        expectOneLineNaming(scene, "/scene/objects/0/gltf");
+        EXPECT_EQ(scene.out.find("valid"), std::string::npos) << scene.out;
+    }
+}
+
+// Probe 25: a bad value a --set gave was blamed on the config file alone, which holds another.
+TEST(UserTextTest, AnErrorInASetValueNamesTheSet) {
+    const Result frames = shell(kBin + " validate " + kSmoke + " --set frames=");
+    expectOneLineNaming(frames, "smoke.json: at /frames: from --set frames=: ");
+    const Result params = shell(kBin + " validate " + kSmoke + " --set 'algorithms.0.params=[1]'");
+    expectOneLineNaming(params, "at /algorithms/0/params: from --set algorithms.0.params=[1]: ");
+    // An error elsewhere stays the file's.
+    const Result other = shell(kBin + " validate " + kSmoke + " --set frames=2 --set resolution=[0,4]");
+    expectOneLineNaming(other, "from --set resolution=[0,4]");
+    EXPECT_EQ(other.out.find("frames"), std::string::npos) << other.out;
 }
 
 // Reproduction 10, its other half: a stage or counter no run measured is named when merging,

@@ -204,8 +204,10 @@ int run(const std::vector<std::string>& args) {
             if (const std::string why = pathTextProblem(args[i]); !why.empty()) usageError("--out: the folder's name " + why);
             opt.outputDir = args[i];
         } else if (a == "--force") {
+            if (opt.force) usageError("--force is given twice");
             opt.force = true;
         } else if (a == "--no-progress") {
+            if (!opt.progress) usageError("--no-progress is given twice");
             opt.progress = false;
         } else if (a == "--set") {
             if (++i >= args.size()) usageError("--set needs PATH=VALUE");
@@ -342,7 +344,8 @@ int info(const std::vector<std::string>& args) {
     bool json = false;
     if (std::any_of(args.begin() + 1, args.end(), isHelp)) return commandUsage(kInfoUsage);
     for (size_t i = 1; i < args.size(); ++i) {
-        if (args[i] == "--json") json = true;
+        if (args[i] == "--json" && json) usageError("--json is given twice");
+        else if (args[i] == "--json") json = true;
         else if (!args[i].empty() && args[i][0] == '-') usageError("unknown option " + args[i] + " (info takes only --json)");
         else usageError("unexpected argument " + args[i] + " (info takes only --json)");
     }

@@ -11,8 +11,10 @@ namespace shadowlab::diskcache {
 namespace fs = std::filesystem;
 
 std::string directory(const std::string& name) {
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/shadowlab/" + name;
-    if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/shadowlab/" + name;
+    // Absolute paths only: the XDG base directory spec calls a relative one invalid, to be ignored
+    // (probe 25: a relative one put cache files in the working folder, outside any output).
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && xdg[0] == '/') return std::string(xdg) + "/shadowlab/" + name;
+    if (const char* home = std::getenv("HOME"); home && home[0] == '/') return std::string(home) + "/.cache/shadowlab/" + name;
     return "";
 }
 

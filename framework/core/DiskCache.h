@@ -12,7 +12,8 @@
 
 namespace shadowlab::diskcache {
 
-/// $XDG_CACHE_HOME/shadowlab/<name>, else ~/.cache/shadowlab/<name>; "" when neither is set.
+/// $XDG_CACHE_HOME/shadowlab/<name>, else ~/.cache/shadowlab/<name>; "" when neither is set to an
+/// absolute path (a relative one is ignored, as the XDG base directory spec says).
 std::string directory(const std::string& name);
 
 constexpr uint64_t kChecksumSeed = 1469598103934665603ull;

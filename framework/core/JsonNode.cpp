@@ -2,6 +2,7 @@
 
 #include "framework/core/FileIO.h"
 #include "framework/core/JsonParse.h"
+#include "framework/core/Text.h"
 
 #include <cmath>
 #include <filesystem>
@@ -160,6 +161,9 @@ std::string JsonNode::getEnum(const std::string& key, const std::string& def, co
 
 std::string JsonNode::getPath(const std::string& key, const std::string& def) {
     std::string s = getString(key, def);
+    // The text as written, before "a/\0/../b" folds to "b" (probe 25: a NUL, a line break or a
+    // bidi mark before a ".." passed every later check of the resolved path).
+    if (const std::string why = pathTextProblem(s); !why.empty()) fail(key, "the path " + why);
     return resolvePath(parentDir(file_), s);
 }
 

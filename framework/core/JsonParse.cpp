@@ -38,6 +38,7 @@ public:
         if (limits_.rejectDuplicateKeys && f.node->contains(k))
             return error(path(false) + "/" + escape(k), "duplicate key \"" + cut(k) + "\" (each key may appear once in an object)");
         f.key = std::move(k);
+        f.keyPending = true;
         return true;
     }
 
@@ -54,8 +55,9 @@ public:
 private:
     struct Frame {
         Json* node;
-        std::string key;   // objects: the key whose value comes next
+        std::string key;   // objects: the key whose value comes next (or came last)
         size_t index = 0;  // arrays: the index of the next element
+        bool keyPending = false; // objects: `key` was read and its value not yet placed
     };
 
     static std::string escape(const std::string& key) {  // JSON pointer (RFC 6901)
@@ -67,13 +69,15 @@ private:
 
     /// The path of the value being read: through each open container's current slot. An enclosing
     /// array's index was advanced when the open child was placed, so its slot is index - 1; the
-    /// innermost array's slot is the next element. `innermostSlot` false: the innermost container.
+    /// innermost array's slot is the next element. `innermostSlot` false: the innermost container,
+    /// and so too where an object's last value is read and its next key not (probe 25: a syntax
+    /// error after "frames": 1 was reported at /frames, a value that was fine).
     std::string path(bool innermostSlot = true) const {
         std::string p;
         for (size_t i = 0; i < frames_.size(); ++i) {
             const Frame& f = frames_[i];
             bool innermost = i + 1 == frames_.size();
-            if (innermost && !innermostSlot) break;
+            if (innermost && (!innermostSlot || (f.node->is_object() && !f.keyPending))) break;
             p += "/" + (f.node->is_array() ? std::to_string(innermost ? f.index : f.index - 1) : escape(f.key));
         }
         return p;
@@ -101,6 +105,7 @@ private:
         }
         Json& slot = (*f.node)[f.key];
         slot = std::move(v);
+        f.keyPending = false;
         return &slot;
     }
 
@@ -121,7 +126,7 @@ private:
         if (int(frames_.size()) >= limits_.maxDepth)
             return error(path(), "nesting deeper than " + std::to_string(limits_.maxDepth) + " levels");
         Json* node = place(std::move(container));
-        frames_.push_back({node, {}, 0});
+        frames_.push_back({node, {}, 0, false});
         return true;
     }
 

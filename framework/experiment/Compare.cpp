@@ -4,11 +4,13 @@
 #include "framework/core/FileIO.h"
 #include "framework/core/Text.h"
 #include "framework/experiment/Config.h"
+#include "framework/experiment/FrameImages.h"
 #include "framework/experiment/JUnit.h"
 #include "framework/experiment/OutputPlace.h"
 #include "framework/metrics/Noise.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -450,55 +452,67 @@ std::string readPng(const std::string& path, Picture& p) {
     return "";
 }
 
-/// The saved visibility images of `id` in both runs, frame by frame: pixels that differ, and a
-/// picture of them (changed pixels red over the new image in grey) in `imagesDir`.
+/// Compares one saved image of both runs: the pixels that differ, and a picture of them (changed
+/// pixels red over the new image in grey) written to `imagesDir` as `picture`.
+Json compareImagePair(const std::string& baseDir, const std::string& newDir, const std::string& name, int frame,
+                      const std::string& kind, const std::string& imagesDir, const std::string& picture) {
+    Json rec = {{"frame", frame}, {"image", kind}};
+    auto notCompared = [&](const std::string& why) {
+        rec["changed_pixels"] = Json();
+        rec["note"] = why;
+        return rec;
+    };
+    Picture a, b;
+    if (const std::string why = readPng(baseDir + "/images/" + name, a); !why.empty()) return notCompared("BASE's image " + name + ": " + why);
+    if (const std::string why = readPng(newDir + "/images/" + name, b); !why.empty()) return notCompared("NEW's image " + name + ": " + why);
+    if (a.width != b.width || a.height != b.height)
+        return notCompared("the images " + name + " differ in size (" + std::to_string(a.width) + "×" + std::to_string(a.height) + " → " +
+                           std::to_string(b.width) + "×" + std::to_string(b.height) + ")");
+    size_t changed = 0;
+    std::vector<unsigned char> pixels(b.rgba.size());
+    for (size_t i = 0; i < b.rgba.size(); i += 4) {
+        const bool differs = !std::equal(a.rgba.begin() + long(i), a.rgba.begin() + long(i) + 3, b.rgba.begin() + long(i));
+        changed += differs ? 1 : 0;
+        const unsigned char grey = static_cast<unsigned char>(b.rgba[i] / 3 + 60);
+        pixels[i] = differs ? 255 : grey;
+        pixels[i + 1] = differs ? 0 : grey;
+        pixels[i + 2] = differs ? 0 : grey;
+        pixels[i + 3] = 255;
+    }
+    rec["changed_pixels"] = changed;
+    rec["pixels"] = size_t(b.width) * size_t(b.height);
+    if (changed > 0 && !imagesDir.empty() &&
+        stbi_write_png((imagesDir + "/" + picture).c_str(), b.width, b.height, 4, pixels.data(), b.width * 4))
+        rec["picture"] = "images/" + picture;
+    return rec;
+}
+
+/// Every image a run saves of `id` a frame (writeFrameImages: visibility, shaded, and the difference
+/// to the reference when it ran), compared between both runs frame by frame. An image either run
+/// saved is compared or named with why not (saved by one run only, unreadable, another size): the
+/// visibility image alone used to be read, and a shaded or difference image that was lost or
+/// changed went unreported (probe 25).
 Json compareImages(const std::string& baseDir, const std::string& newDir, const std::string& id, const std::string& imagesDir) {
     Json out = Json::array();
-    const std::string prefix = id + "_f", suffix = "_visibility.png";
+    const std::string prefix = id + "_f";
+    static const std::array<std::string, 3> kKinds = {"visibility", "shaded", "diff"};
     std::error_code ec;
-    // The frames either run saved (a frame saved by one run only is named, not skipped).
-    std::set<std::string> names;
+    std::set<std::pair<int, size_t>> saved; // (frame, kind)
     for (const std::string& dir : {baseDir, newDir})
         for (const auto& e : fs::directory_iterator(dir + "/images", ec)) {
             const std::string n = e.path().filename().string();
-            if (n.starts_with(prefix) && n.ends_with(suffix) && n.size() == prefix.size() + 4 + suffix.size() &&
-                std::all_of(n.begin() + long(prefix.size()), n.begin() + long(prefix.size() + 4), [](char c) { return c >= '0' && c <= '9'; }))
-                names.insert(n);
+            if (!n.starts_with(prefix) || n.size() < prefix.size() + 5 || n[prefix.size() + 4] != '_' ||
+                !std::all_of(n.begin() + long(prefix.size()), n.begin() + long(prefix.size() + 4), [](char c) { return c >= '0' && c <= '9'; }))
+                continue;
+            const std::string rest = n.substr(prefix.size() + 5);
+            for (size_t k = 0; k < kKinds.size(); ++k)
+                if (rest == kKinds[k] + ".png") saved.insert({std::stoi(n.substr(prefix.size(), 4)), k});
         }
-    for (const std::string& n : names) {
-        const int frame = std::stoi(n.substr(prefix.size(), 4));
-        auto notCompared = [&](const std::string& why) { out.push_back({{"frame", frame}, {"changed_pixels", Json()}, {"note", why}}); };
-        Picture a, b;
-        if (const std::string why = readPng(baseDir + "/images/" + n, a); !why.empty()) {
-            notCompared("BASE's image " + n + ": " + why);
-            continue;
-        }
-        if (const std::string why = readPng(newDir + "/images/" + n, b); !why.empty()) {
-            notCompared("NEW's image " + n + ": " + why);
-            continue;
-        }
-        if (a.width != b.width || a.height != b.height) {
-            notCompared("the images differ in size (" + std::to_string(a.width) + "×" + std::to_string(a.height) + " → " +
-                        std::to_string(b.width) + "×" + std::to_string(b.height) + ")");
-            continue;
-        }
-        size_t changed = 0;
-        std::vector<unsigned char> picture(b.rgba.size());
-        for (size_t i = 0; i < b.rgba.size(); i += 4) {
-            const bool differs = !std::equal(a.rgba.begin() + long(i), a.rgba.begin() + long(i) + 3, b.rgba.begin() + long(i));
-            changed += differs ? 1 : 0;
-            const unsigned char grey = static_cast<unsigned char>(b.rgba[i] / 3 + 60);
-            picture[i] = differs ? 255 : grey;
-            picture[i + 1] = differs ? 0 : grey;
-            picture[i + 2] = differs ? 0 : grey;
-            picture[i + 3] = 255;
-        }
-        Json rec = {{"frame", frame}, {"changed_pixels", changed}, {"pixels", size_t(b.width) * size_t(b.height)}};
-        if (changed > 0 && !imagesDir.empty()) {
-            const std::string file = id + "_f" + n.substr(prefix.size(), 4) + "_changed.png";
-            if (stbi_write_png((imagesDir + "/" + file).c_str(), b.width, b.height, 4, picture.data(), b.width * 4)) rec["picture"] = "images/" + file;
-        }
-        out.push_back(rec);
+    for (const auto& [frame, k] : saved) {
+        const std::string tag = frameImagePrefix(id, frame);
+        // The visibility picture keeps the name it always had; the others say which image they show.
+        const std::string picture = tag + (k == 0 ? std::string() : kKinds[k] + "_") + "changed.png";
+        out.push_back(compareImagePair(baseDir, newDir, tag + kKinds[k] + ".png", frame, kKinds[k], imagesDir, picture));
     }
     return out;
 }
@@ -711,13 +725,14 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
                << " → " << shortNumber(v["new"].get<double>(), 4) << "\n";
         for (const Json& im : r["images"]) {
             if (im.contains("note")) {
-                os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << ": images not compared: "
+                os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << " " << im["image"].get<std::string>()
+                   << ": image not compared: "
                    << markdownLiteral(im["note"].get<std::string>()) << "\n";
                 continue;
             }
             if (im["changed_pixels"].get<size_t>() == 0) continue;
-            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << ": " << im["changed_pixels"] << " of "
-               << im["pixels"] << " pixels changed";
+            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << " " << im["image"].get<std::string>() << ": "
+               << im["changed_pixels"] << " of " << im["pixels"] << " pixels changed";
             if (im.contains("picture")) os << "\n\n  ![changed pixels](" << im["picture"].get<std::string>() << ")";
             os << "\n";
         }

@@ -96,6 +96,7 @@ bool sharedOption(const std::vector<std::string>& args, size_t& i, double& thres
         out = optionValue(args, i, "a folder");
         if (const std::string why = pathTextProblem(out); !why.empty()) throw InputError("--out", "", "the folder's name " + why);
     } else if (a == "--force") {
+        if (force) throw InputError(a, "", "is given twice");
         force = true;
     } else {
         return false;
@@ -195,6 +196,7 @@ int historyCommand(const std::vector<std::string>& args) {
             opt.window = size_t(std::stoi(v));
             windowGiven = true;
         } else if (a == "--by-name") {
+            if (opt.byName) throw InputError(a, "", "is given twice");
             opt.byName = true;
         } else if (!a.empty() && a[0] == '-') {
             throw InputError(shortText(a, 60), "", "unknown option of `history` (see shadowlab history --help)");

@@ -427,16 +427,42 @@ void applyOverride(Json& config, const std::string& assignment) {
     *node = value;
 }
 
+namespace {
+
+/// A config error at or under a value a --set gave names that --set too: the file holds another
+/// value there (probe 25: `--set frames=` read as "base.json: at /frames: expected an integer").
+/// The last --set of a path is the one that took effect.
+[[noreturn]] void blameOverride(const InputError& e, const std::vector<std::string>& overrides) {
+    for (auto o = overrides.rbegin(); o != overrides.rend(); ++o) {
+        std::string pointer = "/" + o->substr(0, o->find('='));
+        std::replace(pointer.begin(), pointer.end(), '.', '/');
+        const std::string& at = e.jsonPath();
+        if (at == pointer || (at.starts_with(pointer) && at[pointer.size()] == '/'))
+            throw InputError(e.file(), at, "from --set " + shortText(*o, 80) + ": " + e.cause());
+    }
+    throw e;
+}
+
+} // namespace
+
 ExperimentConfig loadConfig(const std::string& file, bool loadScene, const std::vector<std::string>& overrides) {
     Json j = JsonNode::parseFile(file);
     for (const auto& o : overrides) applyOverride(j, o);
-    return parseConfig(j, file, loadScene);
+    try {
+        return parseConfig(j, file, loadScene);
+    } catch (const InputError& e) {
+        blameOverride(e, overrides);
+    }
 }
 
 ScenePrediction predictConfigScene(const std::string& file, const std::vector<std::string>& overrides) {
     Json j = JsonNode::parseFile(file);
     for (const auto& o : overrides) applyOverride(j, o);
-    return predictConfigScene(j, file);
+    try {
+        return predictConfigScene(j, file);
+    } catch (const InputError& e) {
+        blameOverride(e, overrides);
+    }
 }
 
 ScenePrediction predictConfigScene(const Json& config, const std::string& file) {

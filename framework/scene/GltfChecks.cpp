@@ -143,6 +143,11 @@ public:
             if (!components.count(obj["componentType"].get<uint64_t>()))
                 fail(path + "/componentType", std::to_string(obj["componentType"].get<uint64_t>()) +
                                                   " is not a component type (5120, 5121, 5122, 5123, 5125, 5126)");
+            // glTF 2.0, 3.6.2.1: normalized MUST NOT be true for FLOAT or UNSIGNED_INT (probe 25).
+            const uint64_t component = obj["componentType"].get<uint64_t>();
+            if (obj.value("normalized", false) && (component == 5126 || component == 5125))
+                fail(path + "/normalized", std::string("must not be true for ") + (component == 5126 ? "FLOAT" : "UNSIGNED_INT") +
+                                               " components (glTF 2.0, accessors)");
         }
     }
 

@@ -197,15 +197,18 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
     size_t chosen = m_.animations.size();
     for (size_t i = 0; i < m_.animations.size(); ++i)
         if (m_.animations[i].name == animation_) chosen = i;
-    if (chosen == m_.animations.size() && !animation_.empty() &&
-        std::all_of(animation_.begin(), animation_.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); }) &&
-        animation_.size() < 10 && std::stoul(animation_) < m_.animations.size())
+    const bool digits = !animation_.empty() &&
+                        std::all_of(animation_.begin(), animation_.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
+    if (chosen == m_.animations.size() && digits && animation_.size() < 10 && std::stoul(animation_) < m_.animations.size())
         chosen = std::stoul(animation_);
     if (chosen == m_.animations.size() && !animation_.empty()) {
+        // An index past the end is said to be one (probe 25: `"animation": 5` read as a name "5").
+        const std::string what = digits ? "no animation of index or name " + animation_.substr(0, 20)
+                                        : "no animation \"" + animation_.substr(0, 40) + "\"";
         std::string names;
         for (size_t i = 0; i < m_.animations.size() && i < 8; ++i)
             names += (i ? ", " : "") + std::to_string(i) + (m_.animations[i].name.empty() ? "" : " \"" + m_.animations[i].name.substr(0, 30) + "\"");
-        fail("/animations", "no animation \"" + animation_.substr(0, 40) + "\" (the file has " +
+        fail("/animations", what + " (the file has " +
                                 (m_.animations.empty() ? std::string("none") : std::to_string(m_.animations.size()) + ": " + names) + ")");
     }
     auto anim = std::make_shared<NodeAnimation>();

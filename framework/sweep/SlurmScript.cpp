@@ -54,9 +54,11 @@ void checkSlurmOptions(const SlurmOptions& o) {
     if (o.gpusPerTask < 0 || o.gpusPerTask > 64) throw InputError("--gpus-per-task", "", "expected 0 to 64");
     if (o.cpusPerTask < 0 || o.cpusPerTask > 1024) throw InputError("--cpus-per-task", "", "expected 0 to 1024");
     const std::string dir = absoluteFolder(o.outputDir);
-    if (const std::string why = pathTextProblem(dir); !why.empty()) throw InputError("--out", "", "the folder's path " + why);
+    if (const std::string why = pathTextProblem(dir); !why.empty())
+        throw InputError(o.outputFrom, o.outputJsonPath, "the folder's path " + why);
     if (dir.find_first_of("%\\") != std::string::npos)
-        throw InputError("--out", "", "\"" + shortText(dir, 200) + "\" holds % or \\, which sbatch's --output reads as a file name pattern");
+        throw InputError(o.outputFrom, o.outputJsonPath,
+                         "\"" + shortText(dir, 200) + "\" holds % or \\, which sbatch's --output reads as a file name pattern");
 }
 
 std::string slurmScript(const Sweep& sweep, const SlurmOptions& o, const std::string& binary) {

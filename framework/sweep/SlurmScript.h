@@ -9,6 +9,8 @@ namespace shadowlab {
 
 struct SlurmOptions {
     std::string outputDir;   ///< DIR; must be on a file system the compute nodes share (docs/cluster.md)
+    std::string outputFrom = "--out"; ///< where DIR was given, for errors: "--out", or the sweep file
+    std::string outputJsonPath;       ///< and its JSON path there ("/output/dir"), empty for --out
     std::string partition;   ///< --partition, empty: the cluster's default
     int gpusPerTask = 0;     ///< --gpus-per-task (0..64); > 0 runs shadowlab-egl (GPU, no display) instead of shadowlab (OSMesa)
     int cpusPerTask = 0;     ///< --cpus-per-task (0..1024), 0: the cluster's default
@@ -21,7 +23,7 @@ struct SlurmOptions {
 /// option: the partition (Slurm names: letters, digits, _ . - and commas between names), the time
 /// (Slurm's formats: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S, or UNLIMITED), the output folder (no
 /// control character, and no % or \, which --output would read as a file name pattern).
-/// InputError naming the option otherwise.
+/// InputError naming the option (or the sweep file's output.dir) otherwise.
 void checkSlurmOptions(const SlurmOptions& options);
 
 /// The sbatch script text for `sweep` (its snapshot at DIR/sweep.json), run by `binary`. Calls

@@ -98,6 +98,7 @@ Args parseArgs(const std::vector<std::string>& args, const std::vector<std::stri
             if (args[i].starts_with("--")) throw InputError(a, "", "needs a value, not the option " + shortText(args[i], 40) + " (a folder named so: ./" + shortText(args[i], 40) + ")");
             out.options[a] = args[i];
         } else if (std::find(flags.begin(), flags.end(), a) != flags.end()) {
+            if (out.options.count(a)) throw InputError(a, "", "is given twice");
             out.options[a] = "";
         } else if (!a.empty() && a[0] == '-') {
             throw InputError(shortText(a, 60), "", "unknown option of `sweep " + args[1] + "` (see shadowlab sweep " + args[1] + " --help)");
@@ -223,6 +224,10 @@ int slurm(const std::vector<std::string>& args) {
     const Sweep s = loadSweep(one(a, "sweep file", "slurm"));
     SlurmOptions o;
     o.outputDir = outputDir(a, s);
+    if (!a.options.count("--out")) { // the sweep file's output.dir (probe 25: an error blamed an --out never given)
+        o.outputFrom = s.file;
+        o.outputJsonPath = "/output/dir";
+    }
     o.partition = get(a, "--partition");
     o.gpusPerTask = int(parseCount(get(a, "--gpus-per-task", "0"), "--gpus-per-task", 0, kMaxGpusPerTask));
     o.cpusPerTask = int(parseCount(get(a, "--cpus-per-task", "0"), "--cpus-per-task", 0, kMaxCpusPerTask));
