@@ -112,6 +112,11 @@ TEST_F(CompareGLTest, ImagesThatCannotBeComparedAreNamed) {
     // Another run's image in place of one: the same size, other pixels.
     std::filesystem::copy_file(dir + "/base/images/psv_f0002_visibility.png", dir + "/broken/images/bvh_raytrace_f0002_shaded.png",
                                std::filesystem::copy_options::overwrite_existing);
+    // Probe 26: heat maps were never compared. A heat map saved by both (here the visibility and
+    // shaded images under its name: other pixels) and one saved by BASE only.
+    std::filesystem::copy_file(dir + "/base/images/psv_f0002_diff.png", dir + "/base/images/psv_f0002_heat_nodes_visited.png");
+    std::filesystem::copy_file(dir + "/base/images/psv_f0002_visibility.png", dir + "/broken/images/psv_f0002_heat_nodes_visited.png");
+    std::filesystem::copy_file(dir + "/base/images/psv_f0002_diff.png", dir + "/base/images/psv_f0002_heat_stack_overflow.png");
     const Comparison c = compareRuns(dir + "/base", dir + "/broken", {});
     auto noted = [&](const std::string& id, const std::string& kind) {
         const Json& im = image(record(c, id)["images"], kind);
@@ -122,6 +127,8 @@ TEST_F(CompareGLTest, ImagesThatCannotBeComparedAreNamed) {
     noted("psv", "shaded");
     noted("bvh_raytrace", "visibility");
     noted("bvh_raytrace", "diff");
+    EXPECT_GT(image(record(c, "psv")["images"], "heat_nodes_visited")["changed_pixels"].get<size_t>(), 0u) << record(c, "psv")["images"].dump();
+    noted("psv", "heat_stack_overflow");
     EXPECT_GT(image(record(c, "bvh_raytrace")["images"], "shaded")["changed_pixels"].get<size_t>(), 0u);
     EXPECT_EQ(image(record(c, "psv")["images"], "diff")["changed_pixels"], 0u);
     const std::string md = comparisonMarkdown(c, dir + "/base", dir + "/broken", {});

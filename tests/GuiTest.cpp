@@ -265,7 +265,12 @@ TEST(GuiTest, MalformedNumbersAndEmptyFileNamesAreBadInput) {
                                    "--frames 2 --frame 010", "--frames 2 --frame 1e0", "--frames ' 2'", "--render-scale 0x1",
                                    "--render-scale inf", "--frames 1 --screenshot ''", "--frames 1 --report ''",
                                    "--record-keyframes '0,3,5,0,,0,0' --save-config x.json", "--record-keyframes '0,3,5,0,0,0' --save-config ''",
-                                   "--record-keyframes '0,3,5,0,0,0;;1,3,5,0,0,0' --save-config x.json"}) {
+                                   "--record-keyframes '0,3,5,0,0,0;;1,3,5,0,0,0' --save-config x.json",
+                                   // Probe 26: names with a line break or a control character, and
+                                   // options given twice (the last taken, the first output lost).
+                                   "--frames 1 --report \"$(printf 'r\\n.json')\"", "--frames 1 --screenshot \"$(printf 's\\001.png')\"",
+                                   "--frames 1 --report r1.json --report r2.json", "--frames 1 --frames 2", "--play --play",
+                                   "--view shaded --view heat"}) {
         std::string out;
         EXPECT_EQ(guiError(kSmoke + " " + args, out), 2) << args << "\n" << out;
         EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 1) << args << "\n" << out;

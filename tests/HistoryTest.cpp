@@ -220,16 +220,19 @@ TEST(HistoryTest, ACommitOrRendererNoRunWritesIsNotCopied) {
     s["renderer"] = std::string(300000, 'R');
     fs::create_directories(dir + "/tampered");
     std::ofstream(dir + "/tampered/summary.json") << s.dump();
-    History h = readHistory(dir, {});
     // A 300,000-character renderer is no run's (twenty-second probe: sweep merge copied one whole
-    // into its report): the summary is left out, and said so.
-    ASSERT_EQ(h.runs.size(), 2u);
-    ASSERT_FALSE(h.notes.empty());
-    EXPECT_NE(h.notes[0].find("left out: tampered"), std::string::npos) << h.notes[0];
+    // into its report): the summary is bad input, named (probe 26: it was left out, and a damaged
+    // newest run could hide a regression).
+    try {
+        readHistory(dir, {});
+        ADD_FAILURE() << "a damaged run was read";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("tampered/summary.json: at /renderer"), std::string::npos) << e.what();
+    }
     // The commit alone is not copied: the run is kept, its commit "unknown".
     s["renderer"] = "llvmpipe";
     std::ofstream(dir + "/tampered/summary.json") << s.dump();
-    h = readHistory(dir, {});
+    const History h = readHistory(dir, {});
     ASSERT_EQ(h.runs.size(), 3u);
     EXPECT_EQ(h.runs[2]["commit"], "unknown");
     EXPECT_EQ(h.runs[2]["label"], "tampered");
@@ -277,9 +280,9 @@ TEST(HistoryTest, BadFoldersAndOptionsAreExit2) {
 }
 
 // Seventh probe: a run whose started_utc was "not-a-date" sorted as the newest and decided the
-// exit code; negative times were tabulated. Such a summary is not a run's: history leaves
-// it out with a note, compare refuses it.
-TEST(HistoryTest, ASummaryNoRunWritesIsLeftOut) {
+// exit code; negative times were tabulated. Such a summary is not a run's: history and compare
+// refuse it.
+TEST(HistoryTest, ASummaryNoRunWritesIsBadInput) {
     const std::string dir = test::makeTempDir("history-tampered");
     writeRuns(dir, {20, 20, 20, 20}, {0, 0, 0, 0}, kSpread);
     auto edit = [&](const std::string& run, const std::function<void(Json&)>& change) {
@@ -292,18 +295,37 @@ TEST(HistoryTest, ASummaryNoRunWritesIsLeftOut) {
     edit("run-98", [](Json& s) { s["algorithms"]["psv"]["repetitions"]["time_ms"]["total"][3] = "fast"; });
     writeRuns(dir + "/more", {20, 20}, {0, 0}, kSpread);
     for (const char* run : {"run-100", "run-99"}) fs::rename(dir + "/more/" + run, dir + "/ok-" + run);
+    // Probe 26: left out with a note, a damaged newest run let the run before it stand for the
+    // newest, and a regression pass (exit 0). A finished run's damaged summary is bad input, named
+    // as compare names it; a folder that holds no run is still left out with a note.
+    try {
+        readHistory(dir, {});
+        ADD_FAILURE() << "a damaged run was read";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("run-100/summary.json: at /started_utc"), std::string::npos) << e.what();
+    }
+    for (const char* run : {"run-100", "run-99", "run-98", "more"}) fs::remove_all(dir + "/" + run);
+    fs::create_directories(dir + "/notes");
     const History h = readHistory(dir, {});
     EXPECT_EQ(h.runs.size(), 3u); // run-97 and the two good ones
     ASSERT_FALSE(h.notes.empty());
-    EXPECT_NE(h.notes[0].find("left out"), std::string::npos) << h.notes[0];
-    const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "compare", dir + "/run-97", dir + "/run-99"});
+    EXPECT_NE(h.notes[0].find("left out: notes"), std::string::npos) << h.notes[0];
+    const std::string bad = test::makeTempDir("history-tampered-compare");
+    writeRuns(bad, {20, 20, 20, 20}, {0, 0, 0, 0}, kSpread);
+    Json s = Json::parse(std::ifstream(bad + "/run-99/summary.json"));
+    s["algorithms"]["psv"]["repetitions"]["time_ms"]["total"][0] = -5.0;
+    std::ofstream(bad + "/run-99/summary.json") << s.dump();
+    const test::Ran ran = test::runArgs({SHADOWLAB_BINARY, "compare", bad + "/run-97", bad + "/run-99"});
     EXPECT_EQ(ran.rc, 2) << ran.err;
     EXPECT_NE(ran.err.find("/algorithms/psv"), std::string::npos) << ran.err;
+    const test::Ran history = test::runArgs({SHADOWLAB_BINARY, "history", bad});
+    EXPECT_EQ(history.rc, 2) << history.err;
+    EXPECT_NE(history.err.find("run-99/summary.json: at /algorithms/psv"), std::string::npos) << history.err;
 }
 
 // Eighth probe: a field of the wrong type (a time written as "NaN", an overflow as "many", a
 // renderer as a number) stopped compare with a library's message and exit 1. It is bad input,
-// named by its file and JSON path, and history leaves such a run out.
+// named by its file and JSON path, by history too.
 TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
     const std::vector<std::pair<std::function<void(Json&)>, std::string>> edits = {
         {[](Json& s) { s["algorithms"]["psv"]["time_ms"]["total"]["mean"] = "NaN"; }, "/algorithms/psv/time_ms/total/mean"},
@@ -355,7 +377,7 @@ TEST(HistoryTest, AFieldOfTheWrongTypeIsBadInputNamingItsPath) {
             EXPECT_EQ(std::count(ran.err.begin(), ran.err.end(), '\n'), 1) << ran.err;
             EXPECT_NE(ran.err.find("run-99/summary.json: at " + path), std::string::npos) << ran.err;
         }
-        EXPECT_EQ(readHistory(dir, {}).runs.size(), 2u);
+        EXPECT_THROW(readHistory(dir, {}), InputError); // history names it as compare does (probe 26)
     }
 }
 

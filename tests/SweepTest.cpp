@@ -75,6 +75,13 @@ const BadSweep kBadSweeps[] = {
     // Seventh probe: a base file that cannot be read named neither the sweep file nor /base.
     {"BaseFileMissing", R"({"base": "missing-base.json"})", "/base|the base config|missing-base.json"},
     {"BaseFileIsAFolder", R"({"base": "."})", "/base|the base config"},
+    // Probe 26: the base's name was checked after "x\u202e/../base.json" folded to "base.json".
+    {"BaseNameWithABidiMarkBeforeDotDot", R"({"base": "x\u202e/../base.json"})", "/base|U+202E"},
+    {"BaseNameWithANulBeforeDotDot", R"({"base": "x\u0000/../base.json"})", "/base|control character"},
+    // ... and a glTF path an axis gives, folded before the config's check saw it.
+    {"AxisGltfPathWithABidiMarkBeforeDotDot",
+     R"({"axes": [{"name": "m", "values": {"scene.objects.0": [{"procedural": "plane"}, {"gltf": "d\u202e/../m.gltf"}]}}]})",
+     "/axes/0|/scene/objects/0/gltf|U+202E"},
     {"RatioTwice", R"({"merge": {"ratios": ["psv/shadow_map", "psv/shadow_map"]}})", "/merge/ratios/1|given twice"},
     {"StageTwice", R"({"merge": {"stages": ["total", "total"]}})", "/merge/stages/1|given twice"},
     {"PaperTimeNotPositive", R"({"merge": {"paper": {"source": "s", "times_ms": {"psv": 0}}}})", "/merge/paper/times_ms/psv|out of range"},

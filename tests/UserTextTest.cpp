@@ -284,6 +284,14 @@ TEST(UserTextTest, AnErrorInASetValueNamesTheSet) {
     expectOneLineNaming(frames, "smoke.json: at /frames: from --set frames=: ");
     const Result params = shell(kBin + " validate " + kSmoke + " --set 'algorithms.0.params=[1]'");
     expectOneLineNaming(params, "at /algorithms/0/params: from --set algorithms.0.params=[1]: ");
+    // Probe 26: an error at a key the --set made, above the value it set.
+    const Json written = Json::parse(std::ifstream(kSmoke));
+    ASSERT_FALSE(written["light"].contains("foo"));
+    const Result made = shell(kBin + " validate " + kSmoke + " --set light.foo.bar=1");
+    expectOneLineNaming(made, "at /light/foo: from --set light.foo.bar=1: ");
+    // A path index spelled with a leading zero is no index (it was the same element as "0" under
+    // another name, so a --set twice went unnoticed).
+    expectOneLineNaming(shell(kBin + " validate " + kSmoke + " --set scene.objects.00.size=[2,2]"), "no element 00");
     // An error elsewhere stays the file's.
     const Result other = shell(kBin + " validate " + kSmoke + " --set frames=2 --set resolution=[0,4]");
     expectOneLineNaming(other, "from --set resolution=[0,4]");

@@ -10,7 +10,6 @@
 #include "framework/metrics/Noise.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -488,31 +487,33 @@ Json compareImagePair(const std::string& baseDir, const std::string& newDir, con
 }
 
 /// Every image a run saves of `id` a frame (writeFrameImages: visibility, shaded, and the difference
-/// to the reference when it ran), compared between both runs frame by frame. An image either run
-/// saved is compared or named with why not (saved by one run only, unreadable, another size): the
-/// visibility image alone used to be read, and a shaded or difference image that was lost or
-/// changed went unreported (probe 25).
+/// to the reference when it ran; writeHeatMaps: heat_NAME), compared between both runs frame by
+/// frame. An image either run saved is compared or named with why not (saved by one run only,
+/// unreadable, another size): the visibility image alone used to be read, and a shaded, difference
+/// or heat-map image that was lost or changed went unreported (probes 25 and 26).
 Json compareImages(const std::string& baseDir, const std::string& newDir, const std::string& id, const std::string& imagesDir) {
     Json out = Json::array();
     const std::string prefix = id + "_f";
-    static const std::array<std::string, 3> kKinds = {"visibility", "shaded", "diff"};
+    auto isKind = [](const std::string& kind) {
+        if (kind == "visibility" || kind == "shaded" || kind == "diff") return true;
+        return kind.size() > 5 && kind.starts_with("heat_") && kind.find("_changed") == std::string::npos;
+    };
     std::error_code ec;
-    std::set<std::pair<int, size_t>> saved; // (frame, kind)
+    std::set<std::pair<int, std::string>> saved; // (frame, kind)
     for (const std::string& dir : {baseDir, newDir})
         for (const auto& e : fs::directory_iterator(dir + "/images", ec)) {
             const std::string n = e.path().filename().string();
-            if (!n.starts_with(prefix) || n.size() < prefix.size() + 5 || n[prefix.size() + 4] != '_' ||
+            if (!n.starts_with(prefix) || n.size() < prefix.size() + 5 || n[prefix.size() + 4] != '_' || !n.ends_with(".png") ||
                 !std::all_of(n.begin() + long(prefix.size()), n.begin() + long(prefix.size() + 4), [](char c) { return c >= '0' && c <= '9'; }))
                 continue;
-            const std::string rest = n.substr(prefix.size() + 5);
-            for (size_t k = 0; k < kKinds.size(); ++k)
-                if (rest == kKinds[k] + ".png") saved.insert({std::stoi(n.substr(prefix.size(), 4)), k});
+            const std::string kind = n.substr(prefix.size() + 5, n.size() - prefix.size() - 5 - 4);
+            if (isKind(kind)) saved.insert({std::stoi(n.substr(prefix.size(), 4)), kind});
         }
-    for (const auto& [frame, k] : saved) {
+    for (const auto& [frame, kind] : saved) {
         const std::string tag = frameImagePrefix(id, frame);
         // The visibility picture keeps the name it always had; the others say which image they show.
-        const std::string picture = tag + (k == 0 ? std::string() : kKinds[k] + "_") + "changed.png";
-        out.push_back(compareImagePair(baseDir, newDir, tag + kKinds[k] + ".png", frame, kKinds[k], imagesDir, picture));
+        const std::string picture = tag + (kind == "visibility" ? std::string() : kind + "_") + "changed.png";
+        out.push_back(compareImagePair(baseDir, newDir, tag + kind + ".png", frame, kind, imagesDir, picture));
     }
     return out;
 }

@@ -410,7 +410,10 @@ void applyOverride(Json& config, const std::string& assignment) {
         if (node->is_array()) {
             // Digits only, and no more of them than an index into this array can have: "-1", "1e3"
             // and 10^20 are a bad path, not an exception from the number parser.
-            const bool numeric = !key.empty() && key.size() <= 18 && key.find_first_not_of("0123456789") == std::string::npos;
+            // No leading zero either (probe 26: "01" and "1" were one element but two paths, so a
+            // --set given twice, or two sweep axes on one path, went unnoticed).
+            const bool numeric = !key.empty() && key.size() <= 18 && key.find_first_not_of("0123456789") == std::string::npos &&
+                                 (key.size() == 1 || key[0] != '0');
             const size_t index = numeric ? size_t(std::strtoull(key.c_str(), nullptr, 10)) : 0;
             if (!numeric || index >= node->size())
                 throw InputError("--set", walked, "no element " + key + " in an array of " + std::to_string(node->size()));
@@ -429,16 +432,27 @@ void applyOverride(Json& config, const std::string& assignment) {
 
 namespace {
 
+/// Whether the config file itself holds a value at JSON pointer `at`.
+bool fileHolds(const Json& file, const std::string& at) {
+    try {
+        return file.contains(Json::json_pointer(at));
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
 /// A config error at or under a value a --set gave names that --set too: the file holds another
-/// value there (probe 25: `--set frames=` read as "base.json: at /frames: expected an integer").
-/// The last --set of a path is the one that took effect.
-[[noreturn]] void blameOverride(const InputError& e, const std::vector<std::string>& overrides) {
+/// value there (probe 25: `--set frames=` read as "base.json: at /frames: expected an integer"),
+/// and so does one at a key a --set made (probe 26: `--set light.foo.bar=1` at /light/foo, a key
+/// the file does not hold). The last --set of a path is the one that took effect.
+[[noreturn]] void blameOverride(const InputError& e, const Json& file, const std::vector<std::string>& overrides) {
+    const std::string& at = e.jsonPath();
     for (auto o = overrides.rbegin(); o != overrides.rend(); ++o) {
         std::string pointer = "/" + o->substr(0, o->find('='));
         std::replace(pointer.begin(), pointer.end(), '.', '/');
-        const std::string& at = e.jsonPath();
-        if (at == pointer || (at.starts_with(pointer) && at[pointer.size()] == '/'))
-            throw InputError(e.file(), at, "from --set " + shortText(*o, 80) + ": " + e.cause());
+        const bool under = at == pointer || (at.starts_with(pointer) && at[pointer.size()] == '/');
+        const bool made = !at.empty() && pointer.starts_with(at + "/") && !fileHolds(file, at);
+        if (under || made) throw InputError(e.file(), at, "from --set " + shortText(*o, 80) + ": " + e.cause());
     }
     throw e;
 }
@@ -446,22 +460,24 @@ namespace {
 } // namespace
 
 ExperimentConfig loadConfig(const std::string& file, bool loadScene, const std::vector<std::string>& overrides) {
-    Json j = JsonNode::parseFile(file);
+    const Json written = JsonNode::parseFile(file);
+    Json j = written;
     for (const auto& o : overrides) applyOverride(j, o);
     try {
         return parseConfig(j, file, loadScene);
     } catch (const InputError& e) {
-        blameOverride(e, overrides);
+        blameOverride(e, written, overrides);
     }
 }
 
 ScenePrediction predictConfigScene(const std::string& file, const std::vector<std::string>& overrides) {
-    Json j = JsonNode::parseFile(file);
+    const Json written = JsonNode::parseFile(file);
+    Json j = written;
     for (const auto& o : overrides) applyOverride(j, o);
     try {
         return predictConfigScene(j, file);
     } catch (const InputError& e) {
-        blameOverride(e, overrides);
+        blameOverride(e, written, overrides);
     }
 }
 

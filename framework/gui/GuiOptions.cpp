@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <set>
 
 namespace shadowlab {
 
@@ -116,6 +117,9 @@ void checkOutputFile(const std::string& opt, const std::string& file) {
 /// `--screenshot ''` wrote nothing and said nothing).
 const std::string& fileName(const std::string& opt, const std::string& value) {
     if (value.empty()) throw usage(opt + " needs a file name");
+    // The name as every output's (probe 26: --report and --screenshot made files whose names held
+    // a line break or a control character).
+    if (const std::string why = pathTextProblem(value); !why.empty()) throw usage(opt + ": the file's path " + why);
     return value;
 }
 
@@ -129,8 +133,12 @@ GuiOptions parseGuiOptions(const std::vector<std::string>& args) {
         if (a == "--version") o.version = true;
     }
     if (o.help || o.version) return o;
+    std::set<std::string> given;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
+        // Twice is a mistake (which was meant?), as for shadowlab's commands (probe 26: the last of
+        // two --report was taken, the first never written); --set is checked per key below.
+        if (a.starts_with("-") && a != "--set" && !given.insert(a).second) throw usage(a + " is given twice");
         auto value = [&]() -> const std::string& {
             if (i + 1 >= args.size()) throw usage(a + " needs a value");
             return args[++i];

@@ -439,6 +439,15 @@ void checkWhatTheReaderRefuses(const Json& doc, const std::string& file, bool bi
                 const std::string decoded = percentDecoded(uri);
                 if (decoded.find('\0') != std::string::npos)
                     throw InputError(file, where + "/uri", "the buffer's file name holds a NUL (%00)");
+                if (const std::string why = pathTextProblem(decoded); !why.empty())
+                    throw InputError(file, where + "/uri", "the buffer's file name " + why);
+                // The reader opens the uri as written, and "link/../b.bin" through a linked folder
+                // is another file than the "b.bin" a text fold checks and hashes (probe 26: a run
+                // built from one file while a sweep's id hashed another).
+                if (decoded == ".." || decoded.starts_with("../") || decoded.ends_with("/..") || decoded.find("/../") != std::string::npos)
+                    throw InputError(file, where + "/uri", "\"" + shortText(uri, 80) +
+                                                               "\" holds a '..' segment: a buffer's uri names a file in the glTF file's "
+                                                               "folder or below it, without '..'");
                 const std::string path = resolvePath(parentDir(file), decoded);
                 struct stat st {};
                 if (::stat(path.c_str(), &st) != 0)

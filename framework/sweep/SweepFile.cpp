@@ -392,6 +392,8 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     root.markRead("base");
     std::string baseFile = file, baseDir = sweepDir, baseWhere = "/base";
     if (base.is_string()) {
+        // As written, before "a/\0/../b" folds (probe 26), and as resolved (the sweep's folder).
+        if (const std::string why = pathTextProblem(base.get<std::string>()); !why.empty()) root.fail("base", "the file name " + why);
         baseFile = resolvePath(sweepDir, base.get<std::string>());
         if (const std::string why = pathTextProblem(baseFile); !why.empty()) root.fail("base", "the file name " + why);
         // A file that cannot be read as JSON is named from the sweep's /base (seventh probe: a
