@@ -83,6 +83,11 @@ const BadSweep kBadSweeps[] = {
      R"({"axes": [{"name": "m", "values": {"scene.objects.0": [{"procedural": "plane"}, {"gltf": "d\u202e/../m.gltf"}]}}]})",
      "/axes/0|/scene/objects/0/gltf|U+202E"},
     {"RatioTwice", R"({"merge": {"ratios": ["psv/shadow_map", "psv/shadow_map"]}})", "/merge/ratios/1|given twice"},
+    // Probe 26: a ratio of two ids that never meet in one run gave a table of no rows.
+    {"RatioOfIdsThatNeverMeet",
+     R"({"axes": [{"name": "a", "values": {"algorithms": [[{"algorithm": "psv", "id": "x"}], [{"algorithm": "psv", "id": "y"}]]}}],
+         "merge": {"ratios": ["x/y"]}})",
+     "/merge/ratios/0|no run holds both"},
     {"StageTwice", R"({"merge": {"stages": ["total", "total"]}})", "/merge/stages/1|given twice"},
     {"PaperTimeNotPositive", R"({"merge": {"paper": {"source": "s", "times_ms": {"psv": 0}}}})", "/merge/paper/times_ms/psv|out of range"},
     {"PaperWithoutSource", R"({"merge": {"paper": {"times_ms": {"psv": 1}}}})", "/merge/paper/source|required"},

@@ -249,9 +249,10 @@ std::string idList(const std::set<std::string>& ids) {
     return shortText(list, 300);
 }
 
-/// merge.ratios and merge.paper name algorithm ids: each must be one that some run measures, or
-/// the table it asks for would be empty.
-void checkMergeIds(const Sweep& s, const std::set<std::string>& ids) {
+/// merge.ratios and merge.paper name algorithm ids: each must be one that some run measures, and a
+/// ratio's two ids must meet in some run, or the table it asks for would be empty (probe 26: an
+/// axis that swaps one id for the other gave a ratio table of no rows, and no word).
+void checkMergeIds(const Sweep& s, const std::set<std::string>& ids, const std::vector<std::set<std::string>>& idsPerRun) {
     if (!s.merge.is_object()) return;
     const auto unknown = [&](const std::string& where, const std::string& id) {
         throw InputError(s.file, where, "\"" + shortText(id, 60) + "\" is not the id of an algorithm in any run (ids: " + idList(ids) + ")");
@@ -263,8 +264,12 @@ void checkMergeIds(const Sweep& s, const std::set<std::string>& ids) {
             const std::string where = "/merge/ratios/" + std::to_string(k);
             if (ratio.find('/', slash + 1) != std::string::npos)
                 throw InputError(s.file, where, "\"" + shortText(ratio, 60) + "\" is not ID/ID (one slash: ids hold none)");
-            for (const std::string& id : {ratio.substr(0, slash), ratio.substr(slash + 1)})
+            const std::string a = ratio.substr(0, slash), b = ratio.substr(slash + 1);
+            for (const std::string& id : {a, b})
                 if (!ids.count(id)) unknown(where, id);
+            if (std::none_of(idsPerRun.begin(), idsPerRun.end(), [&](const std::set<std::string>& run) { return run.count(a) && run.count(b); }))
+                throw InputError(s.file, where, "no run holds both \"" + shortText(a, 60) + "\" and \"" + shortText(b, 60) +
+                                                    "\", so the ratio would have no row");
         }
     if (s.merge.contains("paper"))
         for (const auto& [id, ms] : s.merge["paper"]["times_ms"].items())
@@ -494,6 +499,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     // the base's a few times over, whatever the number of runs.
     std::map<std::string, size_t> ids;
     std::set<std::string> idsInRuns;
+    std::vector<std::set<std::string>> idsPerRun; // the ids of each run, for the ratios
     s.runs.reserve(total);
     for (size_t index = 0; index < total; ++index) {
         SweepRun run;
@@ -517,6 +523,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
             }
             s.runs.back().id = runId(resolved);
             collectIds(resolved, idsInRuns);
+            collectIds(resolved, idsPerRun.emplace_back());
         } catch (const Json::exception& e) {
             // Text that JSON cannot hold (a path that is not UTF-8) or a value of the wrong type
             // deep in a config: bad input, not a crash.
@@ -527,7 +534,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
                                   std::to_string(index) + " (" + runLabel(s, run) +
                                   ") resolve to the same config (an axis repeats a value, or sets one to its default)");
     }
-    checkMergeIds(s, idsInRuns);
+    checkMergeIds(s, idsInRuns, idsPerRun);
     return s;
 }
 

@@ -8,6 +8,8 @@
 #include "framework/sweep/SweepRunner.h"
 #include "framework/sweep/SweepText.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -130,6 +132,21 @@ void checkMergeMeasures(const Sweep& sweep, const std::string& snapshot, const s
     }
 }
 
+/// The previous merge's report (sweep.md, sweep.html, sweep_*.png: scripts/sweep_report.py),
+/// removed before this merge writes its tables: a merge whose report is then refused or fails
+/// would otherwise leave that report beside tables it does not show (probe 26).
+void removePreviousReport(const std::string& dir) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        const std::string n = e.path().filename().string();
+        const bool report = n == "sweep.md" || n == "sweep.html" ||
+                            (n.starts_with("sweep_") && n.ends_with(".png") &&
+                             std::all_of(n.begin() + 6, n.end() - 4, [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }));
+        // A link is left where it is, for the report's own refusal of it to name.
+        if (report && fs::is_regular_file(e.symlink_status(ec))) fs::remove(e.path(), ec);
+    }
+}
+
 } // namespace
 
 MergeResult mergeSweep(const std::string& dir, bool plots) {
@@ -193,6 +210,7 @@ MergeResult mergeSweep(const std::string& dir, bool plots) {
         csv << rows;
         ++r.merged;
     }
+    removePreviousReport(dir);
     writeFileAtomic(dir + "/plan.json", plan.dump(2, ' ', false, Json::error_handler_t::replace) + "\n");
     writeFileAtomic(dir + "/sweep.csv", csv.str());
     if (r.merged > 0) checkMergeMeasures(sweep, snapshot, measured);
