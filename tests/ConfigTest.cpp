@@ -72,7 +72,7 @@ struct BadCase {
 };
 
 const BadCase kBad[] = {
-    {"images_frame_twice", R"({"frames": 3, "output": {"images_at_frames": [1, 0, 1]}})", "/output/images_at_frames", "listed twice"},
+    {"images_frame_twice", R"({"frames": 3, "output": {"images_at_frames": [1, 0, 1]}})", "/output/images_at_frames/2", "listed twice"},
     // Expectations (docs/config.md, `expect`): each entry's problem at its own path.
     {"expect_not_a_list", R"({"expect": {"id": "shadow_map"}})", "/expect", "expected a list"},
     {"expect_unknown_id", R"({"expect": [{"id": "psb", "measure": "overflow", "max": 0}]})", "/expect/0/id", "not an algorithm id"},
@@ -119,7 +119,7 @@ const BadCase kBad[] = {
      "duplicate id"},
     {"unsupported_light", R"({"light": {"type": "area"}})", "/algorithms/0/algorithm", "does not support area"},
     {"bad_light_type", R"({"light": {"type": "laser"}})", "/light/type", "accepted: point, spot"},
-    {"image_frame_outside", R"({"frames": 5, "output": {"images_at_frames": [7]}})", "/output/images_at_frames", "outside"},
+    {"image_frame_outside", R"({"frames": 5, "output": {"images_at_frames": [7]}})", "/output/images_at_frames/0", "outside"},
     {"unknown_camera_key", R"({"camera": {"fov": 60}})", "/camera/fov", "accepted keys"},
     {"keyframes_not_increasing", R"({"camera": {"path": {"keyframes": [{"time": 1, "position": [0,0,0]}, {"time": 1, "position": [1,0,0]}]}}})",
      "/camera/path/keyframes/1/time", "increase"},

@@ -173,6 +173,11 @@ std::vector<BadCase> badCases() {
          {"m.gltf", "/accessors/0/normalized", "FLOAT"}},
         {"GltfNodePathBeyondNodes", "m.gltf", test::triangleGltf({}), {"m.gltf", "node 7"},
          R"(, "node_paths": [{"node": 7, "path": {"keyframes": [{"time": 0}]}}])"},
+        // Probe 26: a path on a node with no mesh at or below it was taken, and moved nothing.
+        {"GltfNodePathOnANodeWithoutAMesh", "m.gltf",
+         test::triangleGltf({{"nodes", R"([{"mesh": 0}, {"name": "empty"}])"}, {"scenes", R"([{"nodes": [0, 1]}])"}}),
+         {"m.gltf", "/nodes/1", "would move nothing"},
+         R"(, "node_paths": [{"node": 1, "path": {"keyframes": [{"time": 0}, {"time": 1, "translate": [1, 0, 0]}]}}])"},
         {"GlbWithDeepExtras", "m.glb", test::glbOf(test::triangleGltf({{"extras", deep}})), {"m.glb", "nesting deeper"}},
         {"GltfRequiresUnknownExtension", "m.gltf", test::triangleGltf({{"extensionsRequired", R"(["EXT_imaginary"])"}}),
          {"/extensionsRequired/0", "EXT_imaginary"}},

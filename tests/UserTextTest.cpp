@@ -313,6 +313,15 @@ TEST(UserTextTest, MergeStagesAreCheckedAgainstWhatTheRunsMeasured) {
     for (const char* old : {"sweep.md", "sweep.html", "sweep_size.png", "sweep_stages.png"}) EXPECT_FALSE(fs::exists(out + "/" + old)) << old;
 }
 
+// Probe 26: a TMPDIR holding a line break refused every run of a valid sweep at `plan --check`,
+// as if the runs were at fault; the check's scratch folder goes to /tmp then.
+TEST(UserTextTest, AnUnusableTmpdirIsNotASweepsFault) {
+    const std::string dir = test::makeTempDir("user-text-tmpdir");
+    const std::string file = test::writeJson(dir + "/s.sweep.json", test::twoRunSweep());
+    const Result r = shell("TMPDIR=\"$(printf '" + dir + "/t\\nx')\" " + kBin + " sweep plan " + file + " --check");
+    EXPECT_EQ(r.rc, 0) << r.out;
+}
+
 TEST(UserTextTest, AnEmptyOutIsRefused) {
     const Result r = shell(kBin + " run " + kSmoke + " --out ''");
     EXPECT_EQ(r.rc, 2) << r.out;

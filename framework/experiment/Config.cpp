@@ -376,10 +376,11 @@ ExperimentConfig parseConfig(const Json& json, const std::string& file, bool loa
     std::unordered_set<int> listed;
     for (size_t k = 0; k < c.imagesAtFrames.size(); ++k) {
         const int f = c.imagesAtFrames[k];
-        if (f < 0 || f >= c.frames)
-            out.fail("images_at_frames", "frame " + std::to_string(f) + " is outside [0, " + std::to_string(c.frames - 1) + "]");
+        // At the element (probe 26: the list was named, not which of its frames).
+        const std::string at = "images_at_frames/" + std::to_string(k);
+        if (f < 0 || f >= c.frames) out.fail(at, "frame " + std::to_string(f) + " is outside [0, " + std::to_string(c.frames - 1) + "]");
         if (!listed.insert(f).second) // a set, not a scan of the list so far (twenty-third probe: 1 M frames took minutes)
-            out.fail("images_at_frames", "frame " + std::to_string(f) + " is listed twice");
+            out.fail(at, "frame " + std::to_string(f) + " is listed twice");
     }
     c.plots = out.getBool("plots", true);
     out.finish();

@@ -115,6 +115,8 @@ private:
     std::vector<float> floats(int accessor, int type, const std::string& path);
     /// Centre of the bounding box of every mesh vertex at or below `node`, in the node's own frame.
     glm::vec3 subtreeCentre(size_t node);
+    /// Whether a mesh hangs at or below `node` (the file's node graph is a forest, checked before).
+    bool subtreeHasMesh(size_t node) const;
 
     const std::string& file_;
     const tinygltf::Model& m_;
@@ -142,6 +144,17 @@ glm::vec3 Loader::subtreeCentre(size_t node) {
         for (int c : nd.children) stack.emplace_back(size_t(c), m * localMatrix(m_.nodes[size_t(c)]));
     }
     return b.empty() ? glm::vec3(0.0f) : b.center();
+}
+
+bool Loader::subtreeHasMesh(size_t node) const {
+    std::vector<size_t> stack{node};
+    while (!stack.empty()) {
+        const auto& nd = m_.nodes[stack.back()];
+        stack.pop_back();
+        if (nd.mesh != -1) return true;
+        for (int c : nd.children) stack.push_back(size_t(c));
+    }
+    return false;
 }
 
 std::vector<float> Loader::floats(int accessor, int type, const std::string& path) {
@@ -221,6 +234,10 @@ std::shared_ptr<const NodeAnimation> Loader::readAnimation() {
                                std::to_string(m_.nodes.size()) + " nodes");
         if (anim->extra[nm.node])
             fail("/nodes/" + std::to_string(nm.node), "two node paths move this node; give each node one path");
+        // A path that moves nothing is a mistake, not a motion (probe 26: accepted, it did nothing).
+        if (!subtreeHasMesh(nm.node))
+            fail("/nodes/" + std::to_string(nm.node), "a node path moves this node, which carries no mesh and has none below it: "
+                                                      "it would move nothing");
         if (nm.aboutCentre) {
             // Spin about the middle of what the node carries, not its frame's origin (which in
             // many files sits far from the part and would swing it round the scene).

@@ -19,8 +19,11 @@ namespace {
 class ScratchFolder {
 public:
     ScratchFolder() {
+        // TMPDIR when it is an absolute path the runs' own check takes, else /tmp (probe 26: a line
+        // break in TMPDIR refused every run of a valid sweep, naming the run).
         const char* tmp = std::getenv("TMPDIR");
-        std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/shadowlab-sweep-check-XXXXXX";
+        const bool usable = tmp && tmp[0] == '/' && pathTextProblem(tmp).empty();
+        std::string pattern = std::string(usable ? tmp : "/tmp") + "/shadowlab-sweep-check-XXXXXX";
         if (!mkdtemp(pattern.data())) throw RuntimeError("sweep plan --check: cannot make a temporary folder in " + shortText(pattern, 200));
         path_ = pattern;
     }
