@@ -83,6 +83,11 @@ const BadSweep kBadSweeps[] = {
      R"({"axes": [{"name": "m", "values": {"scene.objects.0": [{"procedural": "plane"}, {"gltf": "d\u202e/../m.gltf"}]}}]})",
      "/axes/0|/scene/objects/0/gltf|U+202E"},
     {"RatioTwice", R"({"merge": {"ratios": ["psv/shadow_map", "psv/shadow_map"]}})", "/merge/ratios/1|given twice"},
+    // Probe 26: an axis whose values break a valid base's expectations blamed the base.
+    {"AxisValuesBreakAValidBase",
+     R"({"base": {"expect": [{"id": "psv", "measure": "overflow", "max": 0}]},
+         "axes": [{"name": "al", "values": {"algorithms": [[{"algorithm": "psv"}], [{"algorithm": "shadow_map"}]]}}], "merge": null})",
+     "bad.sweep.json: at /axes: run 1 (al=|/expect/0/id"},
     // Probe 26: a ratio of two ids that never meet in one run gave a table of no rows.
     {"RatioOfIdsThatNeverMeet",
      R"({"axes": [{"name": "a", "values": {"algorithms": [[{"algorithm": "psv", "id": "x"}], [{"algorithm": "psv", "id": "y"}]]}}],

@@ -238,7 +238,20 @@ Json resolveRun(const Json& config, const std::string& file) {
                 throw InputError(s.file, axisWhere(a, axis) + ", path " + axis.paths[p] + " = " + shortText(axis.values[p][run.point[a]].dump(), 80),
                                  "at " + e.jsonPath() + ": " + e.cause());
     }
-    // Not an axis path: the base config itself is wrong (in the sweep file at /base, or in its own file).
+    // Not at an axis path, but the base alone is valid: the axes' values together caused it (probe
+    // 26: an axis swapping the algorithms broke the base's expectations, and the base was blamed).
+    if (!s.axes.empty()) {
+        bool baseAloneValid = true;
+        try {
+            resolveRun(s.base, baseFile);
+        } catch (const InputError&) {
+            baseAloneValid = false;
+        }
+        if (baseAloneValid)
+            throw InputError(s.file, "/axes", "run " + std::to_string(run.index) + " (" + runLabel(s, run) + "), its config at " +
+                                                  e.jsonPath() + ": " + e.cause());
+    }
+    // The base config itself is wrong (in the sweep file at /base, or in its own file).
     throw InputError(baseWhere.empty() ? baseFile : s.file, baseWhere + e.jsonPath(),
                      e.cause() + " (run " + std::to_string(run.index) + ": " + runLabel(s, run) + ")");
 }
