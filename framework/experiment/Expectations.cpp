@@ -105,8 +105,8 @@ std::vector<Expectation> parseExpectations(JsonNode& root, const ExpectationIds&
                                     for (const auto& id : ids.all) s += (s.empty() ? "" : ", ") + id;
                                     return s + (ids.reference ? ", reference" : "");
                                 }(), 200) +
-                                "; \"*\" for every algorithm, \"*exact\" for the exact ones; with the algorithms changed by "
-                                "--set, --set expect=[] leaves the expectations out)");
+                                "; \"*\" for every algorithm, \"*exact\" for the exact ones; where a --set or a sweep's "
+                                "axis changes the algorithms, \"expect\": [] (--set expect=[]) leaves the expectations out)");
         e.measure = node.requireString("measure");
         if (const std::string why = measureProblem(e.measure); !why.empty()) node.fail("measure", why);
         if (e.measure.starts_with("accuracy.") && !ids.reference)
