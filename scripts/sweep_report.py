@@ -187,6 +187,11 @@ def fit_table(s, axis):
                 if fit:
                     ratios = ", ".join(f"{x:.2f}" for x in nlogn_ratio([p[0] for p in pts], [p[1] for p in pts]))
                     lines.append(row_line([literal(k) for k in key] + [literal(aid), literal(st), f"{fit[0]:.2f}", ratios]))
+    if len(lines) == 4:
+        # A table of no row says nothing of why: a fit needs two points of different n with times
+        # above 0 in one group of the other axes (probe 26: every point had one triangle count).
+        lines += ["", "No fit: no group of runs holds two points of different n with times above 0 "
+                      "(a fit needs at least two sizes)."]
     return lines
 
 

@@ -530,6 +530,7 @@ TEST(SweepTest, MergeWritesTheTidyTableReportAndPlots) {
     md << mdFile.rdbuf();
     for (const char* part : {"## By `tris`", "## By `pcf`", "## psv / shadow_map", "## Power-law fits along `tris`"})
         EXPECT_NE(md.str().find(part), std::string::npos) << part << "\n" << md.str();
+    EXPECT_EQ(md.str().find("No fit:"), std::string::npos) << md.str();
     EXPECT_TRUE(fs::exists(out + "/sweep_tris.png"));
     EXPECT_TRUE(fs::exists(out + "/sweep_pcf.png"));
 }

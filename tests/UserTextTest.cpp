@@ -313,6 +313,29 @@ TEST(UserTextTest, MergeStagesAreCheckedAgainstWhatTheRunsMeasured) {
     for (const char* old : {"sweep.md", "sweep.html", "sweep_size.png", "sweep_stages.png"}) EXPECT_FALSE(fs::exists(out + "/" + old)) << old;
 }
 
+// Probe 26: a size axis whose runs all hold one triangle count gave a fit table of no rows and
+// no word; it says why now.
+TEST(UserTextTest, AFitTableWithNothingToFitSaysSo) {
+    const std::string dir = test::makeTempDir("user-text-no-fit");
+    Json s = test::smallSweep();
+    s["axes"] = Json::parse(R"([{"name": "pcf", "values": {"algorithms.0.params.pcf": [0, 1]}, "scale": "triangles"}])");
+    const std::string file = test::writeJson(dir + "/nofit.sweep.json", s), out = dir + "/out";
+    ASSERT_FALSE(test::fakeSweepRuns(kBin, file, out).is_null());
+    // Both runs of one size, as the axis (pcf) leaves the scene alone.
+    for (const auto& run : fs::directory_iterator(out + "/runs")) {
+        if (!run.is_directory()) continue;
+        Json summary = Json::parse(std::ifstream(run.path() / "summary.json"));
+        summary["triangles"] = 1000;
+        std::ofstream(run.path() / "summary.json") << summary.dump();
+    }
+    const Result r = shell(kBin + " sweep merge " + out + " --no-plots");
+    ASSERT_EQ(r.rc, 0) << r.out;
+    std::stringstream md;
+    md << std::ifstream(out + "/sweep.md").rdbuf();
+    EXPECT_NE(md.str().find("## Power-law fits along `pcf`"), std::string::npos) << md.str();
+    EXPECT_NE(md.str().find("No fit: no group of runs holds two points of different n"), std::string::npos) << md.str();
+}
+
 // Probe 26: a TMPDIR holding a line break refused every run of a valid sweep at `plan --check`,
 // as if the runs were at fault; the check's scratch folder goes to /tmp then.
 TEST(UserTextTest, AnUnusableTmpdirIsNotASweepsFault) {
