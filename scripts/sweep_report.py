@@ -175,6 +175,7 @@ def fit_table(s, axis):
     lines = [f"## Power-law fits along {code(axis['name'])}: time = c · n^k ({xname}; least squares in log-log)", "",
              row_line([literal(a["name"]) for a in others] + ["id", "stage", "k", "t / (n log n), normalised to the smallest n"]),
              "|" + "---|" * len(others) + "---|---|---:|---|"]
+    header = len(lines)
     groups = defaultdict(list)
     for run in s.ordered_runs(axis):
         groups[s.group_key(axis, run)].append(run)
@@ -187,7 +188,7 @@ def fit_table(s, axis):
                 if fit:
                     ratios = ", ".join(f"{x:.2f}" for x in nlogn_ratio([p[0] for p in pts], [p[1] for p in pts]))
                     lines.append(row_line([literal(k) for k in key] + [literal(aid), literal(st), f"{fit[0]:.2f}", ratios]))
-    if len(lines) == 4:
+    if len(lines) == header:
         # A table of no row says nothing of why: a fit needs two points of different n with times
         # above 0 in one group of the other axes (probe 26: every point had one triangle count).
         lines += ["", "No fit: no group of runs holds two points of different n with times above 0 "

@@ -495,8 +495,8 @@ Json compareImages(const std::string& baseDir, const std::string& newDir, const 
     Json out = Json::array();
     const std::string prefix = id + "_f";
     auto isKind = [](const std::string& kind) {
-        if (kind == "visibility" || kind == "shaded" || kind == "diff") return true;
-        return kind.size() > 5 && kind.starts_with("heat_") && kind.find("_changed") == std::string::npos;
+        return std::find(kFrameImageKinds.begin(), kFrameImageKinds.end(), kind) != kFrameImageKinds.end() ||
+               (kind.starts_with(kHeatMapPrefix) && kind.size() > std::strlen(kHeatMapPrefix));
     };
     std::error_code ec;
     std::set<std::pair<int, std::string>> saved; // (frame, kind)

@@ -21,9 +21,10 @@ void writeFrameImages(const std::string& dir, const std::string& id, int frame, 
                       const std::vector<float>& vis, const std::vector<float>* ref, const std::vector<uint8_t>& lit,
                       const std::vector<uint8_t>& covered) {
     const std::string base = dir + "/images/" + frameImagePrefix(id, frame);
-    writePngRGBA(base + "shaded.png", res.x, res.y, readTextureRGBA8(shading.output(), res.x, res.y));
-    writePngRGBA(base + "visibility.png", res.x, res.y, visibilityImage(vis, covered));
-    if (ref) writePngRGBA(base + "diff.png", res.x, res.y, differenceImage(vis, *ref, lit));
+    const auto& [shaded, visibility, diff] = kFrameImageKinds;
+    writePngRGBA(base + shaded + ".png", res.x, res.y, readTextureRGBA8(shading.output(), res.x, res.y));
+    writePngRGBA(base + visibility + ".png", res.x, res.y, visibilityImage(vis, covered));
+    if (ref) writePngRGBA(base + diff + ".png", res.x, res.y, differenceImage(vis, *ref, lit));
 }
 
 namespace {
@@ -56,14 +57,14 @@ void writeHeatMaps(const std::string& dir, const std::string& id, int frame, glm
         const DebugView& view = views[k];
         auto values = readTextureR32F(view.texture, res.x, res.y);
         const HeatScale scale = heatMapScale(values, view.maxValue);
-        const std::string image = prefix + "heat_" + view.name + ".png";
+        const std::string image = prefix + kHeatMapPrefix + view.name + ".png";
         writePngRGBA(dir + "/images/" + image, res.x, res.y, heatMapImage(values, scale));
         // The PNG holds colours only: its legend (what the colours mean) is this file beside it.
         nlohmann::json legend = heatMapLegend(view, scale, image, res);
         legend["id"] = id;
         legend["frame"] = frame;
         legend["view_index"] = k; // the algorithm's order of its views, which readers keep
-        const std::string path = dir + "/images/" + prefix + "heat_" + view.name + ".json";
+        const std::string path = dir + "/images/" + prefix + kHeatMapPrefix + view.name + ".json";
         writeFileAtomic(path, legend.dump(2) + "\n");
     }
 }

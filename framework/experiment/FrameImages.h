@@ -4,6 +4,8 @@
 #include "framework/render/ShadingPass.h"
 
 #include <glm/glm.hpp>
+
+#include <array>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,11 @@ namespace shadowlab {
 
 /// ID_fNNNN_: the prefix of every image of one algorithm on one frame.
 std::string frameImagePrefix(const std::string& id, int frame);
+
+/// The images a frame may have, ID_fNNNN_KIND.png: writeFrameImages' kinds, and writeHeatMaps'
+/// kHeatMapPrefix + NAME (what `compare` reads back).
+inline constexpr std::array<const char*, 3> kFrameImageKinds = {"shaded", "visibility", "diff"};
+inline constexpr const char* kHeatMapPrefix = "heat_";
 
 /// From the timed pass: shaded.png, visibility.png and, against the reference, diff.png.
 void writeFrameImages(const std::string& dir, const std::string& id, int frame, glm::ivec2 res, ShadingPass& shading,

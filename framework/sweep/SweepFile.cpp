@@ -265,8 +265,10 @@ std::string idList(const std::set<std::string>& ids) {
 /// merge.ratios and merge.paper name algorithm ids: each must be one that some run measures, and a
 /// ratio's two ids must meet in some run, or the table it asks for would be empty (probe 26: an
 /// axis that swaps one id for the other gave a ratio table of no rows, and no word).
-void checkMergeIds(const Sweep& s, const std::set<std::string>& ids, const std::vector<std::set<std::string>>& idsPerRun) {
+void checkMergeIds(const Sweep& s, const std::vector<std::set<std::string>>& idsPerRun) {
     if (!s.merge.is_object()) return;
+    std::set<std::string> ids; // in any run
+    for (const auto& run : idsPerRun) ids.insert(run.begin(), run.end());
     const auto unknown = [&](const std::string& where, const std::string& id) {
         throw InputError(s.file, where, "\"" + shortText(id, 60) + "\" is not the id of an algorithm in any run (ids: " + idList(ids) + ")");
     };
@@ -511,8 +513,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
     // One run at a time: its config is made, validated and dropped before the next, so memory is
     // the base's a few times over, whatever the number of runs.
     std::map<std::string, size_t> ids;
-    std::set<std::string> idsInRuns;
-    std::vector<std::set<std::string>> idsPerRun; // the ids of each run, for the ratios
+    std::vector<std::set<std::string>> idsPerRun; // the ids of each run, for merge's ids and ratios
     s.runs.reserve(total);
     for (size_t index = 0; index < total; ++index) {
         SweepRun run;
@@ -535,7 +536,6 @@ Sweep parseSweep(const Json& json, const std::string& file) {
                 }
             }
             s.runs.back().id = runId(resolved);
-            collectIds(resolved, idsInRuns);
             collectIds(resolved, idsPerRun.emplace_back());
         } catch (const Json::exception& e) {
             // Text that JSON cannot hold (a path that is not UTF-8) or a value of the wrong type
@@ -547,7 +547,7 @@ Sweep parseSweep(const Json& json, const std::string& file) {
                                   std::to_string(index) + " (" + runLabel(s, run) +
                                   ") resolve to the same config (an axis repeats a value, or sets one to its default)");
     }
-    checkMergeIds(s, idsInRuns, idsPerRun);
+    checkMergeIds(s, idsPerRun);
     return s;
 }
 
