@@ -117,6 +117,8 @@ TEST_F(CompareGLTest, ImagesThatCannotBeComparedAreNamed) {
     std::filesystem::copy_file(dir + "/base/images/psv_f0002_diff.png", dir + "/base/images/psv_f0002_heat_nodes_visited.png");
     std::filesystem::copy_file(dir + "/base/images/psv_f0002_visibility.png", dir + "/broken/images/psv_f0002_heat_nodes_visited.png");
     std::filesystem::copy_file(dir + "/base/images/psv_f0002_diff.png", dir + "/base/images/psv_f0002_heat_stack_overflow.png");
+    // A file whose "name" is markup is no heat map of ours: not read, never written into the report.
+    std::filesystem::copy_file(dir + "/base/images/psv_f0002_diff.png", dir + "/broken/images/psv_f0002_heat_x)![a](b.png");
     const Comparison c = compareRuns(dir + "/base", dir + "/broken", {});
     auto noted = [&](const std::string& id, const std::string& kind) {
         const Json& im = image(record(c, id)["images"], kind);
@@ -129,6 +131,7 @@ TEST_F(CompareGLTest, ImagesThatCannotBeComparedAreNamed) {
     noted("bvh_raytrace", "diff");
     EXPECT_GT(image(record(c, "psv")["images"], "heat_nodes_visited")["changed_pixels"].get<size_t>(), 0u) << record(c, "psv")["images"].dump();
     noted("psv", "heat_stack_overflow");
+    for (const Json& im : record(c, "psv")["images"]) EXPECT_EQ(im["image"].get<std::string>().find('!'), std::string::npos) << im.dump();
     EXPECT_GT(image(record(c, "bvh_raytrace")["images"], "shaded")["changed_pixels"].get<size_t>(), 0u);
     EXPECT_EQ(image(record(c, "psv")["images"], "diff")["changed_pixels"], 0u);
     const std::string md = comparisonMarkdown(c, dir + "/base", dir + "/broken", {});

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <optional>
@@ -494,9 +495,13 @@ Json compareImagePair(const std::string& baseDir, const std::string& newDir, con
 Json compareImages(const std::string& baseDir, const std::string& newDir, const std::string& id, const std::string& imagesDir) {
     Json out = Json::array();
     const std::string prefix = id + "_f";
+    // A heat map's name is an identifier (a debug view's): a file name of other text in a run's
+    // folder is no image of ours, and never reaches the report or a picture's name.
     auto isKind = [](const std::string& kind) {
+        const size_t p = std::strlen(kHeatMapPrefix);
         return std::find(kFrameImageKinds.begin(), kFrameImageKinds.end(), kind) != kFrameImageKinds.end() ||
-               (kind.starts_with(kHeatMapPrefix) && kind.size() > std::strlen(kHeatMapPrefix));
+               (kind.starts_with(kHeatMapPrefix) && kind.size() > p && kind.size() <= p + 64 &&
+                std::all_of(kind.begin() + long(p), kind.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }));
     };
     std::error_code ec;
     std::set<std::pair<int, std::string>> saved; // (frame, kind)
@@ -726,13 +731,14 @@ std::string comparisonMarkdown(const Comparison& c, const std::string& baseDir, 
                << " → " << shortNumber(v["new"].get<double>(), 4) << "\n";
         for (const Json& im : r["images"]) {
             if (im.contains("note")) {
-                os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << " " << im["image"].get<std::string>()
-                   << ": image not compared: "
+                os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << " "
+                   << markdownLiteral(im["image"].get<std::string>()) << ": image not compared: "
                    << markdownLiteral(im["note"].get<std::string>()) << "\n";
                 continue;
             }
             if (im["changed_pixels"].get<size_t>() == 0) continue;
-            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << " " << im["image"].get<std::string>() << ": "
+            os << "- " << markdownLiteral(r["id"].get<std::string>()) << " frame " << im["frame"] << " "
+               << markdownLiteral(im["image"].get<std::string>()) << ": "
                << im["changed_pixels"] << " of " << im["pixels"] << " pixels changed";
             if (im.contains("picture")) os << "\n\n  ![changed pixels](" << im["picture"].get<std::string>() << ")";
             os << "\n";
